@@ -1,0 +1,334 @@
+// spaceskip: command-line renderer, generator and benchmark over Core (no VTK).
+#include "spaceskip/Engine.h"
+#include "spaceskip/Generators.h"
+#include "spaceskip/ImageIO.h"
+#include "spaceskip/VolumeIO.h"
+
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace spaceskip;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+const char* kUsage = R"(usage:
+  spaceskip generate SHAPE --dims X Y Z [--seed N] -o FILE(.nrrd|_XxYxZ_TYPE.raw)
+      SHAPE: menger nbody shell noise rm vessels
+  spaceskip render VOLUME -o out.png [options]
+  spaceskip bench VOLUME... [--builders b1,b2,...] [--frames N] [--json FILE] [--csv FILE] [options]
+
+  VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
+options:
+  --builder B        naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu kdtree-gpu-fast hybrid
+  --leaf shallow|deep  --mls N  --bins N  --brick N
+  --backend auto|cpu|cuda     --threads N (oneTBB worker limit)
+  --tf PRESET|FILE   presets: ramp grayscale coolwarm band spike opaque zero
+  --size WxH         (render default 512x512, bench default 1024x1024)
+  --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective
+  --sample-distance D  (world units; default half the smallest spacing)
+  --ert T  --jitter  --filter exact|hardware
+  --compare REF.png  print max difference and PSNR against a reference image
+)";
+
+struct Options {
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> kv;
+  bool has(const std::string& k) const { return kv.count(k) != 0; }
+  std::string get(const std::string& k, const std::string& def) const {
+    auto it = kv.find(k);
+    return it == kv.end() ? def : it->second;
+  }
+};
+
+Options parseArgs(int argc, char** argv, int first) {
+  static const char* flags[] = {"--perspective", "--jitter"};
+  Options o;
+  for (int i = first; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.rfind("--", 0) == 0 || a == "-o") {
+      bool isFlag = false;
+      for (const char* f : flags) isFlag |= a == f;
+      if (isFlag) { o.kv[a] = "1"; continue; }
+      if (a == "--dims") {
+        if (i + 3 >= argc) throw std::invalid_argument("--dims needs X Y Z");
+        o.kv[a] = std::string(argv[i + 1]) + "x" + argv[i + 2] + "x" + argv[i + 3];
+        i += 3;
+        continue;
+      }
+      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+      o.kv[a] = argv[++i];
+    } else {
+      o.positional.push_back(a);
+    }
+  }
+  return o;
+}
+
+vec3l parseDims(const std::string& s) {
+  long long x, y, z;
+  char c1, c2;
+  std::istringstream is(s);
+  if (is >> x >> c1 >> y >> c2 >> z && c1 == 'x' && c2 == 'x') return vec3l{x, y, z};
+  std::istringstream is2(s);
+  if (is2 >> x && is2.eof()) return vec3l{x, x, x};
+  throw std::invalid_argument("bad dims '" + s + "' (N or XxYxZ)");
+}
+
+Volume openVolume(const std::string& spec) {
+  if (spec.rfind("gen:", 0) == 0) {
+    std::string rest = spec.substr(4);
+    size_t c = rest.find(':');
+    if (c == std::string::npos) throw std::invalid_argument("expected gen:SHAPE:N, got " + spec);
+    return generateVolume(rest.substr(0, c), parseDims(rest.substr(c + 1)));
+  }
+  return loadVolume(spec);
+}
+
+TransferFunction makeTF(const Options& o, const Volume& v) {
+  double lo, hi;
+  if (!v.scalarRange(lo, hi)) lo = 0, hi = 1;
+  std::string t = o.get("--tf", "ramp");
+  std::ifstream probe(t);
+  if (probe.good()) return TransferFunction::load(t, lo, hi);
+  return TransferFunction::preset(t, lo, hi);
+}
+
+BuildParams buildParams(const Options& o, const std::string& builder) {
+  BuildParams p;
+  if (!parseBuilder(builder, p.builder)) throw std::invalid_argument("unknown builder '" + builder + "'");
+  std::string leaf = o.get("--leaf", "deep");
+  if (leaf == "shallow") p.leaf = LeafCriterion::Shallow;
+  else if (leaf == "deep") p.leaf = LeafCriterion::Deep;
+  else throw std::invalid_argument("--leaf must be shallow or deep");
+  p.maxLeafSize = std::stoi(o.get("--mls", "0"));
+  p.bins = std::stoi(o.get("--bins", "4"));
+  p.brick = std::stoi(o.get("--brick", "8"));
+  if (p.maxLeafSize < 0 || p.bins < 2 || p.brick < 1) throw std::invalid_argument("bad --mls/--bins/--brick");
+  return p;
+}
+
+RenderParams renderParams(const Options& o) {
+  RenderParams r;
+  r.sampleDistance = std::stod(o.get("--sample-distance", "0"));
+  r.ertThreshold = std::stod(o.get("--ert", "2"));
+  r.jitter = o.has("--jitter");
+  std::string f = o.get("--filter", "exact");
+  if (f == "exact") r.filter = FilterMode::Exact;
+  else if (f == "hardware") r.filter = FilterMode::Hardware;
+  else throw std::invalid_argument("--filter must be exact or hardware");
+  return r;
+}
+
+BackendKind backendKind(const Options& o) {
+  std::string b = o.get("--backend", "auto");
+  if (b == "auto") return BackendKind::Auto;
+  if (b == "cpu") return BackendKind::CPU;
+  if (b == "cuda") return BackendKind::CUDA;
+  throw std::invalid_argument("--backend must be auto, cpu or cuda");
+}
+
+void parseSize(const std::string& s, int& w, int& h) {
+  char x;
+  std::istringstream is(s);
+  if (!(is >> w >> x >> h) || x != 'x' || w <= 0 || h <= 0) throw std::invalid_argument("bad --size '" + s + "'");
+}
+
+Camera makeCamera(const Options& o, const Volume& v, int w, int h, double azDefault = 30, double elDefault = 20) {
+  double az = azDefault, el = elDefault, zoom = 1;
+  if (o.has("--camera")) {
+    std::string c = o.get("--camera", "");
+    for (char& ch : c) if (ch == ',') ch = ' ';
+    std::istringstream is(c);
+    if (!(is >> az >> el)) throw std::invalid_argument("--camera needs AZ,EL[,ZOOM]");
+    is >> zoom;
+  }
+  double b[6];
+  v.worldBounds(b);
+  return orbitCamera(b, az, el, zoom, o.has("--perspective"), double(w) / h);
+}
+
+int cmdGenerate(const Options& o) {
+  if (o.positional.size() != 1 || !o.has("--dims") || !o.has("-o"))
+    throw std::invalid_argument("generate needs SHAPE --dims X Y Z -o FILE");
+  vec3l d = parseDims(o.get("--dims", ""));
+  auto t0 = Clock::now();
+  Volume v = generateVolume(o.positional[0], d, unsigned(std::stoul(o.get("--seed", "1"))));
+  double gen = since(t0);
+  std::string out = o.get("-o", "");
+  if (out.size() > 5 && out.substr(out.size() - 5) == ".nrrd") saveNrrd(v, out);
+  else {
+    vec3l pd;
+    VoxelType pt;
+    if (!parseRawName(out, pd, pt) || pd.x != d.x || pd.y != d.y || pd.z != d.z || pt != v.type)
+      throw std::invalid_argument(std::string("output must end in .nrrd or be named NAME_") + std::to_string(d.x) + "x" +
+                                  std::to_string(d.y) + "x" + std::to_string(d.z) + "_" + voxelTypeName(v.type) + ".raw");
+    saveRaw(v, out);
+  }
+  std::printf("generated %s %lldx%lldx%lld %s in %.3f s -> %s\n", o.positional[0].c_str(), (long long)d.x,
+              (long long)d.y, (long long)d.z, voxelTypeName(v.type), gen, out.c_str());
+  return 0;
+}
+
+int cmdRender(const Options& o) {
+  if (o.positional.size() != 1 || !o.has("-o")) throw std::invalid_argument("render needs VOLUME -o out.png");
+  auto t0 = Clock::now();
+  Volume v = openVolume(o.positional[0]);
+  double load = since(t0);
+  int w = 512, h = 512;
+  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  Engine engine(backendKind(o));
+  engine.setVolume(v);
+  engine.setTransferFunction(makeTF(o, v));
+  engine.setBuildParams(buildParams(o, o.get("--builder", "grid")));
+  engine.setRenderParams(renderParams(o));
+  auto t1 = Clock::now();
+  engine.update();
+  double prep = since(t1);
+  Image img;
+  Camera cam = makeCamera(o, v, w, h);
+  engine.render(cam, w, h, img);  // first frame (warm-up)
+  engine.render(cam, w, h, img);
+  const BuildStats& s = engine.buildStats();
+  std::printf("volume %s: %lldx%lldx%lld %s, load %.3f s\n", o.positional[0].c_str(), (long long)v.dims.x,
+              (long long)v.dims.y, (long long)v.dims.z, voxelTypeName(v.type), load);
+  std::printf("backend %s, builder %s: ranges+classify+build %.3f s (classify %.4f s, build %.4f s), "
+              "nodes %lld, height %d, leaves %lld, occupied bricks %.2f%%\n",
+              engine.backendName(), builderName(s.builder), prep, s.classifySeconds, s.seconds,
+              (long long)s.nodes, s.height, (long long)s.leaves, 100.0 * s.occupancy);
+  std::printf("render %dx%d: %.4f s (%.2f fps), sample distance %g\n", w, h, engine.frameStats().seconds,
+              1.0 / engine.frameStats().seconds, engine.sampleDistance());
+  savePng(img, o.get("-o", ""));
+  std::printf("wrote %s\n", o.get("-o", "").c_str());
+  if (o.has("--compare")) {
+    ImageDiff d = compareImages(img, loadPng(o.get("--compare", "")));
+    std::printf("compare: max diff %.5f (%.2f/255), PSNR %.2f dB, %lld pixels > 1/255\n", d.maxAbs, d.maxAbs * 255,
+                d.psnr, (long long)d.differing);
+  }
+  return 0;
+}
+
+std::vector<std::string> split(const std::string& s, char c) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, c))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+int cmdBench(const Options& o) {
+  if (o.positional.empty()) throw std::invalid_argument("bench needs at least one VOLUME");
+  std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
+  int frames = std::stoi(o.get("--frames", "8"));
+  int w = 1024, h = 1024;
+  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  std::ostringstream json;
+  json << "[\n";
+  std::ofstream csv;
+  if (o.has("--csv")) {
+    csv.open(o.get("--csv", ""));
+    csv << "dataset,dims,builder,backend,leaf,mls,bins,build_s,classify_s,fps,nodes,height,leaves,occupancy\n";
+  }
+  bool firstJson = true;
+  std::printf("%-22s %-16s %-6s %10s %10s %9s %10s %7s %10s\n", "dataset", "builder", "backend", "build_ms",
+              "classify_ms", "fps", "nodes", "height", "vs_naive");
+  for (const std::string& spec : o.positional) {
+    Volume v = openVolume(spec);
+    TransferFunction tf = makeTF(o, v);
+    double naiveFps = 0;
+    for (const std::string& b : builders) {
+      Engine engine(backendKind(o));
+      engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+      engine.setVolume(v);
+      engine.setTransferFunction(tf);
+      BuildParams bp = buildParams(o, b);
+      engine.setBuildParams(bp);
+      engine.setRenderParams(renderParams(o));
+      engine.update();
+      // Rebuild once more, timed alone (the first build includes one-time allocations).
+      BuildParams other = bp;
+      other.bins = bp.bins + 1;
+      engine.setBuildParams(other);
+      engine.update();
+      engine.setBuildParams(bp);
+      engine.update();
+      BuildStats s = engine.buildStats();
+      double b6[6];
+      v.worldBounds(b6);
+      Image img;
+      engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
+      double total = 0;
+      for (int f = 0; f < frames; ++f) {
+        engine.render(orbitCamera(b6, 360.0 * f / frames, 15, 1, false, double(w) / h), w, h, img);
+        total += engine.frameStats().seconds;
+      }
+      double fps = frames / total;
+      if (s.builder == BuilderKind::Naive) naiveFps = fps;
+      std::string dims = std::to_string(v.dims.x) + "x" + std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z);
+      std::string name = spec.substr(spec.find_last_of('/') + 1);
+      std::printf("%-22s %-16s %-6s %10.3f %10.3f %9.2f %10lld %7d %10s\n", name.c_str(), builderName(s.builder),
+                  engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, (long long)s.nodes, s.height,
+                  naiveFps > 0 ? (std::to_string(fps / naiveFps).substr(0, 5) + "x").c_str() : "-");
+      std::fflush(stdout);
+      const char* leaf = bp.leaf == LeafCriterion::Shallow ? "shallow" : "deep";
+      if (!firstJson) json << ",\n";
+      firstJson = false;
+      json << "  {\"dataset\": \"" << name << "\", \"dims\": \"" << dims << "\", \"builder\": \"" << builderName(s.builder)
+           << "\", \"backend\": \"" << engine.backendName() << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize
+           << ", \"bins\": " << bp.bins << ", \"build_s\": " << s.seconds << ", \"classify_s\": " << s.classifySeconds
+           << ", \"fps\": " << fps << ", \"nodes\": " << s.nodes << ", \"height\": " << s.height
+           << ", \"leaves\": " << s.leaves << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
+           << ", \"height_px\": " << h << ", \"frames\": " << frames << "}";
+      if (csv.is_open())
+        csv << name << "," << dims << "," << builderName(s.builder) << "," << engine.backendName() << "," << leaf << ","
+            << bp.maxLeafSize << "," << bp.bins << "," << s.seconds << "," << s.classifySeconds << "," << fps << ","
+            << s.nodes << "," << s.height << "," << s.leaves << "," << s.occupancy << "\n";
+    }
+  }
+  json << "\n]\n";
+  if (o.has("--json")) {
+    std::ofstream js(o.get("--json", ""));
+    js << json.str();
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "--help")) {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  try {
+    std::string cmd = argv[1];
+    Options o = parseArgs(argc, argv, 2);
+    std::unique_ptr<tbb::global_control> threads;
+    if (o.has("--threads"))
+      threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                      size_t(std::stoi(o.get("--threads", "1"))));
+    if (cmd == "generate") return cmdGenerate(o);
+    if (cmd == "render") return cmdRender(o);
+    if (cmd == "bench") return cmdBench(o);
+    std::fprintf(stderr, "unknown command '%s'\n%s", cmd.c_str(), kUsage);
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "spaceskip: error: %s\n", e.what());
+    return 1;
+  }
+}

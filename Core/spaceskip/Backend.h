@@ -1,0 +1,37 @@
+// The executor interface behind Engine: a oneTBB backend and a CUDA backend implement it.
+// Internal to Core (the VTK module only sees Engine).
+#pragma once
+#include "Engine.h"
+#include "Integrator.h"
+
+#include <memory>
+#include <string>
+
+namespace spaceskip {
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual BackendKind kind() const = 0;
+  virtual const char* name() const = 0;
+  /// Takes the volume (uploads it on the GPU) and computes the per-brick value ranges.
+  virtual void setVolume(const Volume& v, int brick) = 0;
+  /// Re-classifies bricks against the TF opacity; returns true when the occupancy changed.
+  virtual bool classify(const TransferFunction& tf) = 0;
+  /// The opacity-corrected table the integrator samples.
+  virtual void setTransferTable(const std::vector<vec4f>& corrected, float lo, float scale) = 0;
+  /// Builds the hierarchy `p.builder` asks for; throws BackendError when this backend cannot.
+  virtual void build(const BuildParams& p, BuildStats& stats) = 0;
+  /// `f` carries camera, box, sampling; the backend fills pointers and traversal kind.
+  virtual void render(FrameView f, FilterMode filter, const float* depth, Image& out) = 0;
+  virtual const OccupancyGrid& occupancy() = 0;
+  virtual Tree tree() = 0;
+};
+
+std::unique_ptr<Backend> makeCpuBackend();
+/// Throws BackendError when built without CUDA or when no usable device exists.
+std::unique_ptr<Backend> makeCudaBackend();
+/// True when this build has CUDA code and a device answers.
+bool cudaAvailable(std::string* why = nullptr);
+
+}  // namespace spaceskip

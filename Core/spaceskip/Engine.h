@@ -1,0 +1,137 @@
+// The one interface the CLI, the VTK mapper and the tests drive, whatever the backend.
+// It keeps what a scene needs and redoes only what a change requires:
+//   volume -> value ranges (once) -> TF opacity edit -> classification -> rebuild only if the
+//   occupancy changed; a colour-only edit updates the TF table alone.
+#pragma once
+#include "Camera.h"
+#include "Classification.h"
+#include "Tree.h"
+#include "TransferFunction.h"
+#include "Volume.h"
+
+#include <functional>
+#include <stdexcept>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace spaceskip {
+
+enum class BuilderKind : int {
+  Naive,          ///< no skipping (the paper's baseline)
+  Grid,           ///< DDA over the macro-cell occupancy grid
+  LBVH,           ///< paper 3.1 on the render backend's device (CUDA, or the oneTBB twin)
+  LBVHCPU,        ///< paper 3.1, oneTBB
+  KdTreeCPU,      ///< paper 3.2.1 (Vidal et al. 2008), oneTBB
+  KdTreeGPU,      ///< paper 3.2.2, CUDA, host-driven recursion
+  KdTreeGPUFast,  ///< ours: level-parallel CUDA k-d tree
+  Hybrid          ///< paper 3.3: shallow k-d tree + 16^3 grid
+};
+enum class LeafCriterion : int { Shallow, Deep };
+enum class BackendKind : int { Auto, CPU, CUDA };
+enum class FilterMode : int { Exact, Hardware };
+
+const char* builderName(BuilderKind b);
+/// Accepts CLI names (naive, grid, lbvh, lbvh-cpu, kdtree-cpu, kdtree-gpu, kdtree-gpu-fast, hybrid)
+/// and the VTK property names (Naive, Grid, LBVH, KdTreeCPU, ...), case-insensitively.
+bool parseBuilder(const std::string& s, BuilderKind& out);
+
+struct BuildParams {
+  BuilderKind builder = BuilderKind::Grid;
+  LeafCriterion leaf = LeafCriterion::Deep;
+  int maxLeafSize = 0;  ///< 0: none; else leaves' edge <= MLS cells (32 or 128 in the paper)
+  int bins = 4;         ///< candidate planes per node + 1 (KdTreeGPU/KdTreeGPUFast)
+  int brick = 8;        ///< macro-cell edge in cells (classification granularity)
+  bool operator==(const BuildParams& o) const {
+    return builder == o.builder && leaf == o.leaf && maxLeafSize == o.maxLeafSize &&
+           bins == o.bins && brick == o.brick;
+  }
+  bool operator!=(const BuildParams& o) const { return !(*this == o); }
+};
+
+struct RenderParams {
+  double sampleDistance = 0;   ///< world units; <= 0: half the smallest spacing
+  double ertThreshold = 2.0;   ///< early ray termination at this alpha; > 1 disables
+  bool jitter = false;
+  unsigned jitterSeed = 0;
+  FilterMode filter = FilterMode::Exact;
+};
+
+struct BuildStats {
+  BuilderKind builder = BuilderKind::Naive;
+  std::string builtOn;       ///< "cpu" or "cuda"
+  double seconds = 0;        ///< hierarchy construction
+  double classifySeconds = 0;
+  int64_t nodes = 0;
+  int height = 0;
+  int64_t leaves = 0;
+  double occupancy = 0;      ///< fraction of occupied macro cells
+};
+
+struct FrameStats {
+  double seconds = 0;
+  std::string backend;
+};
+
+/// How often each stage ran: what tests use to check "rebuild only what a change needs".
+struct Counters {
+  int rangeGrids = 0;
+  int classifications = 0;
+  int builds = 0;
+  int colorUpdates = 0;
+  int frames = 0;
+};
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<vec4f> rgba;  ///< premultiplied, row 0 at the bottom
+};
+
+/// Raised for errors the caller can fall back from (no CUDA device, device out of memory).
+struct BackendError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+class Backend;
+
+class Engine {
+ public:
+  /// Auto picks CUDA when a usable device exists, else the oneTBB backend.
+  explicit Engine(BackendKind backend = BackendKind::Auto);
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  BackendKind backendKind() const;
+  const char* backendName() const;
+  /// Messages (warnings, fallbacks) go here; default prints to stderr.
+  void setLogger(std::function<void(const std::string&)> log);
+
+  /// The engine borrows `v.data` (or shares `v.storage`): keep it alive while rendering.
+  void setVolume(const Volume& v);
+  void setTransferFunction(const TransferFunction& tf);
+  void setBuildParams(const BuildParams& p);
+  void setRenderParams(const RenderParams& p);
+  const BuildParams& buildParams() const;
+  const RenderParams& renderParams() const;
+
+  /// Brings ranges, classification and hierarchy up to date (render() calls it).
+  void update();
+  /// Renders `width` x `height` pixels; `depth` (optional) is the window depth of opaque
+  /// geometry per pixel, in [0,1], row 0 at the bottom.
+  void render(const Camera& cam, int width, int height, Image& out, const float* depth = nullptr);
+
+  const BuildStats& buildStats() const;
+  const FrameStats& frameStats() const;
+  const Counters& counters() const;
+  /// Host copies for tests and statistics (downloaded from the device if needed).
+  const OccupancyGrid& occupancy();
+  Tree tree();
+  double sampleDistance() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace spaceskip

@@ -1,0 +1,177 @@
+// The per-ray integrator (absorption + emission, front to back, post-classification), written
+// once for the oneTBB and CUDA executors. Sample positions are global per ray
+// (t = t0 + k*dt from the ray's entry into the volume box), so skipping never moves a sample.
+#pragma once
+#include "TransferFunction.h"
+#include "Traversal.h"
+
+namespace spaceskip {
+
+enum class TraversalKind : int { Naive = 0, Grid = 1, Tree = 2, Hybrid = 3 };
+
+/// Everything a pixel needs, plain data (device pointers on the GPU).
+struct FrameView {
+  float invViewProj[16];   ///< NDC -> world, column-major
+  float worldToIndex[12];  ///< world -> index space, row-major 3x4 affine
+  int width, height;
+  vec3f boxHi;             ///< index-space volume box is [0, boxHi)
+  float dt;                ///< sample distance in world units
+  float ertThreshold;      ///< early ray termination when alpha >= this; > 1 disables
+  int jitter;              ///< 1: per-pixel random start offset in [0, dt)
+  uint32_t jitterSeed;
+  const float* depth;      ///< optional window depth in [0,1] per pixel (opaque geometry)
+  TraversalKind traversal;
+  GridView grid;           ///< Grid and Hybrid
+  TreeView tree;           ///< Tree and Hybrid
+  TransferFunctionView tf;
+};
+
+/// Exact trilinear sampling in float from a linear voxel array (clamped at the border).
+template <class T>
+struct ArraySampler {
+  const T* data;
+  int64_t nx, ny, nz;
+
+  SS_FUNC float fetch(int64_t i, int64_t j, int64_t k) const {
+    return float(data[i + nx * (j + ny * k)]);
+  }
+  SS_FUNC static void axis(float p, int64_t n, int64_t& i0, int64_t& i1, float& f) {
+    float x = ss_clamp(p, 0.f, float(n - 1));
+    i0 = int64_t(x);
+    if (i0 > n - 2) i0 = n > 1 ? n - 2 : 0;
+    f = x - float(i0);
+    i1 = n > 1 ? i0 + 1 : 0;
+  }
+  SS_FUNC float sample(vec3f p) const {
+    int64_t x0, x1, y0, y1, z0, z1;
+    float fx, fy, fz;
+    axis(p.x, nx, x0, x1, fx);
+    axis(p.y, ny, y0, y1, fy);
+    axis(p.z, nz, z0, z1, fz);
+    float c00 = fetch(x0, y0, z0) + (fetch(x1, y0, z0) - fetch(x0, y0, z0)) * fx;
+    float c10 = fetch(x0, y1, z0) + (fetch(x1, y1, z0) - fetch(x0, y1, z0)) * fx;
+    float c01 = fetch(x0, y0, z1) + (fetch(x1, y0, z1) - fetch(x0, y0, z1)) * fx;
+    float c11 = fetch(x0, y1, z1) + (fetch(x1, y1, z1) - fetch(x0, y1, z1)) * fx;
+    float c0 = c00 + (c10 - c00) * fy;
+    float c1 = c01 + (c11 - c01) * fy;
+    return c0 + (c1 - c0) * fz;
+  }
+};
+
+SS_FUNC uint32_t hashPixel(uint32_t x, uint32_t y, uint32_t seed) {
+  uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ seed * 0xcb1ab31fu;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return h;
+}
+
+SS_FUNC vec3f unproject(const float* m, float x, float y, float z) {
+  float X = m[0] * x + m[4] * y + m[8] * z + m[12];
+  float Y = m[1] * x + m[5] * y + m[9] * z + m[13];
+  float Z = m[2] * x + m[6] * y + m[10] * z + m[14];
+  float W = m[3] * x + m[7] * y + m[11] * z + m[15];
+  return vec3f{X / W, Y / W, Z / W};
+}
+
+/// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
+/// never before `nextK`, so adjacent intervals never take a sample twice.
+template <class Sampler>
+struct IntervalMarcher {
+  const FrameView* f;
+  const Sampler* s;
+  Ray ray;
+  float t0;
+  int nextK;
+  vec4f acc;
+
+  SS_FUNC bool operator()(float a, float b) {
+    const float dt = f->dt;
+    int kBegin = int(ceilf((a - t0) / dt));
+    int kEnd = int(ceilf((b - t0) / dt));
+    if (kBegin < nextK) kBegin = nextK;
+    for (int k = kBegin; k < kEnd; ++k) {
+      float t = t0 + float(k) * dt;
+      vec4f c = lookup(f->tf, s->sample(ray.org + ray.dir * t));
+      if (c.w > 0.f) {
+        float w = (1.f - acc.w) * c.w;
+        acc.x += w * c.x;
+        acc.y += w * c.y;
+        acc.z += w * c.z;
+        acc.w += w;
+        if (acc.w >= f->ertThreshold) {
+          nextK = k + 1;
+          return false;
+        }
+      }
+    }
+    if (kEnd > nextK) nextK = kEnd;
+    return true;
+  }
+};
+
+template <class Sampler>
+struct HybridLeaf {
+  IntervalMarcher<Sampler>* m;
+  vec3f inv;
+  SS_FUNC bool operator()(int, float a, float b) {
+    return traverseGrid(m->f->grid, m->ray, inv, a, b, *m);
+  }
+};
+
+template <class Sampler>
+struct TreeLeaf {
+  IntervalMarcher<Sampler>* m;
+  SS_FUNC bool operator()(int, float a, float b) { return (*m)(a, b); }
+};
+
+/// Premultiplied RGBA of pixel (px, py); row 0 is the bottom row (OpenGL convention).
+template <class Sampler>
+SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) {
+  const float nx = (float(px) + 0.5f) / float(f.width) * 2.f - 1.f;
+  const float ny = (float(py) + 0.5f) / float(f.height) * 2.f - 1.f;
+  vec3f nearW = unproject(f.invViewProj, nx, ny, -1.f);
+  vec3f farW = unproject(f.invViewProj, nx, ny, 1.f);
+  vec3f dirW = normalize(farW - nearW);
+  float tLimit = INFINITY;
+  if (f.depth) {
+    float d = f.depth[int64_t(py) * f.width + px];
+    if (d < 1.f) tLimit = dot(unproject(f.invViewProj, nx, ny, 2.f * d - 1.f) - nearW, dirW);
+  }
+  const float* M = f.worldToIndex;
+  Ray r;
+  r.org = vec3f{M[0] * nearW.x + M[1] * nearW.y + M[2] * nearW.z + M[3],
+                M[4] * nearW.x + M[5] * nearW.y + M[6] * nearW.z + M[7],
+                M[8] * nearW.x + M[9] * nearW.y + M[10] * nearW.z + M[11]};
+  r.dir = vec3f{M[0] * dirW.x + M[1] * dirW.y + M[2] * dirW.z,
+                M[4] * dirW.x + M[5] * dirW.y + M[6] * dirW.z,
+                M[8] * dirW.x + M[9] * dirW.y + M[10] * dirW.z};
+  vec3f inv = safeInverse(r.dir);
+  float tEnter, tExit;
+  intersectBox(r, inv, vec3f{0, 0, 0}, f.boxHi, tEnter, tExit);
+  tEnter = ss_max(tEnter, 0.f);
+  tExit = ss_min(tExit, tLimit);
+  if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
+
+  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}};
+  if (f.jitter) m.t0 += f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f);
+  switch (f.traversal) {
+    case TraversalKind::Naive: m(tEnter, tExit); break;
+    case TraversalKind::Grid: traverseGrid(f.grid, r, inv, tEnter, tExit, m); break;
+    case TraversalKind::Tree: {
+      TreeLeaf<Sampler> leaf{&m};
+      traverseTree(f.tree, r, inv, tEnter, tExit, leaf);
+      break;
+    }
+    case TraversalKind::Hybrid: {
+      HybridLeaf<Sampler> leaf{&m, inv};
+      traverseTree(f.tree, r, inv, tEnter, tExit, leaf);
+      break;
+    }
+  }
+  return m.acc;
+}
+
+}  // namespace spaceskip

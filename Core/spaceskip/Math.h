@@ -1,0 +1,90 @@
+// Small vector/box/matrix types shared by host and device code.
+#pragma once
+#include "Macros.h"
+
+#include <cmath>
+#include <cstdint>
+
+namespace spaceskip {
+
+struct vec3f {
+  float x, y, z;
+  SS_FUNC float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  SS_FUNC float& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+};
+struct vec4f {
+  float x, y, z, w;
+};
+struct vec3i {
+  int x, y, z;
+  SS_FUNC int operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  SS_FUNC int& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+};
+struct vec3l {
+  int64_t x, y, z;
+  SS_FUNC int64_t operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+};
+
+SS_FUNC vec3f make_vec3f(float x, float y, float z) { return vec3f{x, y, z}; }
+SS_FUNC vec3f operator+(vec3f a, vec3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+SS_FUNC vec3f operator-(vec3f a, vec3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+SS_FUNC vec3f operator*(vec3f a, float s) { return {a.x * s, a.y * s, a.z * s}; }
+SS_FUNC vec3f operator*(float s, vec3f a) { return {a.x * s, a.y * s, a.z * s}; }
+SS_FUNC float dot(vec3f a, vec3f b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+SS_FUNC vec3f cross(vec3f a, vec3f b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+SS_FUNC float length(vec3f a) { return sqrtf(dot(a, a)); }
+SS_FUNC vec3f normalize(vec3f a) {
+  float l = length(a);
+  return l > 0.f ? a * (1.f / l) : a;
+}
+SS_FUNC float ss_min(float a, float b) { return a < b ? a : b; }
+SS_FUNC float ss_max(float a, float b) { return a > b ? a : b; }
+SS_FUNC int ss_mini(int a, int b) { return a < b ? a : b; }
+SS_FUNC int ss_maxi(int a, int b) { return a > b ? a : b; }
+SS_FUNC float ss_clamp(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+/// Integer box in cell coordinates, half-open: [lo, hi).
+struct box3i {
+  vec3i lo, hi;
+  SS_FUNC bool empty() const { return hi.x <= lo.x || hi.y <= lo.y || hi.z <= lo.z; }
+  SS_FUNC int64_t volume() const {
+    return empty() ? 0 : int64_t(hi.x - lo.x) * int64_t(hi.y - lo.y) * int64_t(hi.z - lo.z);
+  }
+};
+
+/// Ray in the volume's index space; t is shared with world space (the map is affine).
+struct Ray {
+  vec3f org, dir;
+};
+
+/// Slab test; returns the entry/exit parameters (tnear > tfar when missed).
+/// Division by a zero direction component yields +-inf, which the min/max handle for
+/// axis-parallel rays; the NaN of 0*inf (origin on a slab) is ignored by fminf/fmaxf.
+SS_FUNC void intersectBox(const Ray& r, vec3f inv, vec3f lo, vec3f hi, float& tnear, float& tfar) {
+  float t0x = (lo.x - r.org.x) * inv.x, t1x = (hi.x - r.org.x) * inv.x;
+  float t0y = (lo.y - r.org.y) * inv.y, t1y = (hi.y - r.org.y) * inv.y;
+  float t0z = (lo.z - r.org.z) * inv.z, t1z = (hi.z - r.org.z) * inv.z;
+  tnear = fmaxf(fmaxf(fminf(t0x, t1x), fminf(t0y, t1y)), fminf(t0z, t1z));
+  tfar = fminf(fminf(fmaxf(t0x, t1x), fmaxf(t0y, t1y)), fmaxf(t0z, t1z));
+}
+
+SS_FUNC vec3f safeInverse(vec3f d) {
+  // A zero component gives +inf with the sign of the zero: slabs parallel to the ray then
+  // contribute [-inf, inf] or an empty range, as the slab test expects.
+  return {1.f / d.x, 1.f / d.y, 1.f / d.z};
+}
+
+/// Column-major 4x4 matrix (OpenGL/VTK-transposed convention: m[col*4+row]).
+struct mat4 {
+  double m[16];
+};
+
+mat4 identity4();
+mat4 multiply(const mat4& a, const mat4& b);
+bool invert(const mat4& a, mat4& out);
+/// Transforms a point (w divide included).
+void transformPoint(const mat4& a, const double in[3], double out[3]);
+
+}  // namespace spaceskip

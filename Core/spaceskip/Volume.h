@@ -1,0 +1,52 @@
+// A uniform-grid scalar volume: 64-bit dims, voxel type, spacing/origin/direction.
+#pragma once
+#include "Math.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace spaceskip {
+
+enum class VoxelType : int { UInt8, Int8, UInt16, Int16, Float32, Float64 };
+
+size_t voxelSize(VoxelType t);
+const char* voxelTypeName(VoxelType t);
+/// Parses "uint8", "int16", "float", "float32", "double", ... ; returns false if unknown.
+bool parseVoxelType(const std::string& s, VoxelType& out);
+
+/// Host volume. Either owns its voxels (`storage`) or borrows a caller's buffer (`data`).
+/// Voxel (i,j,k) lives at i + dims.x*(j + dims.y*k) with 64-bit arithmetic.
+struct Volume {
+  vec3l dims{0, 0, 0};
+  VoxelType type = VoxelType::UInt8;
+  double spacing[3] = {1, 1, 1};
+  double origin[3] = {0, 0, 0};
+  /// Row-major 3x3 direction matrix (VTK's vtkImageData::GetDirectionMatrix layout).
+  double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const void* data = nullptr;
+  std::shared_ptr<std::vector<unsigned char>> storage;
+
+  int64_t voxelCount() const { return dims.x * dims.y * dims.z; }
+  size_t byteSize() const { return size_t(voxelCount()) * voxelSize(type); }
+  /// Number of cells per axis. An axis of one voxel gets one cell of constant value, so that
+  /// 1xNxM volumes render as a slab one spacing thick instead of vanishing.
+  vec3i cellDims() const;
+  /// Index space -> world (origin + direction * (index * spacing)).
+  mat4 indexToWorld() const;
+  /// World-space corners of the rendered box.
+  void worldBounds(double bounds[6]) const;
+  double value(int64_t i, int64_t j, int64_t k) const;
+  /// Finite min/max of the voxels (NaN and +-Inf skipped); false if no finite voxel exists.
+  bool scalarRange(double& lo, double& hi) const;
+  /// Allocates owned storage of dims*voxelSize bytes (zeroed).
+  void allocate(vec3l d, VoxelType t);
+  unsigned char* mutableData() { return storage ? storage->data() : nullptr; }
+};
+
+/// Throws std::runtime_error on bad dims (non-positive, or > 2^31 cells per axis).
+void validate(const Volume& v);
+
+}  // namespace spaceskip

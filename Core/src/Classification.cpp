@@ -1,0 +1,107 @@
+// Per-brick value ranges (once per volume) and conservative occupancy (per opacity edit).
+#include "spaceskip/Classification.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace spaceskip {
+
+namespace {
+box3i brickBoxOf(vec3i cellDims, int brick, int x, int y, int z) {
+  box3i b;
+  b.lo = vec3i{x * brick, y * brick, z * brick};
+  b.hi = vec3i{std::min((x + 1) * brick, cellDims.x), std::min((y + 1) * brick, cellDims.y),
+               std::min((z + 1) * brick, cellDims.z)};
+  return b;
+}
+
+template <class T>
+void rangesOf(const Volume& v, RangeGrid& g) {
+  const T* data = static_cast<const T*>(v.data);
+  const int64_t nx = v.dims.x, ny = v.dims.y, nz = v.dims.z;
+  // Parallel over brick rows (y,z): each task writes its own bricks.
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, int64_t(g.dims.y) * g.dims.z),
+                    [&](const tbb::blocked_range<int64_t>& r) {
+    std::vector<float> lo(size_t(g.dims.x)), hi(size_t(g.dims.x));
+    for (int64_t row = r.begin(); row != r.end(); ++row) {
+      const int by = int(row % g.dims.y), bz = int(row / g.dims.y);
+      std::fill(lo.begin(), lo.end(), std::numeric_limits<float>::infinity());
+      std::fill(hi.begin(), hi.end(), -std::numeric_limits<float>::infinity());
+      // Voxels [b*B, (b+1)*B] inclusive (the +1 halo), clamped.
+      const int64_t y0 = int64_t(by) * g.brick, y1 = std::min<int64_t>(y0 + g.brick, ny - 1);
+      const int64_t z0 = int64_t(bz) * g.brick, z1 = std::min<int64_t>(z0 + g.brick, nz - 1);
+      for (int64_t z = z0; z <= z1; ++z)
+        for (int64_t y = y0; y <= y1; ++y) {
+          const T* line = data + nx * (y + ny * z);
+          for (int bx = 0; bx < g.dims.x; ++bx) {
+            const int64_t x0 = int64_t(bx) * g.brick, x1 = std::min<int64_t>(x0 + g.brick, nx - 1);
+            float l = lo[size_t(bx)], h = hi[size_t(bx)];
+            for (int64_t x = x0; x <= x1; ++x) {
+              float val = float(line[x]);
+              if (val != val) continue;  // NaN
+              l = val < l ? val : l;
+              h = val > h ? val : h;
+            }
+            lo[size_t(bx)] = l;
+            hi[size_t(bx)] = h;
+          }
+        }
+      for (int bx = 0; bx < g.dims.x; ++bx) {
+        g.vmin[size_t(g.index(bx, by, bz))] = lo[size_t(bx)];
+        g.vmax[size_t(g.index(bx, by, bz))] = hi[size_t(bx)];
+      }
+    }
+  });
+}
+}  // namespace
+
+box3i RangeGrid::brickBox(int x, int y, int z) const { return brickBoxOf(cellDims, brick, x, y, z); }
+box3i OccupancyGrid::brickBox(int x, int y, int z) const { return brickBoxOf(cellDims, brick, x, y, z); }
+
+RangeGrid computeRangeGrid(const Volume& v, int brick) {
+  validate(v);
+  RangeGrid g;
+  g.brick = std::max(1, brick);
+  g.cellDims = v.cellDims();
+  g.dims = vec3i{(g.cellDims.x + g.brick - 1) / g.brick, (g.cellDims.y + g.brick - 1) / g.brick,
+                 (g.cellDims.z + g.brick - 1) / g.brick};
+  g.vmin.resize(size_t(g.size()));
+  g.vmax.resize(size_t(g.size()));
+  switch (v.type) {
+    case VoxelType::UInt8: rangesOf<uint8_t>(v, g); break;
+    case VoxelType::Int8: rangesOf<int8_t>(v, g); break;
+    case VoxelType::UInt16: rangesOf<uint16_t>(v, g); break;
+    case VoxelType::Int16: rangesOf<int16_t>(v, g); break;
+    case VoxelType::Float32: rangesOf<float>(v, g); break;
+    case VoxelType::Float64: rangesOf<double>(v, g); break;
+  }
+  return g;
+}
+
+OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf) {
+  OccupancyGrid o;
+  o.brick = ranges.brick;
+  o.cellDims = ranges.cellDims;
+  o.dims = ranges.dims;
+  o.occ.resize(size_t(ranges.size()));
+  OpacityRangeMax rmq(tf);
+  o.occupied = tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, ranges.size(), 4096), int64_t(0),
+      [&](const tbb::blocked_range<int64_t>& r, int64_t acc) {
+        for (int64_t i = r.begin(); i != r.end(); ++i) {
+          uint8_t occ = rmq.query(ranges.vmin[size_t(i)], ranges.vmax[size_t(i)]) > 0.f ? 1 : 0;
+          o.occ[size_t(i)] = occ;
+          acc += occ;
+        }
+        return acc;
+      },
+      [](int64_t a, int64_t b) { return a + b; });
+  return o;
+}
+
+}  // namespace spaceskip

@@ -1,0 +1,122 @@
+// The oneTBB backend: tiles of pixels run the shared per-ray integrator.
+#include "spaceskip/Backend.h"
+#include "spaceskip/Builders.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+
+namespace spaceskip {
+
+namespace {
+
+constexpr int kTile = 16;  // pixels per tile edge: one oneTBB task
+
+class CpuBackend final : public Backend {
+ public:
+  BackendKind kind() const override { return BackendKind::CPU; }
+  const char* name() const override { return "cpu"; }
+
+  void setVolume(const Volume& v, int brick) override {
+    volume_ = v;
+    ranges_ = computeRangeGrid(v, brick);
+    occ_ = OccupancyGrid{};
+    tree_ = Tree{};
+  }
+
+  bool classify(const TransferFunction& tf) override {
+    OccupancyGrid o = classify_(tf);
+    bool changed = o.occ != occ_.occ || o.dims.x != occ_.dims.x || o.dims.y != occ_.dims.y ||
+                   o.dims.z != occ_.dims.z;
+    occ_ = std::move(o);
+    return changed;
+  }
+
+  void setTransferTable(const std::vector<vec4f>& t, float lo, float scale) override {
+    table_ = t;
+    tfLo_ = lo;
+    tfScale_ = scale;
+  }
+
+  void build(const BuildParams& p, BuildStats& s) override {
+    auto t0 = std::chrono::steady_clock::now();
+    traversal_ = traversalFor(p.builder);
+    tree_ = Tree{};
+    hybridGrid_ = OccupancyGrid{};
+    if (traversal_ == TraversalKind::Tree || traversal_ == TraversalKind::Hybrid) {
+      BuildParams q = p;
+      if (p.builder == BuilderKind::LBVH) q.builder = BuilderKind::LBVHCPU;
+      tree_ = buildTreeCPU(occ_, q);
+      if (traversal_ == TraversalKind::Hybrid) hybridGrid_ = coarsen(occ_, std::max(1, 16 / occ_.brick));
+    }
+    s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    s.builtOn = "cpu";
+    s.nodes = int64_t(tree_.nodes.size());
+    s.height = tree_.height;
+    s.leaves = tree_.leaves;
+  }
+
+  void render(FrameView f, FilterMode, const float* depth, Image& out) override {
+    f.depth = depth;
+    f.traversal = traversal_;
+    const OccupancyGrid& g = traversal_ == TraversalKind::Hybrid ? hybridGrid_ : occ_;
+    f.grid = GridView{g.occ.data(), g.dims, g.brick};
+    f.tree = TreeView{tree_.nodes.data(), int(tree_.nodes.size())};
+    f.tf = TransferFunctionView{table_.data(), int(table_.size()), tfLo_, tfScale_};
+    out.width = f.width;
+    out.height = f.height;
+    out.rgba.assign(size_t(f.width) * size_t(f.height), vec4f{0, 0, 0, 0});
+    switch (volume_.type) {
+      case VoxelType::UInt8: run<uint8_t>(f, out); break;
+      case VoxelType::Int8: run<int8_t>(f, out); break;
+      case VoxelType::UInt16: run<uint16_t>(f, out); break;
+      case VoxelType::Int16: run<int16_t>(f, out); break;
+      case VoxelType::Float32: run<float>(f, out); break;
+      case VoxelType::Float64: run<double>(f, out); break;
+    }
+  }
+
+  const OccupancyGrid& occupancy() override { return occ_; }
+  Tree tree() override { return tree_; }
+
+ private:
+  OccupancyGrid classify_(const TransferFunction& tf) { return spaceskip::classify(ranges_, tf); }
+
+  template <class T>
+  void run(const FrameView& f, Image& out) {
+    ArraySampler<T> s{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y, volume_.dims.z};
+    vec4f* px = out.rgba.data();
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, f.height, kTile, 0, f.width, kTile),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                        for (int y = r.rows().begin(); y != r.rows().end(); ++y)
+                          for (int x = r.cols().begin(); x != r.cols().end(); ++x)
+                            px[size_t(y) * size_t(f.width) + size_t(x)] = renderPixel(f, s, x, y);
+                      });
+  }
+
+  Volume volume_;
+  RangeGrid ranges_;
+  OccupancyGrid occ_;
+  OccupancyGrid hybridGrid_;
+  Tree tree_;
+  TraversalKind traversal_ = TraversalKind::Naive;
+  std::vector<vec4f> table_;
+  float tfLo_ = 0, tfScale_ = 1;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> makeCpuBackend() { return std::make_unique<CpuBackend>(); }
+
+#ifndef SPACESKIP_HAVE_CUDA
+std::unique_ptr<Backend> makeCudaBackend() {
+  throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
+}
+bool cudaAvailable(std::string* why) {
+  if (why) *why = "built without CUDA";
+  return false;
+}
+#endif
+
+}  // namespace spaceskip

@@ -1,0 +1,94 @@
+// PNG via libpng; image metrics.
+#include "spaceskip/ImageIO.h"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace spaceskip {
+
+namespace {
+unsigned char to8(float v) { return (unsigned char)std::lround(std::clamp(v, 0.f, 1.f) * 255.f); }
+}  // namespace
+
+void savePng(const Image& img, const std::string& path, bool overBlack) {
+  if (img.width <= 0 || img.height <= 0) throw std::invalid_argument("empty image");
+  std::vector<unsigned char> rows(size_t(img.width) * img.height * 4);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const vec4f& p = img.rgba[size_t(y) * img.width + x];
+      unsigned char* o = &rows[(size_t(img.height - 1 - y) * img.width + x) * 4];
+      if (overBlack) {
+        o[0] = to8(p.x); o[1] = to8(p.y); o[2] = to8(p.z); o[3] = 255;
+      } else {
+        // PNG stores straight alpha.
+        float a = p.w;
+        o[0] = to8(a > 0 ? p.x / a : 0); o[1] = to8(a > 0 ? p.y / a : 0); o[2] = to8(a > 0 ? p.z / a : 0);
+        o[3] = to8(a);
+      }
+    }
+  png_image pi{};
+  pi.version = PNG_IMAGE_VERSION;
+  pi.width = png_uint_32(img.width);
+  pi.height = png_uint_32(img.height);
+  pi.format = PNG_FORMAT_RGBA;
+  if (!png_image_write_to_file(&pi, path.c_str(), 0, rows.data(), 0, nullptr))
+    throw std::runtime_error(path + ": cannot write PNG (" + pi.message + ")");
+}
+
+Image loadPng(const std::string& path) {
+  png_image pi{};
+  pi.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&pi, path.c_str()))
+    throw std::runtime_error(path + ": cannot read PNG (" + pi.message + ")");
+  pi.format = PNG_FORMAT_RGBA;
+  std::vector<unsigned char> buf(PNG_IMAGE_SIZE(pi));
+  if (!png_image_finish_read(&pi, nullptr, buf.data(), 0, nullptr))
+    throw std::runtime_error(path + ": cannot decode PNG (" + pi.message + ")");
+  Image img;
+  img.width = int(pi.width);
+  img.height = int(pi.height);
+  img.rgba.resize(size_t(img.width) * img.height);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const unsigned char* s = &buf[(size_t(img.height - 1 - y) * img.width + x) * 4];
+      float a = s[3] / 255.f;
+      img.rgba[size_t(y) * img.width + x] = vec4f{s[0] / 255.f * a, s[1] / 255.f * a, s[2] / 255.f * a, a};
+    }
+  return img;
+}
+
+ImageDiff compareImages(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height) throw std::invalid_argument("image sizes differ");
+  ImageDiff d;
+  double se = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i) {
+    const float da[4] = {a.rgba[i].x - b.rgba[i].x, a.rgba[i].y - b.rgba[i].y, a.rgba[i].z - b.rgba[i].z,
+                         a.rgba[i].w - b.rgba[i].w};
+    float m = 0;
+    for (float v : da) {
+      float av = std::fabs(v);
+      if (!(av == av)) av = 1.f;  // NaN counts as a full difference
+      m = std::max(m, av);
+      se += double(av) * av;
+    }
+    d.maxAbs = std::max(d.maxAbs, m);
+    if (m > 1.f / 255.f) ++d.differing;
+  }
+  double mse = se / double(a.rgba.size() * 4);
+  d.psnr = mse > 0 ? 10.0 * std::log10(1.0 / mse) : std::numeric_limits<double>::infinity();
+  return d;
+}
+
+bool hasNonFinite(const Image& img) {
+  for (const auto& p : img.rgba)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.w)) return true;
+  return false;
+}
+
+}  // namespace spaceskip

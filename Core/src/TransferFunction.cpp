@@ -1,0 +1,159 @@
+// Transfer-function tables, presets and the sparse-table range-max query.
+#include "spaceskip/TransferFunction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace spaceskip {
+
+TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double lo, double hi, int size) {
+  if (size < 1) throw std::invalid_argument("transfer function needs at least one entry");
+  if (pts.empty()) throw std::invalid_argument("transfer function needs at least one point");
+  if (!(hi > lo)) hi = lo + 1.0;  // constant data: give the table a non-empty range
+  std::sort(pts.begin(), pts.end(), [](const TFPoint& a, const TFPoint& b) { return a.value < b.value; });
+  TransferFunction tf;
+  tf.rangeMin = lo;
+  tf.rangeMax = hi;
+  tf.table.resize(size_t(size));
+  for (int i = 0; i < size; ++i) {
+    double v = size == 1 ? lo : lo + (hi - lo) * double(i) / double(size - 1);
+    auto it = std::lower_bound(pts.begin(), pts.end(), v, [](const TFPoint& p, double x) { return p.value < x; });
+    TFPoint p;
+    if (it == pts.begin()) p = pts.front();
+    else if (it == pts.end()) p = pts.back();
+    else {
+      const TFPoint& a = *(it - 1);
+      const TFPoint& b = *it;
+      double f = b.value > a.value ? (v - a.value) / (b.value - a.value) : 0.0;
+      auto mix = [f](float x, float y) { return float(x + (y - x) * f); };
+      p = TFPoint{v, mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b), mix(a.a, b.a)};
+    }
+    tf.table[size_t(i)] = vec4f{p.r, p.g, p.b, std::clamp(p.a, 0.f, 1.f)};
+  }
+  return tf;
+}
+
+TransferFunction TransferFunction::preset(const std::string& name, double lo, double hi, int size) {
+  const double w = hi - lo;
+  auto at = [&](double f) { return lo + f * w; };
+  std::vector<TFPoint> p;
+  if (name == "ramp") {
+    p = {{at(0.0), 0.2f, 0.3f, 0.9f, 0.f}, {at(0.1), 0.2f, 0.3f, 0.9f, 0.f},
+         {at(0.5), 0.9f, 0.8f, 0.3f, 0.3f}, {at(1.0), 1.f, 0.2f, 0.1f, 0.9f}};
+  } else if (name == "grayscale") {
+    p = {{at(0.0), 0.f, 0.f, 0.f, 0.f}, {at(1.0), 1.f, 1.f, 1.f, 1.f}};
+  } else if (name == "coolwarm") {
+    p = {{at(0.0), 0.23f, 0.30f, 0.75f, 0.f}, {at(0.05), 0.23f, 0.30f, 0.75f, 0.f},
+         {at(0.5), 0.87f, 0.87f, 0.87f, 0.2f}, {at(1.0), 0.71f, 0.02f, 0.15f, 0.8f}};
+  } else if (name == "band") {
+    p = {{at(0.0), 1.f, 1.f, 1.f, 0.f}, {at(0.3), 0.3f, 0.8f, 0.3f, 0.f}, {at(0.4), 0.3f, 0.8f, 0.3f, 0.6f},
+         {at(0.6), 0.9f, 0.6f, 0.2f, 0.6f}, {at(0.7), 0.9f, 0.6f, 0.2f, 0.f}, {at(1.0), 1.f, 1.f, 1.f, 0.f}};
+  } else if (name == "spike") {
+    // One table entry in the middle of the range is opaque, every other entry transparent.
+    TransferFunction tf = fromPoints({{lo, 0.f, 0.f, 0.f, 0.f}, {hi, 0.f, 0.f, 0.f, 0.f}}, lo, hi, size);
+    tf.table[size_t(size / 2)] = vec4f{1.f, 0.9f, 0.2f, 1.f};
+    return tf;
+  } else if (name == "opaque") {
+    p = {{at(0.0), 1.f, 1.f, 1.f, 1.f}, {at(1.0), 1.f, 1.f, 1.f, 1.f}};
+  } else if (name == "zero") {
+    p = {{at(0.0), 1.f, 1.f, 1.f, 0.f}, {at(1.0), 1.f, 1.f, 1.f, 0.f}};
+  } else {
+    throw std::invalid_argument("unknown transfer-function preset '" + name +
+                                "' (ramp, grayscale, coolwarm, band, spike, opaque, zero)");
+  }
+  return fromPoints(p, lo, hi, size);
+}
+
+TransferFunction TransferFunction::load(const std::string& path, double lo, double hi) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open transfer-function file");
+  std::vector<TFPoint> pts;
+  int size = 1024;
+  double unit = 1.0;
+  std::string line;
+  int lineNo = 0;
+  while (std::getline(in, line)) {
+    ++lineNo;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream ls(line);
+    std::string first;
+    ls >> first;
+    if (first.empty()) continue;
+    if (first == "range") {
+      if (!(ls >> lo >> hi)) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad range");
+    } else if (first == "size") {
+      if (!(ls >> size) || size < 2) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad size");
+    } else if (first == "unit") {
+      if (!(ls >> unit) || !(unit > 0)) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad unit");
+    } else {
+      TFPoint p{};
+      try {
+        p.value = std::stod(first);
+      } catch (...) {
+        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected 'value r g b a'");
+      }
+      if (!(ls >> p.r >> p.g >> p.b >> p.a))
+        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected 'value r g b a'");
+      pts.push_back(p);
+    }
+  }
+  if (pts.empty()) throw std::runtime_error(path + ": no control points");
+  TransferFunction tf = fromPoints(pts, lo, hi, size);
+  tf.unitDistance = unit;
+  return tf;
+}
+
+bool TransferFunction::sameOpacity(const TransferFunction& o) const {
+  if (table.size() != o.table.size() || rangeMin != o.rangeMin || rangeMax != o.rangeMax ||
+      unitDistance != o.unitDistance)
+    return false;
+  for (size_t i = 0; i < table.size(); ++i)
+    if (table[i].w != o.table[i].w) return false;
+  return true;
+}
+
+bool TransferFunction::sameColor(const TransferFunction& o) const {
+  if (table.size() != o.table.size() || rangeMin != o.rangeMin || rangeMax != o.rangeMax) return false;
+  for (size_t i = 0; i < table.size(); ++i)
+    if (table[i].x != o.table[i].x || table[i].y != o.table[i].y || table[i].z != o.table[i].z) return false;
+  return true;
+}
+
+std::vector<vec4f> correctedTable(const TransferFunction& tf, float dt) {
+  std::vector<vec4f> out(tf.table);
+  for (auto& e : out) e.w = correctOpacity(e.w, dt, float(tf.unitDistance));
+  return out;
+}
+
+OpacityRangeMax::OpacityRangeMax(const TransferFunction& tf)
+    : lo_(tf.rangeMin), size_(int(tf.table.size())) {
+  scale_ = tf.rangeMax > tf.rangeMin ? double(size_ - 1) / (tf.rangeMax - tf.rangeMin) : 0.0;
+  levels_.emplace_back(size_t(size_));
+  for (int i = 0; i < size_; ++i) levels_[0][size_t(i)] = tf.table[size_t(i)].w;
+  for (int len = 2; len <= size_; len *= 2) {
+    const auto& prev = levels_.back();
+    std::vector<float> cur(size_t(size_ - len + 1));
+    for (int i = 0; i + len <= size_; ++i) cur[size_t(i)] = std::max(prev[size_t(i)], prev[size_t(i + len / 2)]);
+    levels_.push_back(std::move(cur));
+  }
+}
+
+float OpacityRangeMax::query(double vmin, double vmax) const {
+  if (!(vmin <= vmax)) return 0.f;  // empty or NaN range
+  // A sample's value lies in [vmin, vmax]; the lookup blends entries floor(x) and floor(x)+1.
+  double x0 = (vmin - lo_) * scale_, x1 = (vmax - lo_) * scale_;
+  x0 = std::clamp(x0, 0.0, double(size_ - 1));
+  x1 = std::clamp(x1, 0.0, double(size_ - 1));
+  // One extra entry on each side absorbs float-vs-double rounding of the integrator's lookup.
+  int i0 = int(std::floor(x0)) - 1, i1 = int(std::ceil(x1)) + 1;
+  i0 = std::clamp(i0, 0, size_ - 1);
+  i1 = std::clamp(i1, i0, size_ - 1);
+  int len = i1 - i0 + 1, k = 0;
+  while ((2 << k) <= len) ++k;
+  return std::max(levels_[size_t(k)][size_t(i0)], levels_[size_t(k)][size_t(i1 - (1 << k) + 1)]);
+}
+
+}  // namespace spaceskip

@@ -1,0 +1,141 @@
+// Volume metadata helpers.
+#include "spaceskip/Volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace spaceskip {
+
+size_t voxelSize(VoxelType t) {
+  switch (t) {
+    case VoxelType::UInt8:
+    case VoxelType::Int8: return 1;
+    case VoxelType::UInt16:
+    case VoxelType::Int16: return 2;
+    case VoxelType::Float32: return 4;
+    case VoxelType::Float64: return 8;
+  }
+  return 1;
+}
+
+const char* voxelTypeName(VoxelType t) {
+  switch (t) {
+    case VoxelType::UInt8: return "uint8";
+    case VoxelType::Int8: return "int8";
+    case VoxelType::UInt16: return "uint16";
+    case VoxelType::Int16: return "int16";
+    case VoxelType::Float32: return "float32";
+    case VoxelType::Float64: return "float64";
+  }
+  return "?";
+}
+
+bool parseVoxelType(const std::string& in, VoxelType& out) {
+  std::string s = in;
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (s == "uint8" || s == "uchar" || s == "unsigned char" || s == "uint8_t") out = VoxelType::UInt8;
+  else if (s == "int8" || s == "char" || s == "signed char" || s == "int8_t") out = VoxelType::Int8;
+  else if (s == "uint16" || s == "ushort" || s == "unsigned short" || s == "uint16_t") out = VoxelType::UInt16;
+  else if (s == "int16" || s == "short" || s == "int16_t") out = VoxelType::Int16;
+  else if (s == "float32" || s == "float") out = VoxelType::Float32;
+  else if (s == "float64" || s == "double") out = VoxelType::Float64;
+  else return false;
+  return true;
+}
+
+vec3i Volume::cellDims() const {
+  return vec3i{int(std::max<int64_t>(dims.x - 1, 1)), int(std::max<int64_t>(dims.y - 1, 1)),
+               int(std::max<int64_t>(dims.z - 1, 1))};
+}
+
+mat4 Volume::indexToWorld() const {
+  mat4 r = identity4();
+  for (int c = 0; c < 3; ++c) {
+    for (int row = 0; row < 3; ++row) r.m[c * 4 + row] = direction[row * 3 + c] * spacing[c];
+    r.m[12 + c] = origin[c];
+  }
+  return r;
+}
+
+void Volume::worldBounds(double b[6]) const {
+  vec3i cd = cellDims();
+  mat4 m = indexToWorld();
+  for (int i = 0; i < 3; ++i) {
+    b[2 * i] = std::numeric_limits<double>::infinity();
+    b[2 * i + 1] = -std::numeric_limits<double>::infinity();
+  }
+  for (int c = 0; c < 8; ++c) {
+    double p[3] = {double((c & 1) ? cd.x : 0), double((c & 2) ? cd.y : 0), double((c & 4) ? cd.z : 0)};
+    double w[3];
+    transformPoint(m, p, w);
+    for (int i = 0; i < 3; ++i) {
+      b[2 * i] = std::min(b[2 * i], w[i]);
+      b[2 * i + 1] = std::max(b[2 * i + 1], w[i]);
+    }
+  }
+}
+
+namespace {
+template <class T>
+double at(const void* d, int64_t i) {
+  return double(static_cast<const T*>(d)[i]);
+}
+}  // namespace
+
+double Volume::value(int64_t i, int64_t j, int64_t k) const {
+  int64_t idx = i + dims.x * (j + dims.y * k);
+  switch (type) {
+    case VoxelType::UInt8: return at<uint8_t>(data, idx);
+    case VoxelType::Int8: return at<int8_t>(data, idx);
+    case VoxelType::UInt16: return at<uint16_t>(data, idx);
+    case VoxelType::Int16: return at<int16_t>(data, idx);
+    case VoxelType::Float32: return at<float>(data, idx);
+    case VoxelType::Float64: return at<double>(data, idx);
+  }
+  return 0;
+}
+
+bool Volume::scalarRange(double& lo, double& hi) const {
+  lo = std::numeric_limits<double>::infinity();
+  hi = -lo;
+  const int64_t n = voxelCount();
+  for (int64_t i = 0; i < n; ++i) {
+    double v;
+    switch (type) {
+      case VoxelType::UInt8: v = at<uint8_t>(data, i); break;
+      case VoxelType::Int8: v = at<int8_t>(data, i); break;
+      case VoxelType::UInt16: v = at<uint16_t>(data, i); break;
+      case VoxelType::Int16: v = at<int16_t>(data, i); break;
+      case VoxelType::Float32: v = at<float>(data, i); break;
+      default: v = at<double>(data, i); break;
+    }
+    if (!std::isfinite(v)) continue;
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  return lo <= hi;
+}
+
+void Volume::allocate(vec3l d, VoxelType t) {
+  dims = d;
+  type = t;
+  storage = std::make_shared<std::vector<unsigned char>>(byteSize());
+  data = storage->data();
+}
+
+void validate(const Volume& v) {
+  if (v.dims.x <= 0 || v.dims.y <= 0 || v.dims.z <= 0)
+    throw std::runtime_error("empty volume extent (" + std::to_string(v.dims.x) + "x" +
+                             std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z) + ")");
+  const int64_t maxAxis = int64_t(1) << 30;
+  if (v.dims.x > maxAxis || v.dims.y > maxAxis || v.dims.z > maxAxis)
+    throw std::runtime_error("volume axis longer than 2^30 voxels");
+  if (!v.data) throw std::runtime_error("volume has no voxel data");
+  for (int i = 0; i < 3; ++i)
+    if (!(v.spacing[i] > 0) || !std::isfinite(v.spacing[i]))
+      throw std::runtime_error("volume spacing must be positive and finite");
+}
+
+}  // namespace spaceskip
