@@ -245,8 +245,8 @@ int cmdBench(const Options& o) {
     csv << "dataset,dims,builder,backend,leaf,mls,bins,build_s,classify_s,fps,nodes,height,leaves,occupancy\n";
   }
   bool firstJson = true;
-  std::printf("%-22s %-16s %-6s %10s %10s %9s %10s %7s %10s\n", "dataset", "builder", "backend", "build_ms",
-              "classify_ms", "fps", "nodes", "height", "vs_naive");
+  std::printf("%-22s %-16s %-6s %10s %10s %9s %10s %7s %10s %9s\n", "dataset", "builder", "backend", "build_ms",
+              "classify_ms", "fps", "nodes", "height", "vs_naive", "Gsmp/s");
   for (const std::string& spec : o.positional) {
     Volume v = openVolume(spec);
     TransferFunction tf = makeTF(o, v);
@@ -278,12 +278,19 @@ int cmdBench(const Options& o) {
         total += engine.frameStats().seconds;
       }
       double fps = frames / total;
+      // One more frame with sample counting (not timed): samples/frame and samples/s.
+      RenderParams counted = renderParams(o);
+      counted.countSamples = true;
+      engine.setRenderParams(counted);
+      engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
+      const double samples = double(engine.frameStats().samples);
+      const double gsps = samples * fps * 1e-9;
       if (s.builder == BuilderKind::Naive) naiveFps = fps;
       std::string dims = std::to_string(v.dims.x) + "x" + std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z);
       std::string name = spec.substr(spec.find_last_of('/') + 1);
-      std::printf("%-22s %-16s %-6s %10.3f %10.3f %9.2f %10lld %7d %10s\n", name.c_str(), builderName(s.builder),
+      std::printf("%-22s %-16s %-6s %10.3f %10.3f %9.2f %10lld %7d %10s %9.3f\n", name.c_str(), builderName(s.builder),
                   engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, (long long)s.nodes, s.height,
-                  naiveFps > 0 ? (std::to_string(fps / naiveFps).substr(0, 5) + "x").c_str() : "-");
+                  naiveFps > 0 ? (std::to_string(fps / naiveFps).substr(0, 5) + "x").c_str() : "-", gsps);
       std::fflush(stdout);
       const char* leaf = bp.leaf == LeafCriterion::Shallow ? "shallow" : "deep";
       if (!firstJson) json << ",\n";
@@ -292,7 +299,7 @@ int cmdBench(const Options& o) {
            << "\", \"backend\": \"" << engine.backendName() << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize
            << ", \"bins\": " << bp.bins << ", \"build_s\": " << s.seconds << ", \"classify_s\": " << s.classifySeconds
            << ", \"fps\": " << fps << ", \"nodes\": " << s.nodes << ", \"height\": " << s.height
-           << ", \"leaves\": " << s.leaves << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
+           << ", \"leaves\": " << s.leaves << ", \"samples_per_frame\": " << samples << ", \"gsamples_per_s\": " << gsps << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
            << ", \"height_px\": " << h << ", \"frames\": " << frames << "}";
       if (csv.is_open())
         csv << name << "," << dims << "," << builderName(s.builder) << "," << engine.backendName() << "," << leaf << ","
