@@ -1,0 +1,128 @@
+// ParaView's image-data volume representation with vtkSpaceSkippingVolumeMapper installed.
+#include "vtkSpaceSkipVolumeRepresentation.h"
+
+#include "vtkObjectFactory.h"
+#include "vtkPVLODVolume.h"
+#include "vtkSpaceSkippingVolumeMapper.h"
+
+vtkStandardNewMacro(vtkSpaceSkipVolumeRepresentation);
+
+//------------------------------------------------------------------------------
+vtkSpaceSkipVolumeRepresentation::vtkSpaceSkipVolumeRepresentation()
+{
+  // Replace the base class's vtkMultiBlockVolumeMapper; UpdateMapperParameters() (run on every
+  // REQUEST_RENDER) connects the delivered piece and sets it on the actor.
+  auto mapper = vtkSmartPointer<vtkSpaceSkippingVolumeMapper>::New();
+  this->SpaceSkipMapper = mapper;
+  this->VolumeMapper = mapper;
+  this->Actor->SetMapper(mapper);
+}
+
+//------------------------------------------------------------------------------
+vtkSpaceSkipVolumeRepresentation::~vtkSpaceSkipVolumeRepresentation() = default;
+
+//------------------------------------------------------------------------------
+// Setters: the mapper's own Modified() makes the next render rebuild what the change needs.
+void vtkSpaceSkipVolumeRepresentation::SetBuilder(int v)
+{
+  this->SpaceSkipMapper->SetBuilder(v);
+}
+int vtkSpaceSkipVolumeRepresentation::GetBuilder()
+{
+  return this->SpaceSkipMapper->GetBuilder();
+}
+void vtkSpaceSkipVolumeRepresentation::SetLeafCriterion(int v)
+{
+  this->SpaceSkipMapper->SetLeafCriterion(v);
+}
+int vtkSpaceSkipVolumeRepresentation::GetLeafCriterion()
+{
+  return this->SpaceSkipMapper->GetLeafCriterion();
+}
+void vtkSpaceSkipVolumeRepresentation::SetMaxLeafSize(int v)
+{
+  this->SpaceSkipMapper->SetMaxLeafSize(v);
+}
+int vtkSpaceSkipVolumeRepresentation::GetMaxLeafSize()
+{
+  return this->SpaceSkipMapper->GetMaxLeafSize();
+}
+void vtkSpaceSkipVolumeRepresentation::SetBinCount(int v)
+{
+  this->SpaceSkipMapper->SetBinCount(v);
+}
+int vtkSpaceSkipVolumeRepresentation::GetBinCount()
+{
+  return this->SpaceSkipMapper->GetBinCount();
+}
+void vtkSpaceSkipVolumeRepresentation::SetSampleDistance(double v)
+{
+  this->SpaceSkipMapper->SetSampleDistance(v);
+}
+double vtkSpaceSkipVolumeRepresentation::GetSampleDistance()
+{
+  return this->SpaceSkipMapper->GetSampleDistance();
+}
+void vtkSpaceSkipVolumeRepresentation::SetBackend(int v)
+{
+  this->SpaceSkipMapper->SetBackend(v);
+}
+int vtkSpaceSkipVolumeRepresentation::GetBackend()
+{
+  return this->SpaceSkipMapper->GetBackend();
+}
+void vtkSpaceSkipVolumeRepresentation::SetEarlyRayTermination(int v)
+{
+  this->SpaceSkipMapper->SetEarlyRayTermination(v != 0);
+}
+int vtkSpaceSkipVolumeRepresentation::GetEarlyRayTermination()
+{
+  return this->SpaceSkipMapper->GetEarlyRayTermination() ? 1 : 0;
+}
+
+//------------------------------------------------------------------------------
+double vtkSpaceSkipVolumeRepresentation::GetLastBuildSeconds()
+{
+  return this->SpaceSkipMapper->GetLastBuildSeconds();
+}
+double vtkSpaceSkipVolumeRepresentation::GetLastRenderSeconds()
+{
+  return this->SpaceSkipMapper->GetLastRenderSeconds();
+}
+double vtkSpaceSkipVolumeRepresentation::GetNodeCount()
+{
+  return static_cast<double>(this->SpaceSkipMapper->GetNodeCount());
+}
+int vtkSpaceSkipVolumeRepresentation::GetTreeHeight()
+{
+  return static_cast<int>(this->SpaceSkipMapper->GetTreeHeight());
+}
+double vtkSpaceSkipVolumeRepresentation::GetLeafCount()
+{
+  return static_cast<double>(this->SpaceSkipMapper->GetLeafCount());
+}
+const char* vtkSpaceSkipVolumeRepresentation::GetBackendUsed()
+{
+  const char* name = this->SpaceSkipMapper->GetBackendUsed();
+  this->BackendUsedName = name ? name : "";
+  return this->BackendUsedName.c_str();
+}
+int vtkSpaceSkipVolumeRepresentation::GetBuildCount()
+{
+  return static_cast<int>(this->SpaceSkipMapper->GetBuildCount());
+}
+int vtkSpaceSkipVolumeRepresentation::GetClassifyCount()
+{
+  return static_cast<int>(this->SpaceSkipMapper->GetClassifyCount());
+}
+int vtkSpaceSkipVolumeRepresentation::GetColorUpdateCount()
+{
+  return static_cast<int>(this->SpaceSkipMapper->GetColorUpdateCount());
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "SpaceSkipMapper: " << this->SpaceSkipMapper << "\n";
+}

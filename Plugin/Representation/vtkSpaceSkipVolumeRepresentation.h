@@ -1,0 +1,79 @@
+// ParaView's image-data volume representation with vtkSpaceSkippingVolumeMapper installed.
+/**
+ * @class vtkSpaceSkipVolumeRepresentation
+ * @brief "Space Skipping Volume": vtkImageVolumeRepresentation rendering with empty-space skipping.
+ *
+ * Everything but the mapper comes from vtkImageVolumeRepresentation: input handling, colour and
+ * opacity transfer functions, the outline on ranks without data, ordered compositing in parallel
+ * (each rank renders its own piece; ParaView composites the pieces in visibility order).
+ * The setters forward to the mapper; the getters report its last build and frame.
+ *
+ * Limits: vtkImageData input only (a vtkPartitionedDataSet or vtkRectilinearGrid is refused by the
+ * base class or by the mapper with a warning); 1-component point scalars.
+ */
+#ifndef vtkSpaceSkipVolumeRepresentation_h
+#define vtkSpaceSkipVolumeRepresentation_h
+
+#include "vtkImageVolumeRepresentation.h"
+#include "vtkSpaceSkipRepresentationModule.h" // for export macro
+
+#include <string> // for std::string
+
+class vtkSpaceSkippingVolumeMapper;
+
+class VTKSPACESKIPREPRESENTATION_EXPORT vtkSpaceSkipVolumeRepresentation
+  : public vtkImageVolumeRepresentation
+{
+public:
+  static vtkSpaceSkipVolumeRepresentation* New();
+  vtkTypeMacro(vtkSpaceSkipVolumeRepresentation, vtkImageVolumeRepresentation);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /// Mapper parameters (see vtkSpaceSkippingVolumeMapper).
+  void SetBuilder(int builder);
+  int GetBuilder();
+  void SetLeafCriterion(int criterion);
+  int GetLeafCriterion();
+  void SetMaxLeafSize(int mls);
+  int GetMaxLeafSize();
+  void SetBinCount(int bins);
+  int GetBinCount();
+  void SetSampleDistance(double distance);
+  double GetSampleDistance();
+  void SetBackend(int backend);
+  int GetBackend();
+  void SetEarlyRayTermination(int on);
+  int GetEarlyRayTermination();
+  ///@}
+
+  ///@{
+  /// Statistics of the mapper's last build and frame on this process (rank 0 in parallel).
+  double GetLastBuildSeconds();
+  double GetLastRenderSeconds();
+  double GetNodeCount();
+  int GetTreeHeight();
+  double GetLeafCount();
+  const char* GetBackendUsed();
+  int GetBuildCount();
+  int GetClassifyCount();
+  int GetColorUpdateCount();
+  ///@}
+
+  /// The mapper itself (for C++ callers and tests).
+  vtkSpaceSkippingVolumeMapper* GetSpaceSkippingMapper() { return this->SpaceSkipMapper; }
+
+protected:
+  vtkSpaceSkipVolumeRepresentation();
+  ~vtkSpaceSkipVolumeRepresentation() override;
+
+  /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
+  vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
+  std::string BackendUsedName;
+
+private:
+  vtkSpaceSkipVolumeRepresentation(const vtkSpaceSkipVolumeRepresentation&) = delete;
+  void operator=(const vtkSpaceSkipVolumeRepresentation&) = delete;
+};
+
+#endif
