@@ -85,6 +85,10 @@ double vtkSpaceSkipVolumeRepresentation::GetLastBuildSeconds()
 {
   return this->SpaceSkipMapper->GetLastBuildSeconds();
 }
+double vtkSpaceSkipVolumeRepresentation::GetLastClassifySeconds()
+{
+  return this->SpaceSkipMapper->GetLastClassifySeconds();
+}
 double vtkSpaceSkipVolumeRepresentation::GetLastRenderSeconds()
 {
   return this->SpaceSkipMapper->GetLastRenderSeconds();
@@ -100,6 +104,17 @@ int vtkSpaceSkipVolumeRepresentation::GetTreeHeight()
 double vtkSpaceSkipVolumeRepresentation::GetLeafCount()
 {
   return static_cast<double>(this->SpaceSkipMapper->GetLeafCount());
+}
+double vtkSpaceSkipVolumeRepresentation::GetOccupancy()
+{
+  return this->SpaceSkipMapper->GetOccupancy();
+}
+// The string getters copy: the wrapped caller reads the value after the mapper may change it.
+const char* vtkSpaceSkipVolumeRepresentation::GetBuilderUsed()
+{
+  const char* name = this->SpaceSkipMapper->GetBuilderUsed();
+  this->BuilderUsedName = name ? name : "";
+  return this->BuilderUsedName.c_str();
 }
 const char* vtkSpaceSkipVolumeRepresentation::GetBackendUsed()
 {
@@ -118,6 +133,10 @@ int vtkSpaceSkipVolumeRepresentation::GetClassifyCount()
 int vtkSpaceSkipVolumeRepresentation::GetColorUpdateCount()
 {
   return static_cast<int>(this->SpaceSkipMapper->GetColorUpdateCount());
+}
+int vtkSpaceSkipVolumeRepresentation::GetFrameCount()
+{
+  return static_cast<int>(this->SpaceSkipMapper->GetFrameCount());
 }
 
 //------------------------------------------------------------------------------

@@ -50,14 +50,18 @@ public:
   ///@{
   /// Statistics of the mapper's last build and frame on this process (rank 0 in parallel).
   double GetLastBuildSeconds();
+  double GetLastClassifySeconds();
   double GetLastRenderSeconds();
   double GetNodeCount();
   int GetTreeHeight();
   double GetLeafCount();
+  double GetOccupancy();
   const char* GetBackendUsed();
+  const char* GetBuilderUsed();
   int GetBuildCount();
   int GetClassifyCount();
   int GetColorUpdateCount();
+  int GetFrameCount();
   ///@}
 
   /// The mapper itself (for C++ callers and tests).
@@ -70,6 +74,7 @@ protected:
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
   std::string BackendUsedName;
+  std::string BuilderUsedName;
 
 private:
   vtkSpaceSkipVolumeRepresentation(const vtkSpaceSkipVolumeRepresentation&) = delete;
