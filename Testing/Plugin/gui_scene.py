@@ -1,0 +1,33 @@
+"""Run inside the paraview GUI (paraview --script=gui_scene.py) with PV_PLUGIN_PATH pointing at
+the plugin: shows the bundled shell with 'Space Skipping Volume', saves the view, and writes
+gui_done.txt (with the representation's statistics) for the driver, test_gui.py."""
+import json
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(os.environ["SPACESKIP_GUI_SCENE"])))
+from paraview.simple import *
+import ssptest
+
+out = os.environ["SPACESKIP_TEMP"]
+try:
+    import paraview.simple
+    paraview.simple._DisableFirstRenderCameraReset()  # keep the scene's camera
+    reader = ssptest.open_data()
+    RenameSource("shell_64x64x64_uint8.raw", reader)
+    view = GetActiveViewOrCreate("RenderView")
+    ssptest.make_view(size=list(view.ViewSize), view=view)
+    disp = ssptest.show_space_skipping(reader, view, builder="Grid", backend="CPU")
+    ssptest.set_camera(view)
+    SetActiveSource(reader)
+    Render(view)
+    SaveScreenshot(os.path.join(out, "gui_view.png"), view, ImageResolution=list(ssptest.IMAGE_SIZE),
+                   TransparentBackground=0)
+    result = {"representation": disp.SMProxy.GetProperty("Representation").GetElement(0),
+              "stats": ssptest.stats(disp)}
+except Exception as e:  # report to the driver instead of leaving it waiting
+    import traceback
+    result = {"error": traceback.format_exc()}
+with open(os.path.join(out, "gui_done.tmp"), "w") as f:
+    json.dump(result, f, default=str)
+os.replace(os.path.join(out, "gui_done.tmp"), os.path.join(out, "gui_done.txt"))

@@ -1,0 +1,21 @@
+"""Renders the reference scene to argv[1]; run by pvbatch serially and under mpiexec.
+Prints how the data was distributed (the ranks that hold a piece of the volume)."""
+import sys
+from paraview.simple import *
+import ssptest
+
+out = sys.argv[1]
+builder = sys.argv[2] if len(sys.argv) > 2 else "Grid"
+ssptest.load_plugin()
+reader, view, disp = ssptest.make_scene(builder=builder, backend="CPU")
+Render(view)
+SaveScreenshot(out, view, ImageResolution=list(view.ViewSize), TransparentBackground=0)
+
+# Which ranks hold which part of the volume: the process-id array of ParaView's own filter.
+pids = ProcessIdScalars(Input=reader) if "ProcessIdScalars" in dir() else ProcessIds(Input=reader)
+pids.UpdatePipeline()
+rng = pids.PointData["ProcessId"].GetRange() if "ProcessId" in pids.PointData.keys() else None
+n = servermanager.ActiveConnection.GetNumberOfDataPartitions()
+print("SPACESKIP_PARALLEL ranks=%d process_id_range=%s" % (n, rng))
+s = ssptest.stats(disp)
+print("SPACESKIP_PARALLEL rank0_stats=%s" % s)

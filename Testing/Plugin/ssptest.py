@@ -1,0 +1,189 @@
+"""Shared helpers of the SpaceSkip ParaView plugin tests (pvpython, pvbatch, paraview GUI).
+
+Environment (set by CTest, see CMakeLists.txt): SPACESKIP_PLUGIN (the plugin .so),
+SPACESKIP_DATA (Data/ folder), SPACESKIP_BASELINES (Baseline/ folder), SPACESKIP_TEMP (output
+folder for images). A missing baseline fails the test and leaves the image in SPACESKIP_TEMP.
+"""
+import math
+import os
+import sys
+
+DATA_FILE = "shell_64x64x64_uint8.raw"
+DIMS = (64, 64, 64)
+ARRAY = "ImageFile"  # the point array vtkImageReader produces
+IMAGE_SIZE = (320, 320)
+
+
+def env(name):
+    value = os.environ.get(name)
+    if not value:
+        raise RuntimeError("environment variable %s is not set (run through ctest)" % name)
+    return value
+
+
+def temp_path(name):
+    folder = env("SPACESKIP_TEMP")
+    os.makedirs(folder, exist_ok=True)
+    return os.path.join(folder, name)
+
+
+def load_plugin():
+    """Loads the plugin on the client and the (builtin or MPI) server."""
+    from paraview import simple
+    simple._DisableFirstRenderCameraReset()  # keep the test's camera on the first Render()
+    simple.LoadPlugin(env("SPACESKIP_PLUGIN"), remote=False, ns=vars(simple))
+
+
+def open_data():
+    from paraview import simple
+    reader = simple.ImageReader(FileNames=[os.path.join(env("SPACESKIP_DATA"), DATA_FILE)])
+    reader.DataScalarType = "unsigned char"
+    reader.DataExtent = [0, DIMS[0] - 1, 0, DIMS[1] - 1, 0, DIMS[2] - 1]
+    reader.DataSpacing = [1.0, 1.0, 1.0]
+    reader.DataOrigin = [0.0, 0.0, 0.0]
+    return reader
+
+
+def make_view(size=IMAGE_SIZE, view=None):
+    from paraview import simple
+    if view is None:
+        view = simple.CreateView("RenderView")
+    view.ViewSize = list(size)
+    view.OrientationAxesVisibility = 0
+    if hasattr(view, "UseColorPaletteForBackground"):
+        view.UseColorPaletteForBackground = 0
+    view.Background = [0.0, 0.0, 0.0]
+    view.EnableRenderOnInteraction = 0
+    return view
+
+
+def set_camera(view):
+    c = [(d - 1) / 2.0 for d in DIMS]
+    view.CameraFocalPoint = c
+    view.CameraPosition = [c[0] + 70.0, c[1] + 45.0, c[2] + 95.0]
+    view.CameraViewUp = [0.0, 1.0, 0.0]
+    view.CameraViewAngle = 30.0
+    view.CameraParallelProjection = 0
+
+
+def set_transfer_functions(lut_points=None, opacity_points=None):
+    """Colour map over [0, 255] and an opacity ramp that is 0 below 40: the shell's inside and
+    outside are empty, so the skipping structures have something to skip."""
+    from paraview import simple
+    lut = simple.GetColorTransferFunction(ARRAY)
+    lut.AutomaticRescaleRangeMode = "Never"
+    lut.RGBPoints = lut_points or [40.0, 0.23, 0.30, 0.75, 140.0, 0.87, 0.87, 0.87,
+                                   255.0, 0.71, 0.02, 0.15]
+    pwf = simple.GetOpacityTransferFunction(ARRAY)
+    pwf.Points = opacity_points or [0.0, 0.0, 0.5, 0.0, 40.0, 0.0, 0.5, 0.0,
+                                    255.0, 0.35, 0.5, 0.0]
+    return lut, pwf
+
+
+def show_space_skipping(source, view, builder="KdTreeCPU", backend="CPU"):
+    from paraview import simple
+    disp = simple.Show(source, view)
+    disp.SetRepresentationType("Space Skipping Volume")
+    simple.ColorBy(disp, ("POINTS", ARRAY))
+    set_transfer_functions()
+    disp.ScalarOpacityUnitDistance = 4.0
+    disp.Builder = builder
+    disp.Backend = backend
+    return disp
+
+
+def make_scene(builder="KdTreeCPU", backend="CPU", size=IMAGE_SIZE, view=None):
+    """The reference scene: the bundled shell, fixed camera, fixed transfer functions."""
+    reader = open_data()
+    view = make_view(size, view)
+    disp = show_space_skipping(reader, view, builder, backend)
+    set_camera(view)
+    return reader, view, disp
+
+
+def mapper_of(disp):
+    """The vtkSpaceSkipVolumeRepresentation behind a display proxy (builtin session only)."""
+    rep = disp.GetClientSideObject().GetActiveRepresentation()
+    if rep is None or rep.GetClassName() != "vtkSpaceSkipVolumeRepresentation":
+        raise AssertionError("active representation is %s" % (rep and rep.GetClassName()))
+    return rep
+
+
+def stats(disp):
+    disp.UpdatePropertyInformation()
+    names = ["BuilderUsed", "BackendUsed", "LastBuildSeconds", "LastClassifySeconds",
+             "LastRenderSeconds", "NodeCount", "LeafCount", "TreeHeight", "Occupancy",
+             "BuildCount", "ClassifyCount", "ColorUpdateCount", "FrameCount"]
+    return {n: disp.GetPropertyValue(n) for n in names}
+
+
+def render_to(view, name):
+    from paraview import simple
+    path = temp_path(name)
+    simple.Render(view)
+    simple.SaveScreenshot(path, view, ImageResolution=list(view.ViewSize),
+                          TransparentBackground=0)
+    return path
+
+
+# -- images ----------------------------------------------------------------------------------
+
+def read_png(path):
+    import numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    if not os.path.exists(path):
+        raise FileNotFoundError(path)
+    r = vtkPNGReader()
+    r.SetFileName(path)
+    r.Update()
+    img = r.GetOutput()
+    w, h, _ = img.GetDimensions()
+    a = vtk_to_numpy(img.GetPointData().GetScalars())
+    a = a.reshape(h, w, -1)[:, :, :3].astype(numpy.float64)
+    return a
+
+
+def psnr(a, b):
+    import numpy
+    if a.shape != b.shape:
+        raise ValueError("image sizes differ: %s vs %s" % (a.shape, b.shape))
+    mse = numpy.mean((a - b) ** 2)
+    return float("inf") if mse == 0 else 10.0 * math.log10(255.0 ** 2 / mse)
+
+
+def lit_fraction(a, threshold=8):
+    """Fraction of pixels that differ from the black background."""
+    return float((a.max(axis=2) > threshold).mean())
+
+
+def compare_to_baseline(path, baseline_name, min_psnr=40.0):
+    base = os.path.join(env("SPACESKIP_BASELINES"), baseline_name)
+    if not os.path.exists(base):
+        raise AssertionError("no baseline %s; the rendered image is %s" % (base, path))
+    value = psnr(read_png(path), read_png(base))
+    print("PSNR %s vs %s: %.2f dB (need >= %.1f)" % (os.path.basename(path), baseline_name,
+                                                     value, min_psnr))
+    if value < min_psnr:
+        raise AssertionError("%s differs from baseline %s: PSNR %.2f dB < %.1f dB"
+                             % (path, base, value, min_psnr))
+    return value
+
+
+class Checker:
+    """Collects failures so one run reports all of them; exit code 1 when any failed."""
+
+    def __init__(self):
+        self.failures = []
+
+    def check(self, cond, message):
+        print(("ok   " if cond else "FAIL ") + message)
+        if not cond:
+            self.failures.append(message)
+
+    def done(self):
+        if self.failures:
+            print("%d check(s) failed" % len(self.failures))
+            sys.stdout.flush()
+            os._exit(1)
+        print("all checks passed")
