@@ -350,10 +350,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       fail(std::string("cannot create the SpaceSkip engine: ") + e.what());
       return;
     }
-    d.Engine->setLogger([this](const std::string& m) {
-      vtkWarningWithObjectMacro(this, << m);
-      vtkLogF(INFO, "vtkSpaceSkippingVolumeMapper: %s", m.c_str());
-    });
+    d.Engine->setLogger([this](const std::string& m) { vtkWarningWithObjectMacro(this, << m); });
     d.EngineBackend = this->Backend;
     d.ResetVolume();
     d.ResetTF();
@@ -537,7 +534,20 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       }
     }
 
+    const int buildsBefore = engine.counters().builds;
     engine.render(camera, width, height, d.Image, depth);
+    if (engine.counters().builds != buildsBefore)
+    {
+      const spaceskip::BuildStats& bs = engine.buildStats();
+      vtkVLogF(vtkLogger::VERBOSITY_TRACE,
+        "vtkSpaceSkippingVolumeMapper: built %s on %s in %.6f s (classify %.6f s): %lld nodes, "
+        "height %d, %lld leaves, occupancy %.4f",
+        spaceskip::builderName(bs.builder), bs.builtOn.c_str(), bs.seconds, bs.classifySeconds,
+        static_cast<long long>(bs.nodes), bs.height, static_cast<long long>(bs.leaves),
+        bs.occupancy);
+    }
+    vtkVLogF(vtkLogger::VERBOSITY_TRACE, "vtkSpaceSkippingVolumeMapper: %dx%d frame in %.6f s on %s",
+      width, height, engine.frameStats().seconds, engine.frameStats().backend.c_str());
     d.BackendUsed = engine.frameStats().backend;
     d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
 
