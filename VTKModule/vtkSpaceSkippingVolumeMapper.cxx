@@ -343,7 +343,11 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.Engine.reset();
     try
     {
-      d.Engine.reset(new spaceskip::Engine(static_cast<spaceskip::BackendKind>(this->Backend)));
+      // Engine(CUDA) would report a missing device before setLogger() can route the message to
+      // VTK; Auto makes the same choice silently and the mapper reports it below.
+      const spaceskip::BackendKind kind = this->Backend == CPU ? spaceskip::BackendKind::CPU
+                                                               : spaceskip::BackendKind::Auto;
+      d.Engine.reset(new spaceskip::Engine(kind));
     }
     catch (const std::exception& e)
     {
@@ -352,6 +356,11 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     }
     d.Engine->setLogger([this](const std::string& m) { vtkWarningWithObjectMacro(this, << m); });
     d.EngineBackend = this->Backend;
+    if (this->Backend == CUDA && d.Engine->backendKind() != spaceskip::BackendKind::CUDA)
+    {
+      vtkWarningMacro(<< "CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
+                         "without CUDA); using the CPU backend");
+    }
     d.ResetVolume();
     d.ResetTF();
   }
