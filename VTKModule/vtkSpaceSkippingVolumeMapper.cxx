@@ -10,6 +10,7 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLCamera.h"
+#include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderUtilities.h"
 #include "vtkOpenGLRenderWindow.h"
@@ -136,7 +137,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   std::vector<float> Depth;
   vtkSmartPointer<vtkTextureObject> Texture;
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
-  bool WarnedMultisample = false;
+  vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
+  bool ResolveStencil = false;
   bool WarnedNearest = false;
   bool WarnedDepthRead = false;
 
@@ -253,7 +255,66 @@ void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
     d.Quad->ReleaseGraphicsResources(win);
     d.Quad.reset();
   }
+  if (d.Resolve)
+  {
+    d.Resolve->ReleaseGraphicsResources(win);
+    d.Resolve = nullptr;
+  }
   this->Superclass::ReleaseGraphicsResources(win);
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkippingVolumeMapper::ReadDepth(
+  vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height)
+{
+  vtkInternals& d = *this->Internals;
+  vtkOpenGLState* ostate = renWin->GetState();
+  while (glGetError() != GL_NO_ERROR)
+  {
+  }
+  ostate->vtkglPixelStorei(GL_PACK_ALIGNMENT, 1);
+  GLint sampleBuffers = 0;
+  glGetIntegerv(GL_SAMPLE_BUFFERS, &sampleBuffers);
+  if (sampleBuffers <= 0)
+  {
+    glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
+    return glGetError() == GL_NO_ERROR;
+  }
+
+  // Multisampled framebuffer: resolve its depth into a single-sample framebuffer of the same
+  // depth format (what vtkOpenGLRenderWindow allocates: 32 bits, stencil when the window has
+  // one), over the same rectangle (a multisample blit cannot move pixels), then read that.
+  GLint source = 0;
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &source);
+  const int needW = x0 + width, needH = y0 + height;
+  const bool stencil = renWin->GetStencilCapable() != 0;
+  ostate->PushFramebufferBindings();
+  if (!d.Resolve || d.ResolveStencil != stencil)
+  {
+    d.Resolve = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
+    d.Resolve->SetContext(renWin);
+    d.Resolve->Bind();
+    d.Resolve->PopulateFramebuffer(needW, needH, true, 1, VTK_UNSIGNED_CHAR, true, 32, 0, stencil);
+    d.ResolveStencil = stencil;
+  }
+  else
+  {
+    int* size = d.Resolve->GetLastSize();
+    if (size[0] != needW || size[1] != needH)
+    {
+      d.Resolve->Bind();
+      d.Resolve->Resize(needW, needH);
+    }
+  }
+  ostate->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<unsigned int>(source));
+  d.Resolve->Bind(GL_DRAW_FRAMEBUFFER);
+  glBlitFramebuffer(x0, y0, x0 + width, y0 + height, x0, y0, x0 + width, y0 + height,
+    GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  d.Resolve->Bind(GL_READ_FRAMEBUFFER);
+  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
+  const bool ok = glGetError() == GL_NO_ERROR;
+  ostate->PopFramebufferBindings();
+  return ok;
 }
 
 //------------------------------------------------------------------------------
@@ -513,34 +574,15 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // Depth of the opaque geometry already drawn, read from the framebuffer being rendered.
     vtkOpenGLState* ostate = renWin->GetState();
     const float* depth = nullptr;
-    GLint sampleBuffers = 0;
-    glGetIntegerv(GL_SAMPLE_BUFFERS, &sampleBuffers);
-    if (sampleBuffers > 0)
+    d.Depth.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
+    if (this->ReadDepth(renWin, x0, y0, width, height))
     {
-      if (!d.WarnedMultisample)
-      {
-        vtkWarningMacro(<< "multisampled framebuffer: the volume ignores the depth of opaque "
-                           "geometry (set the render window's MultiSamples to 0)");
-        d.WarnedMultisample = true;
-      }
+      depth = d.Depth.data();
     }
-    else
+    else if (!d.WarnedDepthRead)
     {
-      d.Depth.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
-      ostate->vtkglPixelStorei(GL_PACK_ALIGNMENT, 1);
-      while (glGetError() != GL_NO_ERROR)
-      {
-      }
-      glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
-      if (glGetError() == GL_NO_ERROR)
-      {
-        depth = d.Depth.data();
-      }
-      else if (!d.WarnedDepthRead)
-      {
-        vtkWarningMacro(<< "could not read the depth buffer: the volume ignores opaque geometry");
-        d.WarnedDepthRead = true;
-      }
+      vtkWarningMacro(<< "could not read the depth buffer: the volume ignores opaque geometry");
+      d.WarnedDepthRead = true;
     }
 
     const int buildsBefore = engine.counters().builds;
