@@ -17,6 +17,7 @@
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
@@ -140,6 +141,9 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
   bool ResolveStencil = false;
   bool WarnedNearest = false;
+  bool WarnedShade = false;
+  bool WarnedBlend = false;
+  bool WarnedClip = false;
   bool WarnedDepthRead = false;
 
   void ResetVolume()
@@ -530,12 +534,23 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       d.TableRange[1] = hi;
       d.HaveTF = true;
     }
-    if (prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION && !d.WarnedNearest)
-    {
-      vtkWarningMacro(<< "nearest interpolation is not supported; rendering with trilinear "
-                         "interpolation");
-      d.WarnedNearest = true;
-    }
+    // Features of vtkVolumeProperty/vtkVolumeMapper the engine does not have: said once each.
+    auto unsupported = [&](bool used, bool& warned, const char* what) {
+      if (used && !warned)
+      {
+        vtkWarningMacro(<< what);
+      }
+      warned = warned || used;
+    };
+    unsupported(prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION, d.WarnedNearest,
+      "nearest interpolation is not supported; rendering with trilinear interpolation");
+    unsupported(prop->GetShade(0) != 0, d.WarnedShade,
+      "shading is not supported yet; rendering unshaded (emission-absorption)");
+    unsupported(this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND, d.WarnedBlend,
+      "only the composite blend mode is supported; rendering with composite blending");
+    unsupported(this->Cropping != 0 ||
+        (this->ClippingPlanes && this->ClippingPlanes->GetNumberOfItems() > 0),
+      d.WarnedClip, "cropping and clipping planes are not supported; rendering the whole volume");
 
     spaceskip::BuildParams bp;
     bp.builder = static_cast<spaceskip::BuilderKind>(this->Builder);

@@ -17,6 +17,8 @@
 
 #include "SpaceSkipTestHelpers.h"
 
+#include <functional>
+
 namespace
 {
 vtkSmartPointer<vtkImageData> Blank(int n)
@@ -163,6 +165,61 @@ int TestSpaceSkippingVolumeBadInput(int, char*[])
       ++failures;
     }
     ren->RemoveVolume(volume);
+  }
+
+  // Unsupported rendering options: one warning each, the volume still drawn (as composite,
+  // trilinear, unshaded, uncropped).
+  {
+    struct Option
+    {
+      const char* name;
+      std::function<void(vtkSpaceSkippingVolumeMapper*, vtkVolumeProperty*)> set;
+      const char* expect;
+    };
+    const Option options[] = {
+      { "nearest interpolation",
+        [](vtkSpaceSkippingVolumeMapper*, vtkVolumeProperty* p) {
+          p->SetInterpolationTypeToNearest();
+        },
+        "nearest interpolation is not supported" },
+      { "shading", [](vtkSpaceSkippingVolumeMapper*, vtkVolumeProperty* p) { p->ShadeOn(); },
+        "shading is not supported" },
+      { "MIP",
+        [](vtkSpaceSkippingVolumeMapper* m, vtkVolumeProperty*) {
+          m->SetBlendModeToMaximumIntensity();
+        },
+        "only the composite blend mode" },
+      { "cropping",
+        [](vtkSpaceSkippingVolumeMapper* m, vtkVolumeProperty*) { m->CroppingOn(); },
+        "cropping and clipping planes are not supported" },
+    };
+    for (const Option& o : options)
+    {
+      vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
+      mapper->SetInputData(good);
+      vtkNew<vtkVolumeProperty> p;
+      p->DeepCopy(prop);
+      o.set(mapper, p);
+      vtkNew<sstest::MessageCollector> messages;
+      mapper->AddObserver(vtkCommand::ErrorEvent, messages);
+      mapper->AddObserver(vtkCommand::WarningEvent, messages);
+      goodVolume->SetMapper(mapper);
+      goodVolume->SetProperty(p);
+      win->Render();
+      win->Render();
+      const vtkIdType drawn = sstest::CountNonBackground(sstest::Capture(win), black);
+      std::cout << o.name << ": warnings " << messages->WarningCount << ", errors "
+                << messages->ErrorCount << ", pixels " << drawn << "\n    message: "
+                << messages->Warnings << "\n";
+      if (messages->WarningCount != 1 || messages->ErrorCount != 0 ||
+        messages->Warnings.find(o.expect) == std::string::npos || drawn < 500)
+      {
+        std::cout << "  FAILED\n";
+        ++failures;
+      }
+    }
+    goodVolume->SetMapper(goodMapper);
+    goodVolume->SetProperty(prop);
   }
 
   // A forced CUDA backend without a usable device: one warning, the CPU backend draws.

@@ -152,6 +152,7 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   const double black[3] = { 0, 0, 0 };
   ok &= sstest::CountNonBackground(img8, black) == 0;
 
+  mapper->Print(std::cout);
   SS_CHECK(ok);
   return EXIT_SUCCESS;
 }
