@@ -10,12 +10,14 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLCamera.h"
+#include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderUtilities.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
@@ -136,8 +138,12 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   std::vector<float> Depth;
   vtkSmartPointer<vtkTextureObject> Texture;
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
-  bool WarnedMultisample = false;
+  vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
+  bool ResolveStencil = false;
   bool WarnedNearest = false;
+  bool WarnedShade = false;
+  bool WarnedBlend = false;
+  bool WarnedClip = false;
   bool WarnedDepthRead = false;
 
   void ResetVolume()
@@ -253,7 +259,66 @@ void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
     d.Quad->ReleaseGraphicsResources(win);
     d.Quad.reset();
   }
+  if (d.Resolve)
+  {
+    d.Resolve->ReleaseGraphicsResources(win);
+    d.Resolve = nullptr;
+  }
   this->Superclass::ReleaseGraphicsResources(win);
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkippingVolumeMapper::ReadDepth(
+  vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height)
+{
+  vtkInternals& d = *this->Internals;
+  vtkOpenGLState* ostate = renWin->GetState();
+  while (glGetError() != GL_NO_ERROR)
+  {
+  }
+  ostate->vtkglPixelStorei(GL_PACK_ALIGNMENT, 1);
+  GLint sampleBuffers = 0;
+  glGetIntegerv(GL_SAMPLE_BUFFERS, &sampleBuffers);
+  if (sampleBuffers <= 0)
+  {
+    glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
+    return glGetError() == GL_NO_ERROR;
+  }
+
+  // Multisampled framebuffer: resolve its depth into a single-sample framebuffer of the same
+  // depth format (what vtkOpenGLRenderWindow allocates: 32 bits, stencil when the window has
+  // one), over the same rectangle (a multisample blit cannot move pixels), then read that.
+  GLint source = 0;
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &source);
+  const int needW = x0 + width, needH = y0 + height;
+  const bool stencil = renWin->GetStencilCapable() != 0;
+  ostate->PushFramebufferBindings();
+  if (!d.Resolve || d.ResolveStencil != stencil)
+  {
+    d.Resolve = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
+    d.Resolve->SetContext(renWin);
+    d.Resolve->Bind();
+    d.Resolve->PopulateFramebuffer(needW, needH, true, 1, VTK_UNSIGNED_CHAR, true, 32, 0, stencil);
+    d.ResolveStencil = stencil;
+  }
+  else
+  {
+    int* size = d.Resolve->GetLastSize();
+    if (size[0] != needW || size[1] != needH)
+    {
+      d.Resolve->Bind();
+      d.Resolve->Resize(needW, needH);
+    }
+  }
+  ostate->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<unsigned int>(source));
+  d.Resolve->Bind(GL_DRAW_FRAMEBUFFER);
+  glBlitFramebuffer(x0, y0, x0 + width, y0 + height, x0, y0, x0 + width, y0 + height,
+    GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  d.Resolve->Bind(GL_READ_FRAMEBUFFER);
+  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
+  const bool ok = glGetError() == GL_NO_ERROR;
+  ostate->PopFramebufferBindings();
+  return ok;
 }
 
 //------------------------------------------------------------------------------
@@ -343,18 +408,24 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.Engine.reset();
     try
     {
-      d.Engine.reset(new spaceskip::Engine(static_cast<spaceskip::BackendKind>(this->Backend)));
+      // Engine(CUDA) would report a missing device before setLogger() can route the message to
+      // VTK; Auto makes the same choice silently and the mapper reports it below.
+      const spaceskip::BackendKind kind = this->Backend == CPU ? spaceskip::BackendKind::CPU
+                                                               : spaceskip::BackendKind::Auto;
+      d.Engine.reset(new spaceskip::Engine(kind));
     }
     catch (const std::exception& e)
     {
       fail(std::string("cannot create the SpaceSkip engine: ") + e.what());
       return;
     }
-    d.Engine->setLogger([this](const std::string& m) {
-      vtkWarningWithObjectMacro(this, << m);
-      vtkLogF(INFO, "vtkSpaceSkippingVolumeMapper: %s", m.c_str());
-    });
+    d.Engine->setLogger([this](const std::string& m) { vtkWarningWithObjectMacro(this, << m); });
     d.EngineBackend = this->Backend;
+    if (this->Backend == CUDA && d.Engine->backendKind() != spaceskip::BackendKind::CUDA)
+    {
+      vtkWarningMacro(<< "CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
+                         "without CUDA); using the CPU backend");
+    }
     d.ResetVolume();
     d.ResetTF();
   }
@@ -463,12 +534,23 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       d.TableRange[1] = hi;
       d.HaveTF = true;
     }
-    if (prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION && !d.WarnedNearest)
-    {
-      vtkWarningMacro(<< "nearest interpolation is not supported; rendering with trilinear "
-                         "interpolation");
-      d.WarnedNearest = true;
-    }
+    // Features of vtkVolumeProperty/vtkVolumeMapper the engine does not have: said once each.
+    auto unsupported = [&](bool used, bool& warned, const char* what) {
+      if (used && !warned)
+      {
+        vtkWarningMacro(<< what);
+      }
+      warned = warned || used;
+    };
+    unsupported(prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION, d.WarnedNearest,
+      "nearest interpolation is not supported; rendering with trilinear interpolation");
+    unsupported(prop->GetShade(0) != 0, d.WarnedShade,
+      "shading is not supported yet; rendering unshaded (emission-absorption)");
+    unsupported(this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND, d.WarnedBlend,
+      "only the composite blend mode is supported; rendering with composite blending");
+    unsupported(this->Cropping != 0 ||
+        (this->ClippingPlanes && this->ClippingPlanes->GetNumberOfItems() > 0),
+      d.WarnedClip, "cropping and clipping planes are not supported; rendering the whole volume");
 
     spaceskip::BuildParams bp;
     bp.builder = static_cast<spaceskip::BuilderKind>(this->Builder);
@@ -507,37 +589,31 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // Depth of the opaque geometry already drawn, read from the framebuffer being rendered.
     vtkOpenGLState* ostate = renWin->GetState();
     const float* depth = nullptr;
-    GLint sampleBuffers = 0;
-    glGetIntegerv(GL_SAMPLE_BUFFERS, &sampleBuffers);
-    if (sampleBuffers > 0)
+    d.Depth.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
+    if (this->ReadDepth(renWin, x0, y0, width, height))
     {
-      if (!d.WarnedMultisample)
-      {
-        vtkWarningMacro(<< "multisampled framebuffer: the volume ignores the depth of opaque "
-                           "geometry (set the render window's MultiSamples to 0)");
-        d.WarnedMultisample = true;
-      }
+      depth = d.Depth.data();
     }
-    else
+    else if (!d.WarnedDepthRead)
     {
-      d.Depth.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
-      ostate->vtkglPixelStorei(GL_PACK_ALIGNMENT, 1);
-      while (glGetError() != GL_NO_ERROR)
-      {
-      }
-      glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
-      if (glGetError() == GL_NO_ERROR)
-      {
-        depth = d.Depth.data();
-      }
-      else if (!d.WarnedDepthRead)
-      {
-        vtkWarningMacro(<< "could not read the depth buffer: the volume ignores opaque geometry");
-        d.WarnedDepthRead = true;
-      }
+      vtkWarningMacro(<< "could not read the depth buffer: the volume ignores opaque geometry");
+      d.WarnedDepthRead = true;
     }
 
+    const int buildsBefore = engine.counters().builds;
     engine.render(camera, width, height, d.Image, depth);
+    if (engine.counters().builds != buildsBefore)
+    {
+      const spaceskip::BuildStats& bs = engine.buildStats();
+      vtkVLogF(vtkLogger::VERBOSITY_TRACE,
+        "vtkSpaceSkippingVolumeMapper: built %s on %s in %.6f s (classify %.6f s): %lld nodes, "
+        "height %d, %lld leaves, occupancy %.4f",
+        spaceskip::builderName(bs.builder), bs.builtOn.c_str(), bs.seconds, bs.classifySeconds,
+        static_cast<long long>(bs.nodes), bs.height, static_cast<long long>(bs.leaves),
+        bs.occupancy);
+    }
+    vtkVLogF(vtkLogger::VERBOSITY_TRACE, "vtkSpaceSkippingVolumeMapper: %dx%d frame in %.6f s on %s",
+      width, height, engine.frameStats().seconds, engine.frameStats().backend.c_str());
     d.BackendUsed = engine.frameStats().backend;
     d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
 

@@ -24,6 +24,7 @@
 
 #include <memory> // For std::unique_ptr
 
+class vtkOpenGLRenderWindow;
 class vtkRenderer;
 class vtkVolume;
 class vtkWindow;
@@ -179,6 +180,9 @@ protected:
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;
   void operator=(const vtkSpaceSkippingVolumeMapper&) = delete;
+
+  // Reads the window depth of the viewport into the internal buffer (resolving MSAA if needed).
+  bool ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
