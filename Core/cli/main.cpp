@@ -43,6 +43,7 @@ options:
   --sample-distance D  (world units; default half the smallest spacing)
   --ert T  --jitter  --filter exact|hardware
   --compare REF.png  print max difference and PSNR against a reference image
+  --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
 )";
 
 struct Options {
@@ -218,6 +219,11 @@ int cmdRender(const Options& o) {
     ImageDiff d = compareImages(img, loadPng(o.get("--compare", "")));
     std::printf("compare: max diff %.5f (%.2f/255), PSNR %.2f dB, %lld pixels > 1/255\n", d.maxAbs, d.maxAbs * 255,
                 d.psnr, (long long)d.differing);
+    if (o.has("--max-diff") && d.maxAbs * 255.0 > std::stod(o.get("--max-diff", "1"))) {
+      std::fprintf(stderr, "spaceskip: max difference %.2f/255 exceeds --max-diff %s\n", d.maxAbs * 255.0,
+                   o.get("--max-diff", "").c_str());
+      return 3;
+    }
   }
   return 0;
 }
