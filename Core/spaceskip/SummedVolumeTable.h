@@ -9,7 +9,7 @@
 namespace spaceskip {
 
 /// Boxes here are in BRICK coordinates, half-open, like OccupancyGrid's (x,y,z) indices.
-/// The table is global (one prefix sum over the whole grid, built with three parallel passes)
+/// The table is global (one prefix sum over the whole grid, built with two parallel passes)
 /// rather than one per 32^3 brick as in the paper: a query is then 8 lookups wherever the box lies.
 class SummedVolumeTable {
  public:

@@ -1,4 +1,4 @@
-// Summed volume table: parallel construction (one pass per axis) and box queries.
+// Summed volume table: parallel construction (per-slice 2-D sums, then along z) and box queries.
 #include "spaceskip/SummedVolumeTable.h"
 
 #include <tbb/blocked_range.h>
@@ -15,26 +15,22 @@ SummedVolumeTable::SummedVolumeTable(const OccupancyGrid& occ) : dims_(occ.dims)
   stride_ = vec3i{nx + 1, ny + 1, nz + 1};
   const size_t sx = size_t(stride_.x), sxy = sx * size_t(stride_.y);
   sums_.assign(sxy * size_t(stride_.z), 0u);
-  // Pass 1 (x): running sums along each row; rows (y,z) are independent.
-  tbb::parallel_for(tbb::blocked_range<int>(0, ny * nz, 64), [&](const tbb::blocked_range<int>& r) {
-    for (int row = r.begin(); row != r.end(); ++row) {
-      const int y = row % ny, z = row / ny;
-      const uint8_t* src = occ.occ.data() + occ.index(0, y, z);
-      uint32_t* dst = sums_.data() + sxy * size_t(z + 1) + sx * size_t(y + 1);
-      uint32_t s = 0;
-      for (int x = 0; x < nx; ++x) dst[x + 1] = (s += src[x] ? 1u : 0u);
-    }
-  });
-  // Pass 2 (y): add the previous row, per z slice.
-  tbb::parallel_for(tbb::blocked_range<int>(1, nz + 1), [&](const tbb::blocked_range<int>& r) {
+  // Pass 1: a 2-D summed area table per z slice (x running sum plus the row below); slices are
+  // independent and a slice stays in cache while it is summed.
+  tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& r) {
     for (int z = r.begin(); z != r.end(); ++z)
-      for (int y = 2; y <= ny; ++y) {
-        uint32_t* cur = sums_.data() + sxy * size_t(z) + sx * size_t(y);
+      for (int y = 0; y < ny; ++y) {
+        const uint8_t* src = occ.occ.data() + occ.index(0, y, z);
+        uint32_t* cur = sums_.data() + sxy * size_t(z + 1) + sx * size_t(y + 1);
         const uint32_t* prev = cur - sx;
-        for (int x = 1; x <= nx; ++x) cur[x] += prev[x];
+        uint32_t s = 0;
+        for (int x = 0; x < nx; ++x) {
+          s += src[x] ? 1u : 0u;
+          cur[x + 1] = s + prev[x + 1];
+        }
       }
   });
-  // Pass 3 (z): add the previous slice, per y row (rows are independent along z).
+  // Pass 2 (z): add the previous slice, per y row (rows are independent along z).
   tbb::parallel_for(tbb::blocked_range<int>(1, ny + 1), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y != r.end(); ++y)
       for (int z = 2; z <= nz; ++z) {
