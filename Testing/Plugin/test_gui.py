@@ -53,6 +53,9 @@ finally:
         proc.wait()
     log.close()
 
+if not result:
+    with open(os.path.join(out, "gui_paraview.log")) as f:
+        print("paraview output (tail):\n" + f.read()[-3000:])
 ok.check("error" not in result, "the GUI script succeeded %s" % result.get("error", ""))
 ok.check(result.get("representation") == "Space Skipping Volume",
          "the GUI offers and uses 'Space Skipping Volume' (%s)" % result.get("representation"))

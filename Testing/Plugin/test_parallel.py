@@ -30,6 +30,8 @@ def run(cmd):
     out = p.stdout.decode(errors="replace")
     info = [l for l in out.splitlines() if "SPACESKIP_PARALLEL" in l]
     print("\n".join(info) if p.returncode == 0 else out[-6000:])
+    # The X server's refusals (see xretry.py) must be visible even when the tail is a stack trace.
+    print("\n".join(l for l in out.splitlines() if "bad X server connection" in l))
     return p.returncode, "\n".join(info)
 
 
