@@ -18,7 +18,10 @@ ssptest.load_plugin()
 reader, view, disp = ssptest.make_scene(builder=builder, backend="CPU")
 if os.environ.get("SPACESKIP_STOCK_VOLUME"):  # experiment: ParaView's own volume mapper
     disp.SetRepresentationType("Volume")
-progress("scene set up")
+if os.environ.get("SPACESKIP_EXP_NOCOLOR"):  # experiment: our representation, mapper idle
+    ColorBy(disp, None)
+progress("scene set up; remote rendering available: %s"
+         % view.GetClientSideObject().GetRemoteRenderingAvailable())
 Render(view)
 progress("rendered")
 SaveScreenshot(out, view, ImageResolution=list(view.ViewSize), TransparentBackground=0)
