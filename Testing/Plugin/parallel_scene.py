@@ -16,10 +16,9 @@ def progress(what):
 
 ssptest.load_plugin()
 reader, view, disp = ssptest.make_scene(builder=builder, backend="CPU")
-if os.environ.get("SPACESKIP_STOCK_VOLUME"):  # experiment: ParaView's own volume mapper
+if os.environ.get("SPACESKIP_STOCK_VOLUME"):
+    # For comparison runs (not a test): the same scene with ParaView's own volume mapper.
     disp.SetRepresentationType("Volume")
-if os.environ.get("SPACESKIP_EXP_NOCOLOR"):  # experiment: our representation, mapper idle
-    ColorBy(disp, None)
 progress("scene set up; remote rendering available: %s"
          % view.GetClientSideObject().GetRemoteRenderingAvailable())
 Render(view)

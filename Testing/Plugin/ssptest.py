@@ -48,9 +48,6 @@ def make_view(size=IMAGE_SIZE, view=None):
     from paraview import simple
     if view is None:
         view = simple.CreateView("RenderView")
-        if os.environ.get("SPACESKIP_EXP_PROBE"):
-            print("SPACESKIP_PARALLEL step: view created; remote rendering available: %s"
-                  % view.GetClientSideObject().GetRemoteRenderingAvailable())
     view.ViewSize = list(size)
     view.OrientationAxesVisibility = 0
     if hasattr(view, "UseColorPaletteForBackground"):
