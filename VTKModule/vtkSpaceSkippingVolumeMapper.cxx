@@ -117,6 +117,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   vtkMTimeType ScalarsMTime = 0;
   bool HaveVolume = false;
   std::vector<float> Converted; // int/long scalars converted to float
+  // The array whose voxels the engine borrows: held so it outlives the engine's use of it.
+  vtkSmartPointer<vtkDataArray> Borrowed;
   double ScalarRange[2] = { 0, 1 };
 
   const void* PropertyKey = nullptr;
@@ -151,6 +153,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
     this->InputKey = this->ScalarsKey = nullptr;
     this->InputMTime = this->ScalarsMTime = 0;
     this->HaveVolume = false;
+    this->Borrowed = nullptr;
   }
   void ResetTF()
   {
@@ -390,7 +393,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     fail("scalar array length does not match the number of points: nothing drawn");
     return;
   }
-  spaceskip::VoxelType vtype;
+  spaceskip::VoxelType vtype = spaceskip::VoxelType::Float32;
   const int stype = scalars->GetDataType();
   const bool native = CoreTypeOf(stype, vtype);
   if (!native && !ConvertibleToFloat(stype))
@@ -450,6 +453,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       {
         v.type = vtype;
         v.data = scalars->GetVoidPointer(0);
+        d.Borrowed = scalars;
         d.Converted.clear();
         d.Converted.shrink_to_fit();
       }
@@ -467,6 +471,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         }
         v.type = spaceskip::VoxelType::Float32;
         v.data = d.Converted.data();
+        d.Borrowed = nullptr;
       }
       engine.setVolume(v);
       scalars->GetFiniteRange(d.ScalarRange, 0);
