@@ -6,6 +6,7 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <cmath>
@@ -39,6 +40,8 @@ const char* kUsage = R"(usage:
   spaceskip generate SHAPE --dims X Y Z [--seed N] -o FILE(.nrrd|_XxYxZ_TYPE.raw)
       SHAPE: menger nbody shell noise rm vessels
   spaceskip render VOLUME -o out.png [options]
+  spaceskip accuracy VOLUME [--builder B] [--size WxH] [options]
+      speed/accuracy trade: sample distance x filter x ERT vs PSNR/SSIM against a fine reference, and fps
   spaceskip bench VOLUME... [--builders b1,b2,...] [--frames N] [--json FILE] [--csv FILE] [options]
       each builder may carry suffixes overriding --leaf/--mls/--bins/--brick, e.g.
       --builders naive,grid,lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid
@@ -55,6 +58,7 @@ options:
   --sample-distance D  (world units; default half the smallest spacing)
   --ert T  --jitter  --filter exact|hardware
   --compare REF.png  print max difference and PSNR against a reference image
+  --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
 )";
 
 struct Options {
@@ -259,6 +263,11 @@ int cmdRender(const Options& o) {
     ImageDiff d = compareImages(img, loadPng(o.get("--compare", "")));
     std::printf("compare: max diff %.5f (%.2f/255), PSNR %.2f dB, %lld pixels > 1/255\n", d.maxAbs, d.maxAbs * 255,
                 d.psnr, (long long)d.differing);
+    if (o.has("--max-diff") && d.maxAbs * 255.0 > std::stod(o.get("--max-diff", "1"))) {
+      std::fprintf(stderr, "spaceskip: max difference %.2f/255 exceeds --max-diff %s\n", d.maxAbs * 255.0,
+                   o.get("--max-diff", "").c_str());
+      return 3;
+    }
   }
   return 0;
 }
@@ -279,8 +288,8 @@ int cmdBench(const Options& o) {
     csv << "dataset,dims,variant,builder,backend,leaf,mls,bins,brick,build_s,classify_s,fps,frame_cpu_s,nodes,height,leaves,occupancy\n";
   }
   bool firstJson = true;
-  std::printf("%-18s %-26s %-6s %10s %11s %8s %9s %9s %6s %9s %8s\n", "dataset", "builder", "backend", "build_ms",
-              "classify_ms", "fps", "cpu_ms/f", "nodes", "height", "leaves", "vs_naive");
+  std::printf("%-18s %-26s %-6s %10s %11s %8s %9s %9s %6s %9s %8s %8s\n", "dataset", "builder", "backend", "build_ms",
+              "classify_ms", "fps", "cpu_ms/f", "nodes", "height", "leaves", "vs_naive", "Gsmp/s");
   for (const std::string& spec : o.positional) {
     Volume v = openVolume(spec);
     TransferFunction tf = makeTF(o, v);
@@ -319,16 +328,23 @@ int cmdBench(const Options& o) {
       }
       double fps = frames / total;
       const double frameCpu = cpuTotal / frames;
+      // One more frame with sample counting (not timed): samples/frame and samples/s.
+      RenderParams counted = renderParams(o);
+      counted.countSamples = true;
+      engine.setRenderParams(counted);
+      engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
+      const double samples = double(engine.frameStats().samples);
+      const double gsps = samples * fps * 1e-9;
       if (s.builder == BuilderKind::Naive) naiveFps = fps;
       std::string dims = std::to_string(v.dims.x) + "x" + std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z);
       std::string name = spec.substr(spec.find_last_of('/') + 1);
       // The variant as asked for; when the engine fell back (e.g. a GPU builder on the CPU), say so.
       std::string label = b;
       if (s.builder != bp.builder) label += std::string("->") + builderName(s.builder);
-      std::printf("%-18s %-26s %-6s %10.3f %11.3f %8.2f %9.1f %9lld %6d %9lld %8s\n", name.c_str(), label.c_str(),
+      std::printf("%-18s %-26s %-6s %10.3f %11.3f %8.2f %9.1f %9lld %6d %9lld %8s %8.3f\n", name.c_str(), label.c_str(),
                   engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, frameCpu * 1e3,
-                  (long long)s.nodes, s.height,
-                  (long long)s.leaves, naiveFps > 0 ? (std::to_string(fps / naiveFps).substr(0, 5) + "x").c_str() : "-");
+                  (long long)s.nodes, s.height, (long long)s.leaves,
+                  naiveFps > 0 ? (std::to_string(fps / naiveFps).substr(0, 5) + "x").c_str() : "-", gsps);
       std::fflush(stdout);
       // Hybrid always builds the shallow tree (paper 3.3).
       const char* leaf = bp.leaf == LeafCriterion::Shallow || s.builder == BuilderKind::Hybrid ? "shallow" : "deep";
@@ -339,7 +355,7 @@ int cmdBench(const Options& o) {
            << "\", \"backend\": \"" << engine.backendName() << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize
            << ", \"bins\": " << bp.bins << ", \"brick\": " << bp.brick << ", \"build_s\": " << s.seconds << ", \"classify_s\": " << s.classifySeconds
            << ", \"fps\": " << fps << ", \"frame_cpu_s\": " << frameCpu << ", \"nodes\": " << s.nodes << ", \"height\": " << s.height
-           << ", \"leaves\": " << s.leaves << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
+           << ", \"leaves\": " << s.leaves << ", \"samples_per_frame\": " << samples << ", \"gsamples_per_s\": " << gsps << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
            << ", \"height_px\": " << h << ", \"frames\": " << frames << "}";
       if (csv.is_open())
         csv << name << "," << dims << "," << label << "," << builderName(s.builder) << "," << engine.backendName() << ","
@@ -351,6 +367,62 @@ int cmdBench(const Options& o) {
   if (o.has("--json")) {
     std::ofstream js(o.get("--json", ""));
     js << json.str();
+  }
+  return 0;
+}
+
+// The speed/accuracy trade: image error against a reference at 1/8 of the smallest spacing
+// (exact trilinear, no ERT), and frame rate, for coarser sample distances, both filter modes
+// (hardware filtering exists on the CUDA backend only) and early ray termination.
+int cmdAccuracy(const Options& o) {
+  if (o.positional.size() != 1) throw std::invalid_argument("accuracy needs one VOLUME");
+  Volume v = openVolume(o.positional[0]);
+  int w = 512, h = 512;
+  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  const double minSpacing = std::min({v.spacing[0], v.spacing[1], v.spacing[2]});
+  Engine engine(backendKind(o));
+  engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+  engine.setVolume(v);
+  engine.setTransferFunction(makeTF(o, v));
+  engine.setBuildParams(buildParams(o, o.get("--builder", "grid")));
+  Camera cam = makeCamera(o, v, w, h);
+  RenderParams ref;
+  ref.sampleDistance = minSpacing / 8;
+  engine.setRenderParams(ref);
+  Image reference;
+  engine.render(cam, w, h, reference);
+  std::printf("reference: sample distance %g (1/8 voxel), exact filtering, no ERT, backend %s\n",
+              ref.sampleDistance, engine.backendName());
+  std::printf("%-10s %-9s %-5s %10s %10s %8s %9s %9s\n", "dt/voxel", "filter", "ert", "max_diff", "psnr_db", "ssim",
+              "fps", "Msmp/frm");
+  std::vector<FilterMode> filters{FilterMode::Exact};
+  if (std::string(engine.backendName()) == "cuda") filters.push_back(FilterMode::Hardware);
+  for (double f : {0.25, 0.5, 1.0, 2.0}) {
+    for (FilterMode fm : filters) {
+      for (bool ert : {false, true}) {
+        RenderParams rp;
+        rp.sampleDistance = f * minSpacing;
+        rp.filter = fm;
+        rp.ertThreshold = ert ? 0.99 : 2.0;
+        engine.setRenderParams(rp);
+        Image img;
+        engine.render(cam, w, h, img);  // warm-up
+        double t = 0;
+        const int frames = 3;
+        for (int i = 0; i < frames; ++i) {
+          engine.render(cam, w, h, img);
+          t += engine.frameStats().seconds;
+        }
+        rp.countSamples = true;
+        engine.setRenderParams(rp);
+        engine.render(cam, w, h, img);
+        ImageDiff d = compareImages(reference, img);
+        std::printf("%-10.2f %-9s %-5s %10.4f %10.2f %8.4f %9.2f %9.2f\n", f, fm == FilterMode::Exact ? "exact" : "hardware",
+                    ert ? "0.99" : "off", d.maxAbs, d.psnr, ssim(reference, img), frames / t,
+                    double(engine.frameStats().samples) * 1e-6);
+        std::fflush(stdout);
+      }
+    }
   }
   return 0;
 }
@@ -372,6 +444,7 @@ int main(int argc, char** argv) {
     if (cmd == "generate") return cmdGenerate(o);
     if (cmd == "render") return cmdRender(o);
     if (cmd == "bench") return cmdBench(o);
+    if (cmd == "accuracy") return cmdAccuracy(o);
     std::fprintf(stderr, "unknown command '%s'\n%s", cmd.c_str(), kUsage);
     return 2;
   } catch (const std::exception& e) {

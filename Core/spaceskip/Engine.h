@@ -55,6 +55,7 @@ struct RenderParams {
   bool jitter = false;
   unsigned jitterSeed = 0;
   FilterMode filter = FilterMode::Exact;
+  bool countSamples = false;   ///< statistics: FrameStats::samples (costs a per-pixel buffer)
 };
 
 struct BuildStats {
@@ -70,6 +71,7 @@ struct BuildStats {
 
 struct FrameStats {
   double seconds = 0;
+  int64_t samples = -1;  ///< samples taken in the frame (RenderParams::countSamples), else -1
   std::string backend;
 };
 

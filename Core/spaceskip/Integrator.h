@@ -24,6 +24,7 @@ struct FrameView {
   GridView grid;           ///< Grid and Hybrid
   TreeView tree;           ///< Tree and Hybrid
   TransferFunctionView tf;
+  unsigned* sampleCount;   ///< optional per-pixel count of samples taken (statistics)
 };
 
 /// Exact trilinear sampling in float from a linear voxel array (clamped at the border).
@@ -86,6 +87,7 @@ struct IntervalMarcher {
   float t0;
   int nextK;
   vec4f acc;
+  unsigned samples;
 
   SS_FUNC bool operator()(float a, float b) {
     const float dt = f->dt;
@@ -102,11 +104,13 @@ struct IntervalMarcher {
         acc.z += w * c.z;
         acc.w += w;
         if (acc.w >= f->ertThreshold) {
+          samples += unsigned(k + 1 - kBegin);
           nextK = k + 1;
           return false;
         }
       }
     }
+    if (kEnd > kBegin) samples += unsigned(kEnd - kBegin);
     if (kEnd > nextK) nextK = kEnd;
     return true;
   }
@@ -153,9 +157,10 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   intersectBox(r, inv, vec3f{0, 0, 0}, f.boxHi, tEnter, tExit);
   tEnter = ss_max(tEnter, 0.f);
   tExit = ss_min(tExit, tLimit);
+  if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
 
-  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}};
+  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u};
   if (f.jitter) m.t0 += f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f);
   switch (f.traversal) {
     case TraversalKind::Naive: m(tEnter, tExit); break;
@@ -171,6 +176,7 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
       break;
     }
   }
+  if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
   return m.acc;
 }
 

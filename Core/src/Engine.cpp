@@ -222,6 +222,11 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
+  std::vector<unsigned> counts;
+  if (d.render.countSamples) {
+    counts.assign(size_t(width) * size_t(height), 0u);
+    f.sampleCount = counts.data();
+  }
   auto t0 = Clock::now();
   try {
     d.backend->render(f, d.render.filter, depth, out);
@@ -232,6 +237,11 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     d.backend->render(f, d.render.filter, depth, out);
   }
   d.frame.seconds = since(t0);
+  d.frame.samples = -1;
+  if (d.render.countSamples) {
+    d.frame.samples = 0;
+    for (unsigned c : counts) d.frame.samples += c;
+  }
   d.frame.backend = d.backend->name();
   ++d.counters.frames;
 }

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -46,16 +45,27 @@ std::string trim(const std::string& s) {
 }  // namespace
 
 bool parseRawName(const std::string& fileName, vec3l& dims, VoxelType& type) {
-  static const std::regex re(R"(.*_(\d+)x(\d+)x(\d+)_([A-Za-z0-9]+)\.raw$)");
-  std::smatch m;
+  // NAME_XxYxZ_TYPE.raw: the last two '_'-separated fields before ".raw".
   std::string name = baseName(fileName);
-  if (!std::regex_match(name, m, re)) return false;
-  try {
-    dims = vec3l{std::stoll(m[1]), std::stoll(m[2]), std::stoll(m[3])};
-  } catch (...) {
-    return false;
+  if (name.size() < 4 || name.compare(name.size() - 4, 4, ".raw") != 0) return false;
+  name.resize(name.size() - 4);
+  size_t t = name.rfind('_');
+  if (t == std::string::npos || t == 0) return false;
+  size_t d = name.rfind('_', t - 1);
+  if (d == std::string::npos) return false;
+  std::string dimStr = name.substr(d + 1, t - d - 1);
+  long long v[3];
+  size_t pos = 0;
+  for (int i = 0; i < 3; ++i) {
+    size_t end = dimStr.find('x', pos);
+    if ((i < 2) != (end != std::string::npos)) return false;
+    std::string num = dimStr.substr(pos, i < 2 ? end - pos : std::string::npos);
+    if (num.empty() || num.find_first_not_of("0123456789") != std::string::npos || num.size() > 12) return false;
+    v[i] = std::stoll(num);
+    pos = end + 1;
   }
-  return parseVoxelType(m[4], type);
+  dims = vec3l{v[0], v[1], v[2]};
+  return parseVoxelType(name.substr(t + 1), type);
 }
 
 Volume loadRaw(const std::string& path) {

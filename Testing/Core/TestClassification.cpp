@@ -1,0 +1,148 @@
+// Conservative classification: value ranges include the +1 halo; a TF spike between two voxel
+// values is never classified empty; a TF edit re-classifies bricks only.
+#include "spaceskip/Classification.h"
+#include "spaceskip/Integrator.h"
+#include "TestUtil.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace spaceskip;
+
+namespace {
+Volume twoValueVolume(uint8_t a, uint8_t b, int n = 16) {
+  // Left half a, right half b: the cells straddling x = n/2 interpolate between them.
+  Volume v;
+  v.allocate(vec3l{n, n, n}, VoxelType::UInt8);
+  uint8_t* d = v.mutableData();
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) d[x + n * (y + n * z)] = x < n / 2 ? a : b;
+  return v;
+}
+}  // namespace
+
+TEST(Classification, RangeGridIncludesHalo) {
+  Volume v = twoValueVolume(0, 200, 16);
+  RangeGrid g = computeRangeGrid(v, 4);
+  // Cells [4,8) of brick 1 use voxels 4..8; voxel 8 is 200, so the range is [0, 200].
+  EXPECT_EQ(g.dims.x, 4);  // 15 cells / 4 -> 4 bricks
+  EXPECT_FLOAT_EQ(g.vmin[size_t(g.index(1, 0, 0))], 0.f);
+  EXPECT_FLOAT_EQ(g.vmax[size_t(g.index(1, 0, 0))], 200.f);
+  EXPECT_FLOAT_EQ(g.vmax[size_t(g.index(0, 0, 0))], 0.f);
+  EXPECT_FLOAT_EQ(g.vmin[size_t(g.index(2, 0, 0))], 200.f);
+}
+
+TEST(Classification, SpikeBetweenVoxelValuesIsNeverEmpty) {
+  // Voxel values 0 and 200 only; the TF is opaque in one entry at 100 and nowhere else.
+  // The paper's per-voxel flag would call everything empty; a trilinear sample between the
+  // two halves does hit 100, so those bricks must stay occupied.
+  Volume v = twoValueVolume(0, 200, 16);
+  auto tf = TransferFunction::fromPoints({{0, 0, 0, 0, 0}, {200, 0, 0, 0, 0}}, 0, 200, 201);
+  tf.table[100] = vec4f{1, 1, 1, 1};
+  OccupancyGrid o = classify(computeRangeGrid(v, 4), tf);
+  EXPECT_TRUE(o.at(1, 0, 0));
+  EXPECT_FALSE(o.at(0, 0, 0));
+  EXPECT_FALSE(o.at(3, 0, 0));
+  // And the image agrees: the grid render is not empty and equals the naive render.
+  Image naive = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 90, 0);
+  Image grid = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0);
+  EXPECT_GT(test::coverage(naive), 0.01);
+  EXPECT_LE(compareImages(naive, grid).maxAbs, 1.f / 255.f);
+}
+
+TEST(Classification, ConservativeAgainstBruteForce) {
+  // For random TFs, every brick that contains a sample with opacity > 0 must be occupied.
+  Volume v = generateVolume("noise", vec3l{24, 20, 18}, 3);
+  double lo, hi;
+  ASSERT_TRUE(v.scalarRange(lo, hi));
+  RangeGrid g = computeRangeGrid(v, 4);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0, 1);
+  const float* d = static_cast<const float*>(v.data);
+  ArraySampler<float> s{d, v.dims.x, v.dims.y, v.dims.z};
+  for (int trial = 0; trial < 10; ++trial) {
+    auto tf = TransferFunction::preset("zero", lo, hi, 256);
+    int spike = int(u(rng) * 255);
+    tf.table[size_t(spike)].w = 0.5f;
+    OccupancyGrid o = classify(g, tf);
+    TransferFunctionView view{tf.table.data(), 256, float(lo), float(255.0 / (hi - lo))};
+    std::uniform_real_distribution<float> px(0.f, float(v.cellDims().x)), py(0.f, float(v.cellDims().y)),
+        pz(0.f, float(v.cellDims().z));
+    for (int i = 0; i < 20000; ++i) {
+      vec3f p{px(rng), py(rng), pz(rng)};
+      if (lookup(view, s.sample(p)).w > 0.f) {
+        int bx = std::min(int(p.x) / 4, o.dims.x - 1), by = std::min(int(p.y) / 4, o.dims.y - 1),
+            bz = std::min(int(p.z) / 4, o.dims.z - 1);
+        ASSERT_TRUE(o.at(bx, by, bz)) << "sample at " << p.x << "," << p.y << "," << p.z;
+      }
+    }
+  }
+}
+
+TEST(Classification, NaNVoxelsAreIgnoredAndInfIsClamped) {
+  Volume v;
+  v.allocate(vec3l{8, 8, 8}, VoxelType::Float32);
+  float* d = reinterpret_cast<float*>(v.mutableData());
+  for (int i = 0; i < 512; ++i) d[i] = NAN;
+  d[0] = INFINITY;
+  RangeGrid g = computeRangeGrid(v, 4);
+  EXPECT_TRUE(std::isinf(g.vmax[0]));
+  EXPECT_GT(g.vmin[size_t(g.index(1, 1, 1))], g.vmax[size_t(g.index(1, 1, 1))]);  // all NaN: empty range
+  auto tf = TransferFunction::preset("opaque", 0, 1);
+  OccupancyGrid o = classify(g, tf);
+  EXPECT_TRUE(o.at(0, 0, 0));
+  EXPECT_FALSE(o.at(1, 1, 1));
+}
+
+TEST(Classification, OpacityZeroEverywhereAndOne) {
+  Volume v = generateVolume("shell", vec3l{32, 32, 32});
+  RangeGrid g = computeRangeGrid(v, 8);
+  EXPECT_EQ(classify(g, TransferFunction::preset("zero", 0, 255)).occupied, 0);
+  EXPECT_EQ(classify(g, TransferFunction::preset("opaque", 0, 255)).occupied, g.size());
+}
+
+TEST(Engine, ColourEditUpdatesTableOnlyOpacityEditReclassifies) {
+  Volume v = generateVolume("shell", vec3l{32, 32, 32});
+  Engine e(BackendKind::CPU);
+  e.setLogger([](const std::string&) {});
+  e.setVolume(v);
+  auto tf = TransferFunction::preset("ramp", 0, 255);
+  e.setTransferFunction(tf);
+  BuildParams p;
+  p.builder = BuilderKind::Grid;
+  e.setBuildParams(p);
+  double b[6];
+  v.worldBounds(b);
+  Image img;
+  Camera cam = orbitCamera(b, 20, 10, 1, false, 1);
+  e.render(cam, 32, 32, img);
+  Counters c0 = e.counters();
+  EXPECT_EQ(c0.rangeGrids, 1);
+  EXPECT_EQ(c0.classifications, 1);
+  EXPECT_EQ(c0.builds, 1);
+  // Colour-only edit: no classification, no rebuild.
+  auto tf2 = tf;
+  for (auto& t : tf2.table) t.x = 1.f - t.x;
+  e.setTransferFunction(tf2);
+  e.render(cam, 32, 32, img);
+  EXPECT_EQ(e.counters().classifications, 1);
+  EXPECT_EQ(e.counters().builds, 1);
+  EXPECT_EQ(e.counters().colorUpdates, 1);
+  // Opacity edit that keeps the occupied set: re-classify, no rebuild.
+  auto tf3 = tf2;
+  for (auto& t : tf3.table) t.w *= 0.5f;
+  e.setTransferFunction(tf3);
+  e.render(cam, 32, 32, img);
+  EXPECT_EQ(e.counters().classifications, 2);
+  EXPECT_EQ(e.counters().builds, 1);
+  // Opacity edit that empties bricks: re-classify and rebuild.
+  e.setTransferFunction(TransferFunction::preset("zero", 0, 255));
+  e.render(cam, 32, 32, img);
+  EXPECT_EQ(e.counters().classifications, 3);
+  EXPECT_EQ(e.counters().builds, 2);
+  EXPECT_EQ(e.counters().rangeGrids, 1);  // value ranges are computed once per volume
+  EXPECT_EQ(test::coverage(img), 0.0);
+}

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages SpaceSkip builds against (run as root). Idempotent.
+# ParaView 5.11 + its VTK come from Debian (paraview-dev); the extra -dev packages are the ones
+# find_package(ParaView) needs but paraview-dev does not pull in (see docs in shared PARAVIEW.md).
+# Do not install libvtk9-dev: it conflicts with python3-paraview.
+set -euo pipefail
+pkgs=(build-essential cmake ninja-build pkg-config libtbb-dev libpng-dev libgtest-dev googletest
+      paraview paraview-dev python3-paraview xvfb xauth
+      libopenmpi-dev openmpi-bin libdouble-conversion-dev liblz4-dev libglew-dev libutfcpp-dev libtiff-dev)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+echo "setup: Debian packages ready"
