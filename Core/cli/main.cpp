@@ -30,7 +30,8 @@ const char* kUsage = R"(usage:
   spaceskip generate SHAPE --dims X Y Z [--seed N] -o FILE(.nrrd|_XxYxZ_TYPE.raw)
       SHAPE: menger nbody shell noise rm vessels
   spaceskip render VOLUME -o out.png [options]
-  spaceskip bench VOLUME... [--builders b1,b2,...] [--frames N] [--json FILE] [--csv FILE] [options]
+  spaceskip bench VOLUME... [--builders b1,b2,...] [--frames N] [--build-runs 1|2] [--json FILE] [--csv FILE] [options]
+      builder items: NAME[:shallow|:deep][:mlsN][:binsN], e.g. kdtree-gpu-fast:deep:mls32
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
@@ -231,10 +232,42 @@ std::vector<std::string> split(const std::string& s, char c) {
   return out;
 }
 
+/// A --builders item: NAME[:shallow|:deep][:mlsN][:binsN][:hw|:exact][:cold], e.g.
+/// kdtree-gpu-fast:deep:mls32. `hw`/`exact` pick the filter for this item, `cold` times the
+/// first build only (no warm rebuild: for very slow builders).
+struct BenchItem {
+  BuildParams params;
+  int filter = -1;  // -1: --filter, else FilterMode
+  bool cold = false;
+};
+
+BenchItem benchParams(const Options& o, const std::string& item) {
+  std::vector<std::string> parts = split(item, ':');
+  if (parts.empty()) throw std::invalid_argument("empty --builders item");
+  BenchItem it;
+  BuildParams& p = it.params;
+  p = buildParams(o, parts[0]);
+  for (size_t i = 1; i < parts.size(); ++i) {
+    const std::string& a = parts[i];
+    if (a == "hw") it.filter = int(FilterMode::Hardware);
+    else if (a == "exact") it.filter = int(FilterMode::Exact);
+    else if (a == "cold") it.cold = true;
+    else if (a == "shallow") p.leaf = LeafCriterion::Shallow;
+    else if (a == "deep") p.leaf = LeafCriterion::Deep;
+    else if (a.rfind("mls", 0) == 0) p.maxLeafSize = std::stoi(a.substr(3));
+    else if (a.rfind("bins", 0) == 0) p.bins = std::stoi(a.substr(4));
+    else throw std::invalid_argument("bad --builders option '" + a + "' in '" + item + "'");
+  }
+  if (p.maxLeafSize < 0 || p.bins < 2) throw std::invalid_argument("bad mls/bins in '" + item + "'");
+  return it;
+}
+
 int cmdBench(const Options& o) {
   if (o.positional.empty()) throw std::invalid_argument("bench needs at least one VOLUME");
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
   int frames = std::stoi(o.get("--frames", "8"));
+  // 2: a cold build, then a warm rebuild (timed); 1: the cold build only (for very slow builders).
+  const int buildRuns = std::stoi(o.get("--build-runs", "2"));
   int w = 1024, h = 1024;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   std::ostringstream json;
@@ -242,69 +275,90 @@ int cmdBench(const Options& o) {
   std::ofstream csv;
   if (o.has("--csv")) {
     csv.open(o.get("--csv", ""));
-    csv << "dataset,dims,builder,backend,leaf,mls,bins,build_s,classify_s,fps,nodes,height,leaves,occupancy\n";
+    csv << "dataset,dims,builder,spec,backend,leaf,mls,bins,build_s,build_cold_s,classify_s,fps,kernel_fps,nodes,"
+           "height,leaves,occupancy,samples_per_frame,gsamples_per_s_kernel,voxel_gbytes_per_s_kernel\n";
   }
   bool firstJson = true;
-  std::printf("%-22s %-16s %-6s %10s %10s %9s %10s %7s %10s %9s\n", "dataset", "builder", "backend", "build_ms",
-              "classify_ms", "fps", "nodes", "height", "vs_naive", "Gsmp/s");
+  std::printf("%-16s %-28s %-6s %10s %10s %9s %10s %10s %7s %9s %9s\n", "dataset", "builder", "backend", "build_ms",
+              "classify_ms", "fps", "kernel_fps", "nodes", "height", "vs_naive", "Gsmp/s");
   for (const std::string& spec : o.positional) {
+    auto tg = Clock::now();
     Volume v = openVolume(spec);
+    std::fprintf(stderr, "  note: %s ready in %.2f s\n", spec.c_str(), since(tg));
     TransferFunction tf = makeTF(o, v);
     double naiveFps = 0;
+    // One engine per data set: the volume is uploaded and its ranges computed once.
+    Engine engine(backendKind(o));
+    engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+    engine.setVolume(v);
+    engine.setTransferFunction(tf);
+    engine.setRenderParams(renderParams(o));
     for (const std::string& b : builders) {
-      Engine engine(backendKind(o));
-      engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
-      engine.setVolume(v);
-      engine.setTransferFunction(tf);
-      BuildParams bp = buildParams(o, b);
-      engine.setBuildParams(bp);
-      engine.setRenderParams(renderParams(o));
-      engine.update();
-      // Rebuild once more, timed alone (the first build includes one-time allocations).
-      BuildParams other = bp;
-      other.bins = bp.bins + 1;
-      engine.setBuildParams(other);
-      engine.update();
+      const BenchItem item = benchParams(o, b);
+      const BuildParams bp = item.params;
+      RenderParams rp = renderParams(o);
+      if (item.filter >= 0) rp.filter = FilterMode(item.filter);
       engine.setBuildParams(bp);
       engine.update();
+      const double cold = engine.buildStats().seconds;
+      if (buildRuns > 1 && !item.cold) {
+        // Rebuild once more, timed alone (the first build includes one-time allocations).
+        BuildParams none = bp;
+        none.builder = BuilderKind::Naive;
+        engine.setBuildParams(none);
+        engine.update();
+        engine.setBuildParams(bp);
+        engine.update();
+      }
       BuildStats s = engine.buildStats();
       double b6[6];
       v.worldBounds(b6);
       Image img;
+      engine.setRenderParams(rp);
       engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
-      double total = 0;
+      double total = 0, totalDevice = 0;
       for (int f = 0; f < frames; ++f) {
         engine.render(orbitCamera(b6, 360.0 * f / frames, 15, 1, false, double(w) / h), w, h, img);
         total += engine.frameStats().seconds;
+        totalDevice += engine.frameStats().deviceSeconds;
       }
-      double fps = frames / total;
+      const double fps = frames / total;
+      const double kernelFps = totalDevice > 0 ? frames / totalDevice : fps;
       // One more frame with sample counting (not timed): samples/frame and samples/s.
-      RenderParams counted = renderParams(o);
+      RenderParams counted = rp;
       counted.countSamples = true;
       engine.setRenderParams(counted);
       engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
       const double samples = double(engine.frameStats().samples);
-      const double gsps = samples * fps * 1e-9;
-      if (s.builder == BuilderKind::Naive) naiveFps = fps;
+      const double gsps = samples * kernelFps * 1e-9;
+      // Logical voxel traffic of trilinear sampling: 8 voxels per sample (mostly cache hits).
+      const double voxelGBs = gsps * 8.0 * double(voxelSize(v.type));
+      if (s.builder == BuilderKind::Naive && naiveFps == 0) naiveFps = kernelFps;
       std::string dims = std::to_string(v.dims.x) + "x" + std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z);
       std::string name = spec.substr(spec.find_last_of('/') + 1);
-      std::printf("%-22s %-16s %-6s %10.3f %10.3f %9.2f %10lld %7d %10s %9.3f\n", name.c_str(), builderName(s.builder),
-                  engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, (long long)s.nodes, s.height,
-                  naiveFps > 0 ? (std::to_string(fps / naiveFps).substr(0, 5) + "x").c_str() : "-", gsps);
+      std::printf("%-16s %-28s %-6s %10.3f %10.3f %9.2f %10.2f %10lld %7d %9s %9.2f\n", name.c_str(), b.c_str(),
+                  engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, kernelFps, (long long)s.nodes,
+                  s.height, naiveFps > 0 ? (std::to_string(kernelFps / naiveFps).substr(0, 5) + "x").c_str() : "-",
+                  gsps);
       std::fflush(stdout);
       const char* leaf = bp.leaf == LeafCriterion::Shallow ? "shallow" : "deep";
       if (!firstJson) json << ",\n";
       firstJson = false;
       json << "  {\"dataset\": \"" << name << "\", \"dims\": \"" << dims << "\", \"builder\": \"" << builderName(s.builder)
-           << "\", \"backend\": \"" << engine.backendName() << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize
-           << ", \"bins\": " << bp.bins << ", \"build_s\": " << s.seconds << ", \"classify_s\": " << s.classifySeconds
-           << ", \"fps\": " << fps << ", \"nodes\": " << s.nodes << ", \"height\": " << s.height
-           << ", \"leaves\": " << s.leaves << ", \"samples_per_frame\": " << samples << ", \"gsamples_per_s\": " << gsps << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
-           << ", \"height_px\": " << h << ", \"frames\": " << frames << "}";
+           << "\", \"spec\": \"" << b << "\", \"backend\": \"" << engine.backendName() << "\", \"built_on\": \""
+           << s.builtOn << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize << ", \"bins\": " << bp.bins
+           << ", \"build_s\": " << s.seconds << ", \"build_cold_s\": " << cold << ", \"classify_s\": " << s.classifySeconds
+           << ", \"fps\": " << fps << ", \"kernel_fps\": " << kernelFps << ", \"nodes\": " << s.nodes
+           << ", \"height\": " << s.height << ", \"leaves\": " << s.leaves << ", \"samples_per_frame\": " << samples
+           << ", \"gsamples_per_s_kernel\": " << gsps << ", \"voxel_gbytes_per_s_kernel\": " << voxelGBs
+           << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w << ", \"height_px\": " << h
+           << ", \"frames\": " << frames << ", \"filter\": \"" << (rp.filter == FilterMode::Hardware ? "hardware" : "exact")
+           << "\"}";
       if (csv.is_open())
-        csv << name << "," << dims << "," << builderName(s.builder) << "," << engine.backendName() << "," << leaf << ","
-            << bp.maxLeafSize << "," << bp.bins << "," << s.seconds << "," << s.classifySeconds << "," << fps << ","
-            << s.nodes << "," << s.height << "," << s.leaves << "," << s.occupancy << "\n";
+        csv << name << "," << dims << "," << builderName(s.builder) << "," << b << "," << engine.backendName() << ","
+            << leaf << "," << bp.maxLeafSize << "," << bp.bins << "," << s.seconds << "," << cold << ","
+            << s.classifySeconds << "," << fps << "," << kernelFps << "," << s.nodes << "," << s.height << ","
+            << s.leaves << "," << s.occupancy << "," << samples << "," << gsps << "," << voxelGBs << "\n";
     }
   }
   json << "\n]\n";
