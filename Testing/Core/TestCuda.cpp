@@ -446,7 +446,9 @@ TEST(CudaTrees, FastKdTreeEqualsPaperKdTree) {
       std::sort(ka.begin(), ka.end());
       std::sort(kb.begin(), kb.end());
       EXPECT_TRUE(ka == kb) << "node sets differ";
-      if (leaf == LeafCriterion::Deep && mls == 0) EXPECT_GT(a.tree.nodes.size(), 1u);
+      // Menger's empty space is inside: the greedy cost finds no split at the root (the paper's
+      // statistics show the same); MLS forces splits there. N-body must split.
+      if (std::string(shape) == "nbody" || mls > 0) EXPECT_GT(a.tree.nodes.size(), 1u);
     }
   }
 }

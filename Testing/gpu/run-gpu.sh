@@ -93,6 +93,11 @@ bench() {  # NAME VOLUME BUILDERS [extra args]
   local rc=$?
   log "bench $name rc=$rc"
   cat "$work/bench-$name.log" >> "$work/bench.log"
+  cp "$work/bench.log" "$out/bench.log"  # progressive: survives a run cut short
+  if [ -f "$work/bench-$name.csv" ]; then
+    [ -f "$out/bench.csv" ] || head -1 "$work/bench-$name.csv" > "$out/bench.csv"
+    tail -n +2 "$work/bench-$name.csv" >> "$out/bench.csv"
+  fi
   [ $rc -eq 0 ] || status=1
 }
 
@@ -119,15 +124,10 @@ if has ncu; then
   done
 fi
 
-if ls "$work"/bench-*.csv > /dev/null 2>&1; then
-  first=1
-  for f in "$work"/bench-*.csv; do
-    if [ $first -eq 1 ]; then cat "$f"; first=0; else tail -n +2 "$f"; fi
-  done > "$out/bench.csv"
+if ls "$work"/bench-*.json > /dev/null 2>&1; then
   { echo "["; sep=""; for f in "$work"/bench-*.json; do
       body=$(sed '1d;$d' "$f"); [ -n "$body" ] && { printf '%s%s' "$sep" "$body"; sep=$',\n'; }
     done; echo; echo "]"; } > "$out/bench.json"
-  cp "$work/bench.log" "$out/bench.log"
 fi
 cp "$work/run.log" "$out/run.log" 2>/dev/null
 tar -C "$work" -czf "$out/logs.tgz" . 2>/dev/null
