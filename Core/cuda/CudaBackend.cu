@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -98,7 +100,7 @@ struct TextureSampler {
   __device__ float sample(vec3f p) const { return tex3D<float>(tex, p.x + 0.5f, p.y + 0.5f, p.z + 0.5f) * scale; }
 };
 
-// Launch shape: 2-D grid of 16x8 blocks, one thread per pixel (rays of a block are coherent).
+// Launch shape: 2-D grid of 16x8 blocks (SPACESKIP_CUDA_BLOCK overrides), one thread per pixel.
 template <class Sampler>
 __global__ void renderKernel(FrameView f, Sampler s, vec4f* out) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
@@ -119,6 +121,14 @@ class CudaBackend final : public Backend {
     SS_CUDA_CHECK(cudaEventCreate(&ev0_));
     SS_CUDA_CHECK(cudaEventCreate(&ev1_));
     SS_CUDA_CHECK(cudaMallocHost(&h_flags_, sizeof(Flags)));
+    // Tuning knob for measurements: SPACESKIP_CUDA_BLOCK=WxH (threads per block, default 16x8).
+    if (const char* b = std::getenv("SPACESKIP_CUDA_BLOCK")) {
+      unsigned w = 0, h = 0;
+      if (std::sscanf(b, "%ux%u", &w, &h) == 2 && w * h >= 32 && w * h <= 1024) {
+        blockX_ = w;
+        blockY_ = h;
+      }
+    }
   }
   ~CudaBackend() override {
     destroyTexture();
@@ -288,8 +298,8 @@ class CudaBackend final : public Backend {
       f.sampleCount = d_counts_.get();
     }
     d_image_.reserve(pixels);
-    const dim3 block(16, 8);
-    const dim3 grid(unsigned((f.width + 15) / 16), unsigned((f.height + 7) / 8));
+    const dim3 block(blockX_, blockY_);
+    const dim3 grid(unsigned((f.width + blockX_ - 1) / blockX_), unsigned((f.height + blockY_ - 1) / blockY_));
     SS_CUDA_CHECK(cudaEventRecord(ev0_, stream_));
     if (filter == FilterMode::Hardware) {
       ensureTexture();
@@ -481,6 +491,7 @@ class CudaBackend final : public Backend {
   DeviceBuffer<unsigned> d_counts_;
   DeviceBuffer<vec4f> d_image_;
   double lastDeviceSeconds_ = -1;
+  unsigned blockX_ = 16, blockY_ = 8;
 };
 
 }  // namespace

@@ -3,7 +3,7 @@
 # on the CUDA tests, and the benchmarks; writes everything into OUTDIR (see DEVICE.md).
 #
 #   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
-#   PHASE: build test sanitize bench-small bench-large ncu   (default: build test sanitize bench-small)
+#   PHASE: build test sanitize bench-small bench-large blocks ncu   (default: build test sanitize bench-small)
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
 #          when present), BENCH_FRAMES (8), SANITIZE_FILTER (gtest filter for the sanitizer runs)
 #
@@ -112,6 +112,12 @@ if has bench-large; then
   kdcold="kdtree-gpu:shallow:cold,kdtree-gpu:deep:mls32:cold,kdtree-gpu:deep:mls128:cold"
   kdfast="kdtree-gpu-fast:shallow,kdtree-gpu-fast:deep,kdtree-gpu-fast:deep:mls32,kdtree-gpu-fast:deep:mls128"
   bench nbody2048 gen:nbody:2048 "naive,grid,lbvh,$kdfast,naive:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw,${BENCH_2048_KDGPU:-$kdcold}"
+fi
+if has blocks; then
+  # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK), recorded for the notes.
+  for bs in 8x8 32x4 16x16 16x8; do
+    SPACESKIP_CUDA_BLOCK=$bs bench "block$bs" gen:nbody:1024 "naive,grid,lbvh,kdtree-gpu-fast:deep:mls32,naive:hw,kdtree-gpu-fast:deep:mls32:hw"
+  done
 fi
 if has ncu; then
   log "ncu: DRAM traffic of the render kernel"
