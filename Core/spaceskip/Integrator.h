@@ -49,17 +49,10 @@ struct ArraySampler {
     axis(p.x, nx, x0, x1, fx);
     axis(p.y, ny, y0, y1, fy);
     axis(p.z, nz, z0, z1, fz);
-    // One base index and three strides instead of eight 64-bit index products (the integer
-    // arithmetic, not memory, bounded the GPU's exact mode); same loads, same float math.
-    const T* b = data + (x0 + nx * (y0 + ny * z0));
-    const int64_t sx = x1 - x0, sy = nx * (y1 - y0), sz = nx * ny * (z1 - z0);
-    const float v000 = float(b[0]), v100 = float(b[sx]), v010 = float(b[sy]), v110 = float(b[sx + sy]);
-    const float v001 = float(b[sz]), v101 = float(b[sx + sz]), v011 = float(b[sy + sz]),
-                v111 = float(b[sx + sy + sz]);
-    float c00 = v000 + (v100 - v000) * fx;
-    float c10 = v010 + (v110 - v010) * fx;
-    float c01 = v001 + (v101 - v001) * fx;
-    float c11 = v011 + (v111 - v011) * fx;
+    float c00 = fetch(x0, y0, z0) + (fetch(x1, y0, z0) - fetch(x0, y0, z0)) * fx;
+    float c10 = fetch(x0, y1, z0) + (fetch(x1, y1, z0) - fetch(x0, y1, z0)) * fx;
+    float c01 = fetch(x0, y0, z1) + (fetch(x1, y0, z1) - fetch(x0, y0, z1)) * fx;
+    float c11 = fetch(x0, y1, z1) + (fetch(x1, y1, z1) - fetch(x0, y1, z1)) * fx;
     float c0 = c00 + (c10 - c00) * fy;
     float c1 = c01 + (c11 - c01) * fy;
     return c0 + (c1 - c0) * fz;
