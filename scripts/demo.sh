@@ -7,6 +7,8 @@ bash "$root/scripts/build.sh"
 cli="$root/build/Core/spaceskip"
 out=${DEMO_OUT:-$root/build/demo}
 mkdir -p "$out"
+echo "== render the bundled MNI152 brain (real MRI data) with grid skipping"
+"$cli" render "$root/Data/mni152_t1_99x117x95_uint8.raw" --builder grid --tf ramp --camera 60,10 --size 512x512 -o "$out/mni152.png"
 echo "== render a 256^3 Menger sponge (paper's data set shape), naive vs grid skipping"
 "$cli" render gen:menger:256 --builder naive --size 512x512 -o "$out/menger_naive.png"
 "$cli" render gen:menger:256 --builder grid --size 512x512 -o "$out/menger_grid.png" --compare "$out/menger_naive.png"

@@ -18,6 +18,8 @@ struct ImageDiff {
 };
 /// Compares two images of the same size (throws std::invalid_argument otherwise).
 ImageDiff compareImages(const Image& a, const Image& b);
+/// Mean SSIM of the luminance over 8x8 windows (Wang et al. 2004 constants), in [-1, 1].
+double ssim(const Image& a, const Image& b);
 /// True when any channel of any pixel is NaN or Inf.
 bool hasNonFinite(const Image& img);
 

@@ -1,10 +1,15 @@
 // Builder dispatch and helpers shared by the CPU builders.
 #include "spaceskip/Builders.h"
 
+#include "spaceskip/KdTreeBuilder.h"
+#include "spaceskip/LbvhBuilder.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace spaceskip {
 
@@ -41,8 +46,24 @@ OccupancyGrid coarsen(const OccupancyGrid& occ, int factor) {
 }
 
 Tree buildTreeCPU(const OccupancyGrid& occ, const BuildParams& p) {
-  (void)occ;
-  throw BackendError(std::string("builder ") + builderName(p.builder) + " has no CPU implementation yet");
+  Tree t;
+  switch (p.builder) {
+    case BuilderKind::LBVHCPU: t = buildLbvh(occ); break;
+    case BuilderKind::KdTreeCPU: t = buildKdTree(occ, p); break;
+    case BuilderKind::Hybrid: {
+      // Paper 3.3: the shallow k-d tree; the 16^3 grid is coarsen()'s, rendered per leaf.
+      BuildParams q = p;
+      q.leaf = LeafCriterion::Shallow;
+      t = buildKdTree(occ, q);
+      break;
+    }
+    default:
+      throw BackendError(std::string("builder ") + builderName(p.builder) + " has no CPU implementation");
+  }
+  if (t.height >= kMaxTreeHeight)
+    throw std::runtime_error(std::string(builderName(p.builder)) + ": tree height " + std::to_string(t.height) +
+                             " reaches kMaxTreeHeight");
+  return t;
 }
 
 }  // namespace spaceskip

@@ -96,6 +96,28 @@ ImageDiff compareImages(const Image& a, const Image& b) {
   return d;
 }
 
+double ssim(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height) throw std::invalid_argument("image sizes differ");
+  auto lum = [](const vec4f& p) { return 0.299 * p.x + 0.587 * p.y + 0.114 * p.z; };
+  const double c1 = 0.01 * 0.01, c2 = 0.03 * 0.03;
+  double sum = 0;
+  int64_t windows = 0;
+  for (int y0 = 0; y0 + 8 <= a.height; y0 += 4)
+    for (int x0 = 0; x0 + 8 <= a.width; x0 += 4) {
+      double ma = 0, mb = 0, va = 0, vb = 0, cov = 0;
+      for (int y = y0; y < y0 + 8; ++y)
+        for (int x = x0; x < x0 + 8; ++x) {
+          double pa = lum(a.rgba[size_t(y) * a.width + x]), pb = lum(b.rgba[size_t(y) * b.width + x]);
+          ma += pa; mb += pb; va += pa * pa; vb += pb * pb; cov += pa * pb;
+        }
+      ma /= 64; mb /= 64;
+      va = va / 64 - ma * ma; vb = vb / 64 - mb * mb; cov = cov / 64 - ma * mb;
+      sum += ((2 * ma * mb + c1) * (2 * cov + c2)) / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+      ++windows;
+    }
+  return windows ? sum / double(windows) : 1.0;
+}
+
 bool hasNonFinite(const Image& img) {
   for (const auto& p : img.rgba)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.w)) return true;
