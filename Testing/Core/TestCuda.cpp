@@ -4,6 +4,7 @@
 #include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
 #include "TestUtil.h"
+#include "TreeInvariants.h"
 
 #include <gtest/gtest.h>
 
@@ -412,6 +413,7 @@ TEST(CudaTrees, InvariantsHold) {
         ASSERT_EQ(b.kind, BackendKind::CUDA);
         ASSERT_GT(b.occ.occupied, 0);
         checkTree(b.tree, b.occ, p);
+        test::checkTreeInvariants(b.tree, b.occ, describe(p));  // the CPU builders' checks too
         EXPECT_EQ(b.stats.nodes, int64_t(b.tree.nodes.size()));
         if (p.builder == BuilderKind::LBVH) EXPECT_EQ(b.tree.leaves, b.occ.occupied);
       }
