@@ -102,7 +102,7 @@ struct TextureSampler {
 
 // Launch shape: 2-D grid of 16x8 blocks (SPACESKIP_CUDA_BLOCK overrides), one thread per pixel.
 template <class Sampler>
-__global__ void renderKernel(FrameView f, Sampler s, vec4f* out) {
+__global__ void renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= f.width || y >= f.height) return;
   out[int64_t(y) * f.width + x] = renderPixel(f, s, x, y);

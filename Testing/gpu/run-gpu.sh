@@ -103,7 +103,8 @@ bench() {  # NAME VOLUME BUILDERS [extra args]
 
 kd="kdtree-gpu:shallow,kdtree-gpu:deep:mls32,kdtree-gpu:deep:mls128,kdtree-gpu-fast:shallow,kdtree-gpu-fast:deep,kdtree-gpu-fast:deep:mls32,kdtree-gpu-fast:deep:mls128"
 cpu="lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid"
-all="naive,grid,lbvh,$kd,$cpu,naive:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw"
+hw="naive:hw,grid:hw,grid:brick16:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw,kdtree-gpu-fast:deep:mls128:hw"
+all="naive,grid,lbvh,$kd,$cpu,$hw"
 if has bench-small; then
   for n in 256 512 1024; do bench "nbody$n" "gen:nbody:$n" "$all"; done
   bench menger1024 gen:menger:1024 "$all"
@@ -114,7 +115,7 @@ if has bench-large; then
   kdfast="kdtree-gpu-fast:shallow,kdtree-gpu-fast:deep,kdtree-gpu-fast:deep:mls32,kdtree-gpu-fast:deep:mls128"
   # CPU-built trees (built on the GPU machine's 16 cores, uploaded) likewise.
   cpucold="lbvh-cpu:cold,kdtree-cpu:shallow:cold,kdtree-cpu:deep:mls32:cold,kdtree-cpu:deep:mls128:cold,hybrid:cold"
-  bench nbody2048 gen:nbody:2048 "naive,grid,lbvh,$kdfast,naive:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw,$cpucold,${BENCH_2048_KDGPU:-$kdcold}"
+  bench nbody2048 gen:nbody:2048 "naive,grid,lbvh,$kdfast,$hw,$cpucold,${BENCH_2048_KDGPU:-$kdcold}"
 fi
 if has blocks; then
   # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK), recorded for the notes.
