@@ -101,6 +101,9 @@ class Engine {
  public:
   /// Auto picks CUDA when a usable device exists, else the oneTBB backend.
   explicit Engine(BackendKind backend = BackendKind::Auto);
+  /// Same, with the logger installed before the backend is chosen (so a CUDA fallback message
+  /// reaches it instead of stderr).
+  Engine(BackendKind backend, std::function<void(const std::string&)> log);
   ~Engine();
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;

@@ -151,6 +151,11 @@ Engine::Engine(BackendKind backend) : impl_(new Impl) {
   impl_->requested = backend;
   impl_->chooseBackend();
 }
+Engine::Engine(BackendKind backend, std::function<void(const std::string&)> log) : impl_(new Impl) {
+  impl_->requested = backend;
+  if (log) impl_->log = std::move(log);
+  impl_->chooseBackend();
+}
 Engine::~Engine() = default;
 
 BackendKind Engine::backendKind() const { return impl_->backend->kind(); }

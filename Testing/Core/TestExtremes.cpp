@@ -142,8 +142,10 @@ TEST(Extremes, BadInputIsRejectedClearly) {
 TEST(Extremes, CudaRequestWithoutDeviceFallsBackToCpu) {
   if (cudaAvailable()) GTEST_SKIP() << "a CUDA device is present";
   std::vector<std::string> log;
-  Engine e(BackendKind::CUDA);
+  Engine e(BackendKind::CUDA, [&](const std::string& m) { log.push_back(m); });
   EXPECT_EQ(e.backendKind(), BackendKind::CPU);
+  ASSERT_EQ(log.size(), 1u);  // one clear message, through the caller's logger
+  EXPECT_NE(log[0].find("CPU backend"), std::string::npos) << log[0];
   // And it renders.
   Volume v = generateVolume("shell", vec3l{16, 16, 16});
   e.setVolume(v);

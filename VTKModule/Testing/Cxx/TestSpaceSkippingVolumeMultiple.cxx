@@ -1,0 +1,97 @@
+// Several volumes of different voxel types in one offscreen window, one placed by its vtkVolume
+// matrix (scale, rotation, translation), drawn again after a resize: regression image of the last
+// frame; resizing must not rebuild anything.
+#include "vtkActor.h"
+#include "vtkCamera.h"
+#include "vtkImageShiftScale.h"
+#include "vtkNew.h"
+#include "vtkRegressionTestImage.h"
+#include "vtkRenderWindow.h"
+#include "vtkRenderWindowInteractor.h"
+#include "vtkRenderer.h"
+#include "vtkSpaceSkippingVolumeMapper.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+
+#include "SpaceSkipTestHelpers.h"
+
+int TestSpaceSkippingVolumeMultiple(int argc, char* argv[])
+{
+  auto wavelet = sstest::MakeWavelet(48);
+  double range[2];
+  wavelet->GetScalarRange(range);
+
+  // uint8 over [0, 255] and int16 over [-1000, 1000], from the same field.
+  vtkNew<vtkImageShiftScale> toU8;
+  toU8->SetInputData(wavelet);
+  toU8->SetShift(-range[0]);
+  toU8->SetScale(255.0 / (range[1] - range[0]));
+  toU8->SetOutputScalarTypeToUnsignedChar();
+  toU8->ClampOverflowOn();
+  vtkNew<vtkImageShiftScale> toI16;
+  toI16->SetInputData(wavelet);
+  toI16->SetShift(-0.5 * (range[0] + range[1]));
+  toI16->SetScale(2000.0 / (range[1] - range[0]));
+  toI16->SetOutputScalarTypeToShort();
+
+  vtkNew<vtkSpaceSkippingVolumeMapper> m8, m16, mf;
+  m8->SetInputConnection(toU8->GetOutputPort());
+  m16->SetInputConnection(toI16->GetOutputPort());
+  mf->SetInputData(wavelet);
+  m16->SetBuilderToNaive();
+
+  vtkNew<vtkVolumeProperty> p8, p16, pf;
+  sstest::SetupProperty(p8, 0, 255, 0.7);
+  sstest::SetupProperty(p16, -1000, 1000, 0.7);
+  sstest::SetupProperty(pf, range[0], range[1], 0.7);
+  vtkNew<vtkVolume> v8, v16, vf;
+  v8->SetMapper(m8);
+  v8->SetProperty(p8);
+  v8->SetPosition(-50, 0, 0);
+  v16->SetMapper(m16);
+  v16->SetProperty(p16);
+  v16->SetPosition(0, 0, 0);
+  v16->SetOrientation(0, 0, 45);
+  v16->SetScale(0.8, 1.2, 1.0);
+  vf->SetMapper(mf);
+  vf->SetProperty(pf);
+  vf->SetPosition(50, 0, 0);
+
+  vtkNew<vtkRenderer> ren;
+  ren->SetBackground(0.15, 0.15, 0.15);
+  ren->AddVolume(v8);
+  ren->AddVolume(v16);
+  ren->AddVolume(vf);
+  vtkNew<vtkRenderWindow> win;
+  win->SetOffScreenRendering(1);
+  win->SetMultiSamples(0);
+  win->SetSize(300, 150);
+  win->AddRenderer(ren);
+  vtkNew<vtkRenderWindowInteractor> iren;
+  iren->SetRenderWindow(win);
+  ren->ResetCamera();
+  ren->GetActiveCamera()->Elevation(20);
+  ren->GetActiveCamera()->OrthogonalizeViewUp();
+  ren->GetActiveCamera()->Zoom(1.5);
+  ren->ResetCameraClippingRange();
+
+  win->Render();
+  win->SetSize(360, 180);
+  win->Render();
+  auto shot = sstest::Capture(win);
+  const double bg[3] = { 0.15, 0.15, 0.15 };
+  std::cout << "pixels drawn " << sstest::CountNonBackground(shot, bg) << " at "
+            << shot->GetDimensions()[0] << "x" << shot->GetDimensions()[1] << "; builds "
+            << m8->GetBuildCount() << " " << m16->GetBuildCount() << " " << mf->GetBuildCount()
+            << "; frames " << m8->GetFrameCount() << "\n";
+  SS_CHECK(shot->GetDimensions()[0] == 360 && shot->GetDimensions()[1] == 180);
+  SS_CHECK(m8->GetBuildCount() == 1 && m16->GetBuildCount() == 1 && mf->GetBuildCount() == 1);
+  SS_CHECK(m8->GetFrameCount() >= 2);
+
+  int retVal = vtkRegressionTestImage(win);
+  if (retVal == vtkRegressionTester::DO_INTERACTOR)
+  {
+    iren->Start();
+  }
+  return !retVal;
+}

@@ -1,0 +1,700 @@
+// vtkSpaceSkippingVolumeMapper: VTK types -> spaceskip::Engine, and the engine's image -> the window.
+#include "vtkSpaceSkippingVolumeMapper.h"
+
+#include "vtkColorTransferFunction.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkLogger.h"
+#include "vtkMatrix3x3.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkOpenGLCamera.h"
+#include "vtkOpenGLFramebufferObject.h"
+#include "vtkOpenGLQuadHelper.h"
+#include "vtkOpenGLRenderUtilities.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPlaneCollection.h"
+#include "vtkPointData.h"
+#include "vtkRenderer.h"
+#include "vtkShaderProgram.h"
+#include "vtkSmartPointer.h"
+#include "vtkTextureObject.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+#include "vtk_glew.h"
+
+#include "spaceskip/Engine.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+// Table resolution of the transfer function, sampled over the data's scalar range (what
+// vtkGPUVolumeRayCastMapper does by default, ColorRangeType == SCALAR).
+constexpr int kTableSize = 1024;
+// Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
+constexpr double kErtThreshold = 0.99;
+
+// Core voxel types by VTK type; int/unsigned int/long become float (see ConvertScalars).
+bool CoreTypeOf(int vtkType, spaceskip::VoxelType& out)
+{
+  switch (vtkType)
+  {
+    case VTK_UNSIGNED_CHAR:
+      out = spaceskip::VoxelType::UInt8;
+      return true;
+    case VTK_CHAR:
+    case VTK_SIGNED_CHAR:
+      out = spaceskip::VoxelType::Int8;
+      return true;
+    case VTK_UNSIGNED_SHORT:
+      out = spaceskip::VoxelType::UInt16;
+      return true;
+    case VTK_SHORT:
+      out = spaceskip::VoxelType::Int16;
+      return true;
+    case VTK_FLOAT:
+      out = spaceskip::VoxelType::Float32;
+      return true;
+    case VTK_DOUBLE:
+      out = spaceskip::VoxelType::Float64;
+      return true;
+    default:
+      return false;
+  }
+}
+
+bool ConvertibleToFloat(int vtkType)
+{
+  switch (vtkType)
+  {
+    case VTK_INT:
+    case VTK_UNSIGNED_INT:
+    case VTK_LONG:
+    case VTK_UNSIGNED_LONG:
+    case VTK_LONG_LONG:
+    case VTK_UNSIGNED_LONG_LONG:
+    case VTK_ID_TYPE:
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Core's column-major mat4 from a row-major vtkMatrix4x4.
+spaceskip::mat4 ToCore(const vtkMatrix4x4* m)
+{
+  spaceskip::mat4 out;
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      out.m[c * 4 + r] = m->GetElement(r, c);
+    }
+  }
+  return out;
+}
+} // namespace
+
+struct vtkSpaceSkippingVolumeMapper::vtkInternals
+{
+  std::unique_ptr<spaceskip::Engine> Engine;
+  int EngineBackend = -1;
+  spaceskip::Counters CountOffset; // stages run by engines replaced after a Backend change
+
+  // What the engine was last given; compared by identity and MTime to redo only what changed.
+  const void* InputKey = nullptr;
+  const void* ScalarsKey = nullptr;
+  vtkMTimeType InputMTime = 0;
+  vtkMTimeType ScalarsMTime = 0;
+  bool HaveVolume = false;
+  std::vector<float> Converted; // int/long scalars converted to float
+  // The array whose voxels the engine borrows: held so it outlives the engine's use of it.
+  vtkSmartPointer<vtkDataArray> Borrowed;
+  double ScalarRange[2] = { 0, 1 };
+
+  const void* PropertyKey = nullptr;
+  const void* ColorKey = nullptr;
+  const void* OpacityKey = nullptr;
+  vtkMTimeType PropertyMTime = 0;
+  vtkMTimeType ColorMTime = 0;
+  vtkMTimeType OpacityMTime = 0;
+  double TableRange[2] = { 0, 0 };
+  bool HaveTF = false;
+
+  // One message per distinct problem, not one per frame.
+  std::string LastProblem;
+
+  std::string BackendUsed = "none";
+  std::string BuilderUsed = "none";
+
+  spaceskip::Image Image;
+  std::vector<float> Depth;
+  vtkSmartPointer<vtkTextureObject> Texture;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+  vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
+  bool ResolveStencil = false;
+  bool WarnedNearest = false;
+  bool WarnedShade = false;
+  bool WarnedBlend = false;
+  bool WarnedClip = false;
+  bool WarnedDepthRead = false;
+
+  void ResetVolume()
+  {
+    this->InputKey = this->ScalarsKey = nullptr;
+    this->InputMTime = this->ScalarsMTime = 0;
+    this->HaveVolume = false;
+    this->Borrowed = nullptr;
+  }
+  void ResetTF()
+  {
+    this->PropertyKey = this->ColorKey = this->OpacityKey = nullptr;
+    this->PropertyMTime = this->ColorMTime = this->OpacityMTime = 0;
+    this->HaveTF = false;
+  }
+  spaceskip::Counters Counts() const
+  {
+    spaceskip::Counters c = this->CountOffset;
+    if (this->Engine)
+    {
+      const spaceskip::Counters& e = this->Engine->counters();
+      c.rangeGrids += e.rangeGrids;
+      c.classifications += e.classifications;
+      c.builds += e.builds;
+      c.colorUpdates += e.colorUpdates;
+      c.frames += e.frames;
+    }
+    return c;
+  }
+};
+
+vtkStandardNewMacro(vtkSpaceSkippingVolumeMapper);
+
+//------------------------------------------------------------------------------
+vtkSpaceSkippingVolumeMapper::vtkSpaceSkippingVolumeMapper()
+  : Internals(new vtkInternals)
+{
+}
+
+//------------------------------------------------------------------------------
+vtkSpaceSkippingVolumeMapper::~vtkSpaceSkippingVolumeMapper() = default;
+
+//------------------------------------------------------------------------------
+const char* vtkSpaceSkippingVolumeMapper::GetBuilderAsString()
+{
+  return spaceskip::builderName(static_cast<spaceskip::BuilderKind>(this->Builder));
+}
+
+//------------------------------------------------------------------------------
+double vtkSpaceSkippingVolumeMapper::GetLastBuildSeconds()
+{
+  return this->Internals->Engine ? this->Internals->Engine->buildStats().seconds : 0.0;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds()
+{
+  return this->Internals->Engine ? this->Internals->Engine->buildStats().classifySeconds : 0.0;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
+{
+  return this->Internals->Engine ? this->Internals->Engine->frameStats().seconds : 0.0;
+}
+vtkIdType vtkSpaceSkippingVolumeMapper::GetNodeCount()
+{
+  return this->Internals->Engine ? this->Internals->Engine->buildStats().nodes : 0;
+}
+int vtkSpaceSkippingVolumeMapper::GetTreeHeight()
+{
+  return this->Internals->Engine ? this->Internals->Engine->buildStats().height : 0;
+}
+vtkIdType vtkSpaceSkippingVolumeMapper::GetLeafCount()
+{
+  return this->Internals->Engine ? this->Internals->Engine->buildStats().leaves : 0;
+}
+double vtkSpaceSkippingVolumeMapper::GetOccupancy()
+{
+  return this->Internals->Engine ? this->Internals->Engine->buildStats().occupancy : 0.0;
+}
+const char* vtkSpaceSkippingVolumeMapper::GetBackendUsed()
+{
+  return this->Internals->BackendUsed.c_str();
+}
+const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
+{
+  return this->Internals->BuilderUsed.c_str();
+}
+int vtkSpaceSkippingVolumeMapper::GetBuildCount()
+{
+  return this->Internals->Counts().builds;
+}
+int vtkSpaceSkippingVolumeMapper::GetClassifyCount()
+{
+  return this->Internals->Counts().classifications;
+}
+int vtkSpaceSkippingVolumeMapper::GetColorUpdateCount()
+{
+  return this->Internals->Counts().colorUpdates;
+}
+int vtkSpaceSkippingVolumeMapper::GetFrameCount()
+{
+  return this->Internals->Counts().frames;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
+{
+  vtkInternals& d = *this->Internals;
+  if (d.Texture)
+  {
+    d.Texture->ReleaseGraphicsResources(win);
+    d.Texture = nullptr;
+  }
+  if (d.Quad)
+  {
+    d.Quad->ReleaseGraphicsResources(win);
+    d.Quad.reset();
+  }
+  if (d.Resolve)
+  {
+    d.Resolve->ReleaseGraphicsResources(win);
+    d.Resolve = nullptr;
+  }
+  this->Superclass::ReleaseGraphicsResources(win);
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkippingVolumeMapper::ReadDepth(
+  vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height)
+{
+  vtkInternals& d = *this->Internals;
+  vtkOpenGLState* ostate = renWin->GetState();
+  while (glGetError() != GL_NO_ERROR)
+  {
+  }
+  ostate->vtkglPixelStorei(GL_PACK_ALIGNMENT, 1);
+  GLint sampleBuffers = 0;
+  glGetIntegerv(GL_SAMPLE_BUFFERS, &sampleBuffers);
+  if (sampleBuffers <= 0)
+  {
+    glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
+    return glGetError() == GL_NO_ERROR;
+  }
+
+  // Multisampled framebuffer: resolve its depth into a single-sample framebuffer of the same
+  // depth format (what vtkOpenGLRenderWindow allocates: 32 bits, stencil when the window has
+  // one), over the same rectangle (a multisample blit cannot move pixels), then read that.
+  GLint source = 0;
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &source);
+  const int needW = x0 + width, needH = y0 + height;
+  const bool stencil = renWin->GetStencilCapable() != 0;
+  ostate->PushFramebufferBindings();
+  if (!d.Resolve || d.ResolveStencil != stencil)
+  {
+    d.Resolve = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
+    d.Resolve->SetContext(renWin);
+    d.Resolve->Bind();
+    d.Resolve->PopulateFramebuffer(needW, needH, true, 1, VTK_UNSIGNED_CHAR, true, 32, 0, stencil);
+    d.ResolveStencil = stencil;
+  }
+  else
+  {
+    int* size = d.Resolve->GetLastSize();
+    if (size[0] != needW || size[1] != needH)
+    {
+      d.Resolve->Bind();
+      d.Resolve->Resize(needW, needH);
+    }
+  }
+  ostate->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<unsigned int>(source));
+  d.Resolve->Bind(GL_DRAW_FRAMEBUFFER);
+  glBlitFramebuffer(x0, y0, x0 + width, y0 + height, x0, y0, x0 + width, y0 + height,
+    GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  d.Resolve->Bind(GL_READ_FRAMEBUFFER);
+  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, d.Depth.data());
+  const bool ok = glGetError() == GL_NO_ERROR;
+  ostate->PopFramebufferBindings();
+  return ok;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  vtkInternals& d = *this->Internals;
+  // Reports a problem once (until the next different one), draws nothing.
+  auto fail = [&](const std::string& msg) {
+    if (msg != d.LastProblem)
+    {
+      vtkErrorMacro(<< msg);
+      d.LastProblem = msg;
+    }
+  };
+
+  vtkOpenGLRenderWindow* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  vtkOpenGLCamera* cam = vtkOpenGLCamera::SafeDownCast(ren->GetActiveCamera());
+  if (!renWin || !cam || !vol || !vol->GetProperty())
+  {
+    fail("needs an OpenGL render window, an OpenGL camera and a volume with a property");
+    return;
+  }
+
+  // Input.
+  if (this->GetNumberOfInputConnections(0) > 0 && this->GetInputAlgorithm())
+  {
+    this->GetInputAlgorithm()->Update();
+  }
+  vtkImageData* input = vtkImageData::SafeDownCast(this->GetInput());
+  if (!input)
+  {
+    fail("no vtkImageData input: nothing drawn");
+    return;
+  }
+  int ext[6];
+  input->GetExtent(ext);
+  if (ext[1] < ext[0] || ext[3] < ext[2] || ext[5] < ext[4])
+  {
+    fail("input has an empty extent: nothing drawn");
+    return;
+  }
+  int cellFlag = 0;
+  vtkDataArray* scalars = vtkAbstractMapper::GetScalars(input, this->ScalarMode,
+    this->ArrayAccessMode, this->ArrayId, this->ArrayName, cellFlag);
+  if (!scalars)
+  {
+    fail("input has no point scalars (or the selected array does not exist): nothing drawn");
+    return;
+  }
+  if (cellFlag)
+  {
+    fail(std::string("scalars '") + (scalars->GetName() ? scalars->GetName() : "") +
+      "' are cell data; only point scalars are supported (apply vtkCellDataToPointData): "
+      "nothing drawn");
+    return;
+  }
+  if (scalars->GetNumberOfComponents() != 1)
+  {
+    std::ostringstream s;
+    s << "scalars '" << (scalars->GetName() ? scalars->GetName() : "") << "' have "
+      << scalars->GetNumberOfComponents()
+      << " components; only single-component scalars are supported: nothing drawn";
+    fail(s.str());
+    return;
+  }
+  const vtkIdType npts = input->GetNumberOfPoints();
+  if (scalars->GetNumberOfTuples() != npts)
+  {
+    fail("scalar array length does not match the number of points: nothing drawn");
+    return;
+  }
+  spaceskip::VoxelType vtype = spaceskip::VoxelType::Float32;
+  const int stype = scalars->GetDataType();
+  const bool native = CoreTypeOf(stype, vtype);
+  if (!native && !ConvertibleToFloat(stype))
+  {
+    fail(std::string("scalar type ") + scalars->GetDataTypeAsString() +
+      " is not supported (uint8, int8, uint16, int16, float, double; int/long are converted "
+      "to float): nothing drawn");
+    return;
+  }
+
+  // Engine (re)created when the backend changes; counts are carried over.
+  if (!d.Engine || d.EngineBackend != this->Backend)
+  {
+    d.CountOffset = d.Counts();
+    d.Engine.reset();
+    try
+    {
+      // Engine(CUDA) would report a missing device before setLogger() can route the message to
+      // VTK; Auto makes the same choice silently and the mapper reports it below.
+      const spaceskip::BackendKind kind = this->Backend == CPU ? spaceskip::BackendKind::CPU
+                                                               : spaceskip::BackendKind::Auto;
+      d.Engine.reset(new spaceskip::Engine(kind));
+    }
+    catch (const std::exception& e)
+    {
+      fail(std::string("cannot create the SpaceSkip engine: ") + e.what());
+      return;
+    }
+    d.Engine->setLogger([this](const std::string& m) { vtkWarningWithObjectMacro(this, << m); });
+    d.EngineBackend = this->Backend;
+    if (this->Backend == CUDA && d.Engine->backendKind() != spaceskip::BackendKind::CUDA)
+    {
+      vtkWarningMacro(<< "CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
+                         "without CUDA); using the CPU backend");
+    }
+    d.ResetVolume();
+    d.ResetTF();
+  }
+  spaceskip::Engine& engine = *d.Engine;
+
+  try
+  {
+    // Volume: only when the data changed (the engine then recomputes its value ranges).
+    if (!d.HaveVolume || d.InputKey != input || d.InputMTime != input->GetMTime() ||
+      d.ScalarsKey != scalars || d.ScalarsMTime != scalars->GetMTime())
+    {
+      spaceskip::Volume v;
+      int dims[3];
+      input->GetDimensions(dims);
+      v.dims = spaceskip::vec3l{ dims[0], dims[1], dims[2] };
+      const double* sp = input->GetSpacing();
+      std::copy(sp, sp + 3, v.spacing);
+      input->TransformIndexToPhysicalPoint(ext[0], ext[2], ext[4], v.origin);
+      const double* dir = input->GetDirectionMatrix()->GetData();
+      std::copy(dir, dir + 9, v.direction);
+      if (native && scalars->HasStandardMemoryLayout())
+      {
+        v.type = vtype;
+        v.data = scalars->GetVoidPointer(0);
+        d.Borrowed = scalars;
+        d.Converted.clear();
+        d.Converted.shrink_to_fit();
+      }
+      else
+      {
+        if (!native)
+        {
+          vtkWarningMacro(<< "scalar type " << scalars->GetDataTypeAsString()
+                          << " converted to float (values beyond 2^24 lose precision)");
+        }
+        d.Converted.resize(static_cast<size_t>(npts));
+        for (vtkIdType i = 0; i < npts; ++i)
+        {
+          d.Converted[static_cast<size_t>(i)] = static_cast<float>(scalars->GetComponent(i, 0));
+        }
+        v.type = spaceskip::VoxelType::Float32;
+        v.data = d.Converted.data();
+        d.Borrowed = nullptr;
+      }
+      engine.setVolume(v);
+      scalars->GetFiniteRange(d.ScalarRange, 0);
+      if (!(d.ScalarRange[0] <= d.ScalarRange[1]))
+      {
+        d.ScalarRange[0] = 0; // no finite value at all: an empty table range
+        d.ScalarRange[1] = 1;
+      }
+      d.InputKey = input;
+      d.InputMTime = input->GetMTime();
+      d.ScalarsKey = scalars;
+      d.ScalarsMTime = scalars->GetMTime();
+      d.HaveVolume = true;
+    }
+
+    // Transfer function: resampled only when the property or one of its functions changed;
+    // the engine itself tells a colour-only edit from an opacity edit.
+    vtkVolumeProperty* prop = vol->GetProperty();
+    const bool gray = prop->GetColorChannels(0) == 1;
+    vtkObject* color = gray ? static_cast<vtkObject*>(prop->GetGrayTransferFunction(0))
+                            : static_cast<vtkObject*>(prop->GetRGBTransferFunction(0));
+    vtkPiecewiseFunction* opacity = prop->GetScalarOpacity(0);
+    double lo = d.ScalarRange[0], hi = d.ScalarRange[1];
+    if (!(hi > lo))
+    {
+      hi = lo + 1.0; // constant volume: any non-empty range samples its one value
+    }
+    if (!d.HaveTF || d.PropertyKey != prop || d.PropertyMTime != prop->GetMTime() ||
+      d.ColorKey != color || d.ColorMTime != color->GetMTime() || d.OpacityKey != opacity ||
+      d.OpacityMTime != opacity->GetMTime() || d.TableRange[0] != lo || d.TableRange[1] != hi)
+    {
+      spaceskip::TransferFunction tf;
+      tf.rangeMin = lo;
+      tf.rangeMax = hi;
+      tf.unitDistance = std::max(prop->GetScalarOpacityUnitDistance(0), 1e-12);
+      std::vector<float> rgb(3 * kTableSize), alpha(kTableSize);
+      if (gray)
+      {
+        std::vector<float> g(kTableSize);
+        static_cast<vtkPiecewiseFunction*>(color)->GetTable(lo, hi, kTableSize, g.data());
+        for (int i = 0; i < kTableSize; ++i)
+        {
+          rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = g[i];
+        }
+      }
+      else
+      {
+        static_cast<vtkColorTransferFunction*>(color)->GetTable(lo, hi, kTableSize, rgb.data());
+      }
+      opacity->GetTable(lo, hi, kTableSize, alpha.data());
+      tf.table.resize(kTableSize);
+      for (int i = 0; i < kTableSize; ++i)
+      {
+        tf.table[i] = spaceskip::vec4f{ rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2],
+          std::min(std::max(alpha[i], 0.f), 1.f) };
+      }
+      engine.setTransferFunction(tf);
+      d.PropertyKey = prop;
+      d.PropertyMTime = prop->GetMTime();
+      d.ColorKey = color;
+      d.ColorMTime = color->GetMTime();
+      d.OpacityKey = opacity;
+      d.OpacityMTime = opacity->GetMTime();
+      d.TableRange[0] = lo;
+      d.TableRange[1] = hi;
+      d.HaveTF = true;
+    }
+    // Features of vtkVolumeProperty/vtkVolumeMapper the engine does not have: said once each.
+    auto unsupported = [&](bool used, bool& warned, const char* what) {
+      if (used && !warned)
+      {
+        vtkWarningMacro(<< what);
+      }
+      warned = warned || used;
+    };
+    unsupported(prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION, d.WarnedNearest,
+      "nearest interpolation is not supported; rendering with trilinear interpolation");
+    unsupported(prop->GetShade(0) != 0, d.WarnedShade,
+      "shading is not supported yet; rendering unshaded (emission-absorption)");
+    unsupported(this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND, d.WarnedBlend,
+      "only the composite blend mode is supported; rendering with composite blending");
+    unsupported(this->Cropping != 0 ||
+        (this->ClippingPlanes && this->ClippingPlanes->GetNumberOfItems() > 0),
+      d.WarnedClip, "cropping and clipping planes are not supported; rendering the whole volume");
+
+    spaceskip::BuildParams bp;
+    bp.builder = static_cast<spaceskip::BuilderKind>(this->Builder);
+    bp.leaf = static_cast<spaceskip::LeafCriterion>(this->LeafCriterion);
+    bp.maxLeafSize = this->MaxLeafSize;
+    bp.bins = this->BinCount;
+    bp.brick = engine.buildParams().brick;
+    engine.setBuildParams(bp);
+    spaceskip::RenderParams rp = engine.renderParams();
+    rp.sampleDistance = this->SampleDistance;
+    rp.ertThreshold = this->EarlyRayTermination ? kErtThreshold : 2.0;
+    engine.setRenderParams(rp);
+
+    // Camera: the volume's matrix is folded into the view, so the engine marches in the
+    // image's physical space and the projected depth matches what OpenGL drew.
+    vtkMatrix4x4* wcvc;
+    vtkMatrix3x3* norms;
+    vtkMatrix4x4* vcdc;
+    vtkMatrix4x4* wcdc;
+    cam->GetKeyMatrices(ren, wcvc, norms, vcdc, wcdc);
+    vtkNew<vtkMatrix4x4> view, proj, viewModel;
+    vtkMatrix4x4::Transpose(wcvc, view); // key matrices are stored transposed for OpenGL
+    vtkMatrix4x4::Transpose(vcdc, proj);
+    vtkMatrix4x4::Multiply4x4(view, vol->GetMatrix(), viewModel);
+    spaceskip::Camera camera;
+    camera.view = ToCore(viewModel);
+    camera.proj = ToCore(proj);
+
+    int width, height, x0, y0;
+    ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+    if (width <= 0 || height <= 0)
+    {
+      return;
+    }
+
+    // Depth of the opaque geometry already drawn, read from the framebuffer being rendered.
+    vtkOpenGLState* ostate = renWin->GetState();
+    const float* depth = nullptr;
+    d.Depth.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
+    if (this->ReadDepth(renWin, x0, y0, width, height))
+    {
+      depth = d.Depth.data();
+    }
+    else if (!d.WarnedDepthRead)
+    {
+      vtkWarningMacro(<< "could not read the depth buffer: the volume ignores opaque geometry");
+      d.WarnedDepthRead = true;
+    }
+
+    const int buildsBefore = engine.counters().builds;
+    engine.render(camera, width, height, d.Image, depth);
+    if (engine.counters().builds != buildsBefore)
+    {
+      const spaceskip::BuildStats& bs = engine.buildStats();
+      vtkVLogF(vtkLogger::VERBOSITY_TRACE,
+        "vtkSpaceSkippingVolumeMapper: built %s on %s in %.6f s (classify %.6f s): %lld nodes, "
+        "height %d, %lld leaves, occupancy %.4f",
+        spaceskip::builderName(bs.builder), bs.builtOn.c_str(), bs.seconds, bs.classifySeconds,
+        static_cast<long long>(bs.nodes), bs.height, static_cast<long long>(bs.leaves),
+        bs.occupancy);
+    }
+    vtkVLogF(vtkLogger::VERBOSITY_TRACE, "vtkSpaceSkippingVolumeMapper: %dx%d frame in %.6f s on %s",
+      width, height, engine.frameStats().seconds, engine.frameStats().backend.c_str());
+    d.BackendUsed = engine.frameStats().backend;
+    d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
+
+    // Composite: premultiplied RGBA over what is drawn, (ONE, ONE_MINUS_SRC_ALPHA).
+    if (!d.Texture)
+    {
+      d.Texture = vtkSmartPointer<vtkTextureObject>::New();
+    }
+    d.Texture->SetContext(renWin);
+    d.Texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    d.Texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    d.Texture->SetWrapS(vtkTextureObject::ClampToEdge);
+    d.Texture->SetWrapT(vtkTextureObject::ClampToEdge);
+    d.Texture->Create2DFromRaw(static_cast<unsigned>(width), static_cast<unsigned>(height), 4,
+      VTK_FLOAT, d.Image.rgba.data());
+
+    if (!d.Quad)
+    {
+      std::string fs = vtkOpenGLRenderUtilities::GetFullScreenQuadFragmentShaderTemplate();
+      vtkShaderProgram::Substitute(fs, "//VTK::FSQ::Decl", "uniform sampler2D ssImage;");
+      vtkShaderProgram::Substitute(
+        fs, "//VTK::FSQ::Impl", "  gl_FragData[0] = texture(ssImage, texCoord);");
+      d.Quad.reset(new vtkOpenGLQuadHelper(renWin,
+        vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), fs.c_str(), ""));
+    }
+    else
+    {
+      renWin->GetShaderCache()->ReadyShaderProgram(d.Quad->Program);
+    }
+    if (!d.Quad->Program || !d.Quad->Program->GetCompiled())
+    {
+      fail("could not compile the compositing shader: nothing drawn");
+      return;
+    }
+
+    vtkOpenGLState::ScopedglEnableDisable blendSaver(ostate, GL_BLEND);
+    vtkOpenGLState::ScopedglEnableDisable depthSaver(ostate, GL_DEPTH_TEST);
+    vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(ostate);
+    vtkOpenGLState::ScopedglDepthMask depthMaskSaver(ostate);
+    ostate->vtkglEnable(GL_BLEND);
+    ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    ostate->vtkglDisable(GL_DEPTH_TEST);
+    ostate->vtkglDepthMask(GL_FALSE);
+    d.Texture->Activate();
+    d.Quad->Program->SetUniformi("ssImage", d.Texture->GetTextureUnit());
+    d.Quad->Render();
+    d.Texture->Deactivate();
+    d.LastProblem.clear();
+  }
+  catch (const std::exception& e)
+  {
+    fail(std::string("SpaceSkip engine error: ") + e.what() + ": nothing drawn");
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Builder: " << this->GetBuilderAsString() << "\n";
+  os << indent << "LeafCriterion: " << (this->LeafCriterion == Shallow ? "Shallow" : "Deep")
+     << "\n";
+  os << indent << "MaxLeafSize: " << this->MaxLeafSize << "\n";
+  os << indent << "BinCount: " << this->BinCount << "\n";
+  os << indent << "SampleDistance: " << this->SampleDistance << "\n";
+  os << indent << "Backend: "
+     << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";
+  os << indent << "EarlyRayTermination: " << (this->EarlyRayTermination ? "On" : "Off") << "\n";
+  os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
+  os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
+  os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";
+  os << indent << "LastRenderSeconds: " << this->GetLastRenderSeconds() << "\n";
+  os << indent << "NodeCount: " << this->GetNodeCount() << "\n";
+  os << indent << "TreeHeight: " << this->GetTreeHeight() << "\n";
+  os << indent << "LeafCount: " << this->GetLeafCount() << "\n";
+  os << indent << "BuildCount: " << this->GetBuildCount() << "\n";
+  os << indent << "ClassifyCount: " << this->GetClassifyCount() << "\n";
+  os << indent << "ColorUpdateCount: " << this->GetColorUpdateCount() << "\n";
+}
