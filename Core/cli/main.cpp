@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -27,6 +28,14 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+/// CPU seconds used by this process (all threads): a frame's work, robust against other load
+/// on a shared machine (wall-clock fps is not).
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 const char* kUsage = R"(usage:
   spaceskip generate SHAPE --dims X Y Z [--seed N] -o FILE(.nrrd|_XxYxZ_TYPE.raw)
       SHAPE: menger nbody shell noise rm vessels
@@ -37,6 +46,7 @@ const char* kUsage = R"(usage:
       each builder may carry suffixes overriding --leaf/--mls/--bins/--brick, e.g.
       --builders naive,grid,lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid
       --build-reps N: report the fastest of N rebuilds (default 1)
+      bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only)
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
@@ -263,6 +273,26 @@ int cmdRender(const Options& o) {
   return 0;
 }
 
+/// Bench-only suffixes of a --builders item, stripped before buildParams sees it:
+/// `hw`/`exact` pick the filter for this item, `cold` times the first build only (no rebuilds:
+/// for very slow builders such as the paper's KdTreeGPU at 2048^3).
+struct BenchItem {
+  std::string spec;  ///< the item without bench-only suffixes
+  int filter = -1;   ///< -1: --filter, else a FilterMode
+  bool cold = false;
+};
+
+BenchItem benchItem(const std::string& item) {
+  BenchItem it;
+  for (const std::string& part : split(item, ':')) {
+    if (part == "hw") it.filter = int(FilterMode::Hardware);
+    else if (part == "exact") it.filter = int(FilterMode::Exact);
+    else if (part == "cold") it.cold = true;
+    else it.spec += (it.spec.empty() ? "" : ":") + part;
+  }
+  return it;
+}
+
 int cmdBench(const Options& o) {
   if (o.positional.empty()) throw std::invalid_argument("bench needs at least one VOLUME");
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
@@ -276,31 +306,40 @@ int cmdBench(const Options& o) {
   std::ofstream csv;
   if (o.has("--csv")) {
     csv.open(o.get("--csv", ""));
-    csv << "dataset,dims,variant,builder,backend,leaf,mls,bins,brick,build_s,classify_s,fps,nodes,height,leaves,occupancy\n";
+    csv << "dataset,dims,variant,builder,backend,leaf,mls,bins,brick,build_s,classify_s,fps,nodes,height,leaves,occupancy,"
+           "filter,kernel_fps,build_cold_s,built_on,samples_per_frame,gsamples_per_s_kernel,voxel_gbytes_per_s_kernel,frame_cpu_s\n";
   }
   bool firstJson = true;
-  std::printf("%-18s %-26s %-6s %10s %11s %8s %9s %6s %9s %8s %8s\n", "dataset", "builder", "backend", "build_ms",
-              "classify_ms", "fps", "nodes", "height", "leaves", "vs_naive", "Gsmp/s");
+  std::printf("%-16s %-30s %-6s %10s %11s %8s %9s %9s %9s %6s %9s %8s %8s\n", "dataset", "builder", "backend", "build_ms",
+              "classify_ms", "fps", "kern_fps", "cpu_ms/f", "nodes", "height", "leaves", "vs_naive", "Gsmp/s");
   for (const std::string& spec : o.positional) {
+    auto tg = Clock::now();
     Volume v = openVolume(spec);
+    std::fprintf(stderr, "  note: %s ready in %.2f s\n", spec.c_str(), since(tg));
     TransferFunction tf = makeTF(o, v);
     double naiveFps = 0;
+    // One engine per data set: the volume is uploaded (CUDA) and its ranges computed once.
+    Engine engine(backendKind(o));
+    engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+    engine.setVolume(v);
+    engine.setTransferFunction(tf);
     for (const std::string& b : builders) {
-      Engine engine(backendKind(o));
-      engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
-      engine.setVolume(v);
-      engine.setTransferFunction(tf);
-      BuildParams bp = buildParams(o, b);
+      const BenchItem item = benchItem(b);
+      const BuildParams bp = buildParams(o, item.spec);
+      RenderParams rp = renderParams(o);
+      if (item.filter >= 0) rp.filter = FilterMode(item.filter);
+      engine.setRenderParams(rp);
       engine.setBuildParams(bp);
-      engine.setRenderParams(renderParams(o));
       engine.update();
+      const double cold = engine.buildStats().seconds;
       // Rebuild, timed alone (the first build includes one-time allocations); with
-      // --build-reps N the fastest of N rebuilds (robust against other load on the machine).
-      BuildStats s;
-      for (int rep = 0; rep < buildReps; ++rep) {
-        BuildParams other = bp;
-        other.bins = bp.bins + 1;
-        engine.setBuildParams(other);
+      // --build-reps N the fastest of N rebuilds. A Naive build in between (which costs nothing)
+      // forces each rebuild.
+      BuildStats s = engine.buildStats();
+      for (int rep = 0; rep < buildReps && !item.cold; ++rep) {
+        BuildParams none = bp;
+        none.builder = BuilderKind::Naive;
+        engine.setBuildParams(none);
         engine.update();
         engine.setBuildParams(bp);
         engine.update();
@@ -310,44 +349,59 @@ int cmdBench(const Options& o) {
       v.worldBounds(b6);
       Image img;
       engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
-      double total = 0;
+      double total = 0, totalDevice = 0, cpuTotal = 0;
       for (int f = 0; f < frames; ++f) {
+        const double c0 = processCpuSeconds();
         engine.render(orbitCamera(b6, 360.0 * f / frames, 15, 1, false, double(w) / h), w, h, img);
+        cpuTotal += processCpuSeconds() - c0;
         total += engine.frameStats().seconds;
+        totalDevice += engine.frameStats().deviceSeconds;
       }
-      double fps = frames / total;
+      const double fps = frames / total;
+      // CUDA: frame rate of the render kernel alone (CUDA events), without the host copy.
+      const double kernelFps = totalDevice > 0 ? frames / totalDevice : fps;
+      const double frameCpu = cpuTotal / frames;
       // One more frame with sample counting (not timed): samples/frame and samples/s.
-      RenderParams counted = renderParams(o);
+      RenderParams counted = rp;
       counted.countSamples = true;
       engine.setRenderParams(counted);
       engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
       const double samples = double(engine.frameStats().samples);
-      const double gsps = samples * fps * 1e-9;
-      if (s.builder == BuilderKind::Naive) naiveFps = fps;
+      const double gsps = samples * kernelFps * 1e-9;
+      // Logical voxel traffic of trilinear sampling: 8 voxels per sample (mostly cache hits).
+      const double voxelGBs = gsps * 8.0 * double(voxelSize(v.type));
+      if (s.builder == BuilderKind::Naive && naiveFps == 0) naiveFps = kernelFps;
       std::string dims = std::to_string(v.dims.x) + "x" + std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z);
       std::string name = spec.substr(spec.find_last_of('/') + 1);
       // The variant as asked for; when the engine fell back (e.g. a GPU builder on the CPU), say so.
       std::string label = b;
       if (s.builder != bp.builder) label += std::string("->") + builderName(s.builder);
-      std::printf("%-18s %-26s %-6s %10.3f %11.3f %8.2f %9lld %6d %9lld %8s %8.3f\n", name.c_str(), label.c_str(),
-                  engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, (long long)s.nodes, s.height,
-                  (long long)s.leaves, naiveFps > 0 ? (std::to_string(fps / naiveFps).substr(0, 5) + "x").c_str() : "-", gsps);
+      const char* filter = rp.filter == FilterMode::Hardware ? "hardware" : "exact";
+      std::printf("%-16s %-30s %-6s %10.3f %11.3f %8.2f %9.2f %9.1f %9lld %6d %9lld %8s %8.3f\n", name.c_str(), label.c_str(),
+                  engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, kernelFps, frameCpu * 1e3, (long long)s.nodes,
+                  s.height, (long long)s.leaves,
+                  naiveFps > 0 ? (std::to_string(kernelFps / naiveFps).substr(0, 5) + "x").c_str() : "-", gsps);
       std::fflush(stdout);
       // Hybrid always builds the shallow tree (paper 3.3).
       const char* leaf = bp.leaf == LeafCriterion::Shallow || s.builder == BuilderKind::Hybrid ? "shallow" : "deep";
       if (!firstJson) json << ",\n";
       firstJson = false;
       json << "  {\"dataset\": \"" << name << "\", \"dims\": \"" << dims << "\", \"variant\": \"" << label
-           << "\", \"builder\": \"" << builderName(s.builder)
-           << "\", \"backend\": \"" << engine.backendName() << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize
-           << ", \"bins\": " << bp.bins << ", \"brick\": " << bp.brick << ", \"build_s\": " << s.seconds << ", \"classify_s\": " << s.classifySeconds
-           << ", \"fps\": " << fps << ", \"nodes\": " << s.nodes << ", \"height\": " << s.height
-           << ", \"leaves\": " << s.leaves << ", \"samples_per_frame\": " << samples << ", \"gsamples_per_s\": " << gsps << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
-           << ", \"height_px\": " << h << ", \"frames\": " << frames << "}";
+           << "\", \"builder\": \"" << builderName(s.builder) << "\", \"backend\": \"" << engine.backendName()
+           << "\", \"built_on\": \"" << s.builtOn << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize
+           << ", \"bins\": " << bp.bins << ", \"brick\": " << bp.brick << ", \"filter\": \"" << filter
+           << "\", \"build_s\": " << s.seconds << ", \"build_cold_s\": " << cold << ", \"classify_s\": " << s.classifySeconds
+           << ", \"fps\": " << fps << ", \"kernel_fps\": " << kernelFps << ", \"frame_cpu_s\": " << frameCpu << ", \"nodes\": " << s.nodes
+           << ", \"height\": " << s.height << ", \"leaves\": " << s.leaves << ", \"samples_per_frame\": " << samples
+           << ", \"gsamples_per_s\": " << gsps << ", \"voxel_gbytes_per_s\": " << voxelGBs
+           << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w << ", \"height_px\": " << h
+           << ", \"frames\": " << frames << "}";
       if (csv.is_open())
         csv << name << "," << dims << "," << label << "," << builderName(s.builder) << "," << engine.backendName() << ","
-            << leaf << "," << bp.maxLeafSize << "," << bp.bins << "," << bp.brick << "," << s.seconds << "," << s.classifySeconds << "," << fps << ","
-            << s.nodes << "," << s.height << "," << s.leaves << "," << s.occupancy << "\n";
+            << leaf << "," << bp.maxLeafSize << "," << bp.bins << "," << bp.brick << "," << s.seconds << ","
+            << s.classifySeconds << "," << fps << "," << s.nodes << "," << s.height << "," << s.leaves << ","
+            << s.occupancy << "," << filter << "," << kernelFps << "," << cold << "," << s.builtOn << "," << samples
+            << "," << gsps << "," << voxelGBs << "," << frameCpu << "\n";
     }
   }
   json << "\n]\n";

@@ -24,6 +24,8 @@ class Backend {
   virtual void build(const BuildParams& p, BuildStats& stats) = 0;
   /// `f` carries camera, box, sampling; the backend fills pointers and traversal kind.
   virtual void render(FrameView f, FilterMode filter, const float* depth, Image& out) = 0;
+  /// Seconds the last render() spent in device work (CUDA events), -1 when not measured.
+  virtual double lastFrameDeviceSeconds() const { return -1; }
   virtual const OccupancyGrid& occupancy() = 0;
   virtual Tree tree() = 0;
 };

@@ -72,6 +72,7 @@ struct BuildStats {
 struct FrameStats {
   double seconds = 0;
   int64_t samples = -1;  ///< samples taken in the frame (RenderParams::countSamples), else -1
+  double deviceSeconds = -1;  ///< render kernel time on the GPU (CUDA events), -1 on the CPU
   std::string backend;
 };
 

@@ -15,8 +15,9 @@ constexpr int64_t kKdTreeSerialCutoffBricks = 4096;
 
 /// Builds the k-d tree:
 ///  - the root box is the tight box of all occupied bricks (empty occupancy: no nodes);
-///  - candidate planes run along the node's longest axis at every brick boundary (every 8 cells
-///    when bricks are smaller than 8), relative to the node's low face as in Vidal's code;
+///  - candidate planes run along the node's longest axis at every brick boundary for bricks of
+///    8 cells or more, else every ceil(8/brick) bricks (every 8 cells for brick 1, 2, 4), placed
+///    relative to the node's low face as in Vidal's code;
 ///  - cost = volume of the tight left box + volume of the tight right box (cells); a plane is
 ///    rejected when it removes <= 1/1000 of the node volume as empty space; least cost wins;
 ///  - halting: Shallow = node volume < 10% of the root volume, Deep = node volume <= 8^3 cells,

@@ -4,7 +4,7 @@
 #include "Classification.h"
 
 #include <cstdint>
-#include <vector>
+#include <memory>
 
 namespace spaceskip {
 
@@ -13,7 +13,7 @@ namespace spaceskip {
 /// rather than one per 32^3 brick as in the paper: a query is then 8 lookups wherever the box lies.
 class SummedVolumeTable {
  public:
-  SummedVolumeTable() = default;
+  SummedVolumeTable() = default;  ///< empty table (dims 0): every count is 0
   /// Builds the table in parallel (oneTBB). Throws std::length_error when the grid has 2^32 or
   /// more bricks (counts are 32-bit).
   explicit SummedVolumeTable(const OccupancyGrid& occ);
@@ -32,7 +32,7 @@ class SummedVolumeTable {
   }
   vec3i dims_{0, 0, 0};
   vec3i stride_{1, 1, 1};
-  std::vector<uint32_t> sums_;
+  std::unique_ptr<uint32_t[]> sums_;
 };
 
 }  // namespace spaceskip

@@ -76,8 +76,9 @@ template <class Leaf>
 SS_FUNC bool traverseTree(const TreeView& tv, const Ray& r, vec3f inv, float tmin, float tmax,
                           Leaf& leaf) {
   if (tv.numNodes <= 0) return true;
+  // Only node indices are stacked: a popped node's interval is recomputed from its box (the
+  // same float operations give the same values), which halves the stack's local-memory traffic.
   int stack[kMaxTreeHeight + 1];
-  float stackT[kMaxTreeHeight + 1];
   int sp = 0;
   int node = 0;
   float tn, tf;
@@ -105,12 +106,10 @@ SS_FUNC bool traverseTree(const TreeView& tv, const Ray& r, vec3f inv, float tmi
       if (hit0 && hit1) {
         int nearC = t0[1] < t0[0] ? 1 : 0;
         stack[sp] = n.child + (1 - nearC);
-        stackT[sp] = t1[1 - nearC];
         ++sp;
         node = n.child + nearC;
         nodeT0 = t0[nearC];
         nodeT1 = t1[nearC];
-        // The far child's entry is kept implicit: it is recomputed when popped.
         continue;
       }
       if (hit0 || hit1) {
@@ -129,7 +128,7 @@ SS_FUNC bool traverseTree(const TreeView& tv, const Ray& r, vec3f inv, float tmi
     intersectBox(r, inv, vec3f{float(b.lo.x), float(b.lo.y), float(b.lo.z)},
                  vec3f{float(b.hi.x), float(b.hi.y), float(b.hi.z)}, tn, tf);
     nodeT0 = ss_max(tn, tmin);
-    nodeT1 = ss_min(stackT[sp], ss_min(tf, tmax));
+    nodeT1 = ss_min(tf, tmax);
   }
 }
 

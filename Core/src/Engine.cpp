@@ -242,6 +242,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     d.backend->render(f, d.render.filter, depth, out);
   }
   d.frame.seconds = since(t0);
+  d.frame.deviceSeconds = d.backend->lastFrameDeviceSeconds();
   d.frame.samples = -1;
   if (d.render.countSamples) {
     d.frame.samples = 0;

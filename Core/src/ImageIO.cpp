@@ -1,7 +1,9 @@
 // PNG via libpng; image metrics.
 #include "spaceskip/ImageIO.h"
 
+#ifdef SPACESKIP_HAVE_PNG
 #include <png.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -13,11 +15,15 @@
 namespace spaceskip {
 
 namespace {
-unsigned char to8(float v) { return (unsigned char)std::lround(std::clamp(v, 0.f, 1.f) * 255.f); }
+[[maybe_unused]] unsigned char to8(float v) { return (unsigned char)std::lround(std::clamp(v, 0.f, 1.f) * 255.f); }
 }  // namespace
 
 void savePng(const Image& img, const std::string& path, bool overBlack) {
   if (img.width <= 0 || img.height <= 0) throw std::invalid_argument("empty image");
+#ifndef SPACESKIP_HAVE_PNG
+  (void)overBlack;
+  throw std::runtime_error(path + ": cannot write PNG: SpaceSkip was built without libpng");
+#else
   std::vector<unsigned char> rows(size_t(img.width) * img.height * 4);
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) {
@@ -39,9 +45,13 @@ void savePng(const Image& img, const std::string& path, bool overBlack) {
   pi.format = PNG_FORMAT_RGBA;
   if (!png_image_write_to_file(&pi, path.c_str(), 0, rows.data(), 0, nullptr))
     throw std::runtime_error(path + ": cannot write PNG (" + pi.message + ")");
+#endif
 }
 
 Image loadPng(const std::string& path) {
+#ifndef SPACESKIP_HAVE_PNG
+  throw std::runtime_error(path + ": cannot read PNG: SpaceSkip was built without libpng");
+#else
   png_image pi{};
   pi.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&pi, path.c_str()))
@@ -61,6 +71,7 @@ Image loadPng(const std::string& path) {
       img.rgba[size_t(y) * img.width + x] = vec4f{s[0] / 255.f * a, s[1] / 255.f * a, s[2] / 255.f * a, a};
     }
   return img;
+#endif
 }
 
 ImageDiff compareImages(const Image& a, const Image& b) {

@@ -14,27 +14,37 @@ SummedVolumeTable::SummedVolumeTable(const OccupancyGrid& occ) : dims_(occ.dims)
   const int nx = dims_.x, ny = dims_.y, nz = dims_.z;
   stride_ = vec3i{nx + 1, ny + 1, nz + 1};
   const size_t sx = size_t(stride_.x), sxy = sx * size_t(stride_.y);
-  sums_.assign(sxy * size_t(stride_.z), 0u);
+  // No serial zero fill: the zero borders are written by the parallel passes (first touch in
+  // parallel too), every other entry by pass 1.
+  sums_.reset(new uint32_t[sxy * size_t(stride_.z)]);  // default-initialised: no zero fill
   // Pass 1: a 2-D summed area table per z slice (x running sum plus the row below); slices are
-  // independent and a slice stays in cache while it is summed.
-  tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& r) {
-    for (int z = r.begin(); z != r.end(); ++z)
+  // independent and a slice stays in cache while it is summed. Slice 0 is the zero border.
+  tbb::parallel_for(tbb::blocked_range<int>(-1, nz), [&](const tbb::blocked_range<int>& r) {
+    for (int z = r.begin(); z != r.end(); ++z) {
+      uint32_t* slice = sums_.get() + sxy * size_t(z + 1);
+      if (z < 0) {
+        std::fill(slice, slice + sxy, 0u);
+        continue;
+      }
+      std::fill(slice, slice + sx, 0u);  // row y = 0
       for (int y = 0; y < ny; ++y) {
         const uint8_t* src = occ.occ.data() + occ.index(0, y, z);
-        uint32_t* cur = sums_.data() + sxy * size_t(z + 1) + sx * size_t(y + 1);
+        uint32_t* cur = slice + sx * size_t(y + 1);
         const uint32_t* prev = cur - sx;
         uint32_t s = 0;
+        cur[0] = 0;
         for (int x = 0; x < nx; ++x) {
           s += src[x] ? 1u : 0u;
           cur[x + 1] = s + prev[x + 1];
         }
       }
+    }
   });
   // Pass 2 (z): add the previous slice, per y row (rows are independent along z).
   tbb::parallel_for(tbb::blocked_range<int>(1, ny + 1), [&](const tbb::blocked_range<int>& r) {
     for (int y = r.begin(); y != r.end(); ++y)
       for (int z = 2; z <= nz; ++z) {
-        uint32_t* cur = sums_.data() + sxy * size_t(z) + sx * size_t(y);
+        uint32_t* cur = sums_.get() + sxy * size_t(z) + sx * size_t(y);
         const uint32_t* prev = cur - sxy;
         for (int x = 1; x <= nx; ++x) cur[x] += prev[x];
       }

@@ -1,0 +1,46 @@
+// GPU k-d trees over the brick occupancy (same cost, halting and MLS as KdTreeSplit.cuh):
+//  - KdTreeGPU: the paper's method (3.2.2): Morton-ordered brick boxes, one reduction per
+//    candidate child over the region's Morton range, recursion driven by the host.
+//  - KdTreeGPUFast (ours): breadth-first, one kernel pass per level for all nodes, tight boxes
+//    and counts from a 3-D summed volume table over the bricks.
+#pragma once
+#include "DeviceTree.cuh"
+#include "KdTreeSplit.cuh"
+#include "spaceskip/Engine.h"
+
+namespace spaceskip::cuda {
+
+struct KdParams {
+  LeafCriterion leaf = LeafCriterion::Deep;
+  int maxLeafSize = 0;
+  int bins = 4;
+};
+
+struct KdTreeGpuWorkspace {
+  DeviceBuffer<box3i> mortonBoxes;  ///< brick boxes in Morton order, padded to a 2^k cube
+  DeviceBuffer<box3i> result;
+  TempStorage temp;
+  box3i* h_result = nullptr;  ///< pinned
+  ~KdTreeGpuWorkspace();
+};
+
+struct KdTreeGpuFastWorkspace {
+  DeviceBuffer<int> svt;  ///< (dims+1)^3 inclusive prefix counts
+  DeviceBuffer<box3i> levelBoxes[2];
+  DeviceBuffer<box3i> childBoxes;
+  DeviceBuffer<int> splitFlags, splitOffsets;
+  DeviceBuffer<int> counter;
+  TempStorage temp;
+  int* h_counter = nullptr;  ///< pinned
+  ~KdTreeGpuFastWorkspace();
+};
+
+/// The paper's KdTreeGPU. Synchronizes `stream` (it must: the recursion runs on the host).
+void buildKdTreeGpu(const BrickGridView& g, const KdParams& p, KdTreeGpuWorkspace& ws, DeviceTree& out,
+                    cudaStream_t stream);
+
+/// KdTreeGPUFast. Synchronizes `stream` once per tree level (to size the next level's launch).
+void buildKdTreeGpuFast(const BrickGridView& g, const KdParams& p, KdTreeGpuFastWorkspace& ws, DeviceTree& out,
+                        cudaStream_t stream);
+
+}  // namespace spaceskip::cuda

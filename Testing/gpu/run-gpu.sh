@@ -1,0 +1,147 @@
+#!/usr/bin/env bash
+# Builds Core with CUDA on a GPU machine, runs the tests, compute-sanitizer (memcheck, racecheck)
+# on the CUDA tests, and the benchmarks; writes everything into OUTDIR (see DEVICE.md).
+#
+#   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
+#   PHASE: build test sanitize bench-small bench-large blocks ncu   (default: build test sanitize bench-small)
+#   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
+#          when present), BENCH_FRAMES (8), SANITIZE_FILTER (gtest filter for the sanitizer runs)
+#
+# OUTDIR receives at most 8 files (the device tool's limit): env.txt, build.log, ctest.log,
+# sanitize.log, bench.log, bench.csv, bench.json, and logs.tgz (everything).
+set -uo pipefail
+out=${1:?usage: run-gpu.sh OUTDIR [PHASE...]}
+shift
+phases=${*:-build test sanitize bench-small}
+src=$(cd "$(dirname "$0")/../.." && pwd)
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+work=$(mktemp -d)
+build=${BUILD_DIR:-$src/build-gpu}
+frames=${BENCH_FRAMES:-8}
+status=0
+
+for d in "$src/../.deps/tbb" "$src/.deps/tbb"; do
+  if [ -d "$d" ]; then
+    export TBB_DIR=$(cd "$d" && pwd)/usr/lib/x86_64-linux-gnu/cmake/TBB
+    export LD_LIBRARY_PATH=$(cd "$d" && pwd)/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+    break
+  fi
+done
+
+log() { echo "[$(date -u +%H:%M:%S)] $*" | tee -a "$work/run.log"; }
+has() { case " $phases " in *" $1 "*) return 0 ;; *) return 1 ;; esac; }
+
+{
+  echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
+  echo "host: $(hostname)  phases: $phases"
+  nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.max.sm,clocks.max.mem --format=csv 2>&1
+  nvcc --version 2>&1 | tail -2
+  echo "cmake: $(cmake --version | head -1)  cores: $(nproc)"
+  echo "git: $(cd "$src" && git rev-parse HEAD 2>/dev/null || echo 'no git (copied tree)')"
+} > "$work/env.txt"
+cp "$work/env.txt" "$out/env.txt"
+
+if has build; then
+  log "configure + build in $build"
+  cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSPACESKIP_ENABLE_CUDA=ON \
+    -DSPACESKIP_ENABLE_PARAVIEW=OFF -DCMAKE_CUDA_ARCHITECTURES=90 > "$work/build.log" 2>&1 &&
+    ninja -C "$build" >> "$work/build.log" 2>&1
+  rc=$?
+  log "build rc=$rc"
+  [ $rc -eq 0 ] || status=1
+  tail -c 60000 "$work/build.log" > "$out/build.log"
+fi
+tests=$build/Testing/spaceskip_core_tests
+cli=$build/Core/spaceskip
+
+if has test; then
+  log "ctest"
+  (cd "$build" && ctest --output-on-failure -j4 --timeout 600) > "$work/ctest.log" 2>&1
+  rc=$?
+  log "ctest rc=$rc"
+  [ $rc -eq 0 ] || status=1
+  # The CUDA tests alone, verbose (hardware-filter error lines, skip reasons).
+  "$tests" --gtest_filter='*Cuda*' > "$work/cuda-tests.log" 2>&1
+  log "cuda tests rc=$?"
+  { tail -c 40000 "$work/ctest.log"; echo; echo "==== CUDA tests ===="; cat "$work/cuda-tests.log"; } > "$out/ctest.log"
+fi
+
+if has sanitize; then
+  filter=${SANITIZE_FILTER:-'CudaBackend.*:Volumes/CudaImage.EqualsCpuForEveryBuilder/nbody_*'}
+  for tool in memcheck racecheck; do
+    log "compute-sanitizer $tool ($filter)"
+    timeout ${SANITIZE_TIMEOUT:-240} compute-sanitizer --tool $tool --error-exitcode 99 --target-processes all \
+      "$tests" --gtest_filter="$filter" > "$work/sanitize-$tool.log" 2>&1
+    rc=$?
+    log "compute-sanitizer $tool rc=$rc"
+    [ $rc -eq 0 ] || status=1
+  done
+  for tool in memcheck racecheck; do
+    echo "==== $tool ===="
+    grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race|hazard|\[  (PASSED|FAILED|SKIPPED) |tests ran" "$work/sanitize-$tool.log" | head -60
+    tail -5 "$work/sanitize-$tool.log"
+  done > "$out/sanitize.log"
+fi
+
+bench() {  # NAME VOLUME BUILDERS [extra args]
+  local name=$1 vol=$2 builders=$3
+  shift 3
+  log "bench $name: $vol"
+  "$cli" bench "$vol" --backend cuda --builders "$builders" --size 1024x1024 --frames "$frames" \
+    --json "$work/bench-$name.json" --csv "$work/bench-$name.csv" "$@" > "$work/bench-$name.log" 2>&1
+  local rc=$?
+  log "bench $name rc=$rc"
+  cat "$work/bench-$name.log" >> "$work/bench.log"
+  cp "$work/bench.log" "$out/bench.log"  # progressive: survives a run cut short
+  if [ -f "$work/bench-$name.csv" ]; then
+    [ -f "$out/bench.csv" ] || head -1 "$work/bench-$name.csv" > "$out/bench.csv"
+    tail -n +2 "$work/bench-$name.csv" >> "$out/bench.csv"
+  fi
+  [ $rc -eq 0 ] || status=1
+}
+
+kd="kdtree-gpu:shallow,kdtree-gpu:deep:mls32,kdtree-gpu:deep:mls128,kdtree-gpu-fast:shallow,kdtree-gpu-fast:deep,kdtree-gpu-fast:deep:mls32,kdtree-gpu-fast:deep:mls128"
+cpu="lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid"
+hw="naive:hw,grid:hw,grid:brick16:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw,kdtree-gpu-fast:deep:mls128:hw"
+all="naive,grid,lbvh,$kd,$cpu,$hw"
+if has bench-small; then
+  for n in 256 512 1024; do bench "nbody$n" "gen:nbody:$n" "$all"; done
+  bench menger1024 gen:menger:1024 "$all"
+fi
+if has bench-large; then
+  # KdTreeGPU (the paper's host-driven recursion) is timed on its first build only at 2048^3.
+  kdcold="kdtree-gpu:shallow:cold,kdtree-gpu:deep:mls32:cold,kdtree-gpu:deep:mls128:cold"
+  kdfast="kdtree-gpu-fast:shallow,kdtree-gpu-fast:deep,kdtree-gpu-fast:deep:mls32,kdtree-gpu-fast:deep:mls128"
+  # CPU-built trees (built on the GPU machine's 16 cores, uploaded) likewise.
+  cpucold="lbvh-cpu:cold,kdtree-cpu:shallow:cold,kdtree-cpu:deep:mls32:cold,kdtree-cpu:deep:mls128:cold,hybrid:cold"
+  bench nbody2048 gen:nbody:2048 "naive,grid,lbvh,$kdfast,$hw,$cpucold,${BENCH_2048_KDGPU:-$kdcold}"
+fi
+if has blocks; then
+  # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK), recorded for the notes.
+  for bs in 8x8 32x4 16x16 16x8; do
+    SPACESKIP_CUDA_BLOCK=$bs bench "block$bs" gen:nbody:1024 "naive,grid,lbvh,kdtree-gpu-fast:deep:mls32,naive:hw,kdtree-gpu-fast:deep:mls32:hw"
+  done
+fi
+if has ncu; then
+  log "ncu: DRAM traffic of the render kernel"
+  for b in naive kdtree-gpu-fast; do
+    timeout 300 ncu --kernel-name regex:renderKernel --launch-count 1 --launch-skip 1 \
+      --metrics gpu__time_duration.sum,dram__bytes_read.sum,dram__throughput.avg.pct_of_peak_sustained_elapsed,lts__t_bytes.sum,l1tex__t_bytes.sum \
+      "$cli" render gen:nbody:1024 --backend cuda --builder $b --size 1024x1024 -o /tmp/ncu.png > "$work/ncu-$b.log" 2>&1
+    log "ncu $b rc=$?"
+    cat "$work/ncu-$b.log" >> "$work/bench.log"
+  done
+fi
+
+if ls "$work"/bench-*.json > /dev/null 2>&1; then
+  { echo "["; sep=""; for f in "$work"/bench-*.json; do
+      body=$(sed '1d;$d' "$f"); [ -n "$body" ] && { printf '%s%s' "$sep" "$body"; sep=$',\n'; }
+    done; echo; echo "]"; } > "$out/bench.json"
+fi
+cp "$work/run.log" "$out/run.log" 2>/dev/null
+tar -C "$work" -czf "$out/logs.tgz" . 2>/dev/null
+# Keep the device tool's limit of 8 files: run.log folds into logs.tgz when needed.
+[ "$(ls "$out" | wc -l)" -le 8 ] || rm -f "$out/run.log"
+log "done, status=$status"
+exit $status
