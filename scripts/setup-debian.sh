@@ -5,7 +5,7 @@
 # Do not install libvtk9-dev: it conflicts with python3-paraview.
 set -euo pipefail
 pkgs=(build-essential cmake ninja-build pkg-config libtbb-dev libpng-dev libgtest-dev googletest
-      paraview paraview-dev python3-paraview xvfb xauth
+      paraview paraview-dev python3-paraview python3-numpy xvfb xauth
       libopenmpi-dev openmpi-bin libdouble-conversion-dev liblz4-dev libglew-dev libutfcpp-dev libtiff-dev)
 missing=()
 for p in "${pkgs[@]}"; do
