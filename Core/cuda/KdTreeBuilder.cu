@@ -2,7 +2,7 @@
 // reduction per candidate child) and KdTreeGPUFast (ours: level-parallel over a 3-D SVT).
 // Both use decideKdSplit (KdTreeSplit.cuh), so they build the same tree.
 #include "KdTreeBuilder.cuh"
-#include "Morton.cuh"
+#include "spaceskip/Morton.h"
 
 #include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>

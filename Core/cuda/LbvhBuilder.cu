@@ -1,7 +1,7 @@
 // LBVH over occupied bricks (paper 3.1): compaction, Morton codes, radix sort, Karras 2012
 // hierarchy, bottom-up boxes; the result uses Core's flat node layout.
 #include "LbvhBuilder.cuh"
-#include "Morton.cuh"
+#include "spaceskip/Morton.h"
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_select.cuh>

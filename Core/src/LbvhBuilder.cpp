@@ -1,6 +1,8 @@
 // LBVH CPU twin: compaction, Morton codes, parallel sort, Karras 2012 hierarchy, bottom-up boxes.
 #include "spaceskip/LbvhBuilder.h"
 
+#include "spaceskip/Morton.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
@@ -15,34 +17,11 @@ namespace spaceskip {
 
 namespace {
 
-// Spreads the low 21 bits of v so that bit i lands at bit 3i.
-uint64_t spreadBits3(uint64_t v) {
-  v &= 0x1fffffull;
-  v = (v | v << 32) & 0x1f00000000ffffull;
-  v = (v | v << 16) & 0x1f0000ff0000ffull;
-  v = (v | v << 8) & 0x100f00f00f00f00full;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-  v = (v | v << 2) & 0x1249249249249249ull;
-  return v;
-}
-
-uint32_t compactBits3(uint64_t v) {
-  v &= 0x1249249249249249ull;
-  v = (v ^ (v >> 2)) & 0x10c30c30c30c30c3ull;
-  v = (v ^ (v >> 4)) & 0x100f00f00f00f00full;
-  v = (v ^ (v >> 8)) & 0x1f0000ff0000ffull;
-  v = (v ^ (v >> 16)) & 0x1f00000000ffffull;
-  v = (v ^ (v >> 32)) & 0x1fffffull;
-  return uint32_t(v);
-}
-
 int clz64(uint64_t v) { return v ? __builtin_clzll(v) : 64; }
 
 }  // namespace
 
-uint64_t mortonCode3(uint32_t x, uint32_t y, uint32_t z) {
-  return spreadBits3(x) | (spreadBits3(y) << 1) | (spreadBits3(z) << 2);
-}
+uint64_t mortonCode3(uint32_t x, uint32_t y, uint32_t z) { return mortonEncode3(x, y, z); }
 
 namespace detail {
 

@@ -1,10 +1,11 @@
-// 3-D Morton (z-order) codes of brick coordinates, 21 bits per axis (LBVH keys, KdTreeGPU order).
+// 3-D Morton (z-order) codes of brick coordinates, 21 bits per axis (LBVH keys on CPU and GPU,
+// KdTreeGPU order): one host/device definition for both twins.
 #pragma once
-#include "spaceskip/Macros.h"
+#include "Macros.h"
 
 #include <cstdint>
 
-namespace spaceskip::cuda {
+namespace spaceskip {
 
 /// Spreads the low 21 bits of v so that bit i moves to bit 3i.
 SS_FUNC uint64_t spreadBits3(uint64_t v) {
@@ -44,4 +45,4 @@ inline int bitsFor(int n) {
   return b;
 }
 
-}  // namespace spaceskip::cuda
+}  // namespace spaceskip
