@@ -50,19 +50,20 @@ Volume menger(vec3l dims) {
 
 // N-body-like: ONE fixed particle set (kNbodyParticles points in the unit cube, independent of
 // the resolution), laid out as a cosmic web and splatted into single voxels at any resolution.
-//  - 48 nodes (massive halos) uniform in [0.05, 0.95]^3, each joined to its 3 nearest nodes by a
+//  - 64 nodes (massive halos) uniform in [0.05, 0.95]^3, each joined to its 3 nearest nodes by a
 //    filament (a segment);
-//  - 4000 halos: the 48 nodes plus halos strewn along the filaments (length-weighted), masses from
-//    a Pareto law (exponent 1.9, capped), radius ~ mass^(1/3), a cuspy profile (r = R u^1.3);
-//  - 60% of the particles in halos (mass-weighted), 30% along the filaments (Gaussian tubes,
-//    sigma 0.006), 0.4% a uniform field (the voids are not quite empty), the rest in halos too.
+//  - 6000 halos: the 64 nodes plus halos strewn along the filaments (length-weighted), masses from
+//    a Pareto law (exponent 1.9, capped), radius ~ mass^(1/3), a cuspy profile (r = R u^1.5);
+//  - 70% of the particles in halos (mass-weighted), 30% along the filaments (Gaussian tubes,
+//    sigma 0.008); the voids are empty (a uniform field would stop every k-d split).
 // Every random number is a hash of (seed, particle, stream): deterministic per seed and independent
 // of the thread count. A voxel's value grows with the particles in it (64 for one, 255 when >= 9).
 // Calibrated so that the occupied 8^3 bricks approach the paper's LBVH node counts
-// (nodes = 2 bricks - 1): ~13% at 256^3, ~8% at 512^3, ~3% at 1024^3, ~1.1% at 2048^3; so, unlike
-// the old generator (0.15% of voxels at every size), voxel occupancy falls with resolution
-// (about 1% of voxels at 256^3, 0.004% at 2048^3). Small volumes (<= 128^3) are comparatively dense.
-constexpr int64_t kNbodyParticles = 327680;
+// (nodes = 2 bricks - 1; paper ~13.4% at 256^3, 8.0% at 512^3, 3.0% at 1024^3, 1.1% at 2048^3):
+// ours 13.0%, 6.9%, 3.6%, 1.1%. So, unlike the old generator (0.15% of voxels at every size), voxel
+// occupancy falls with resolution: 0.83% of voxels at 256^3, 0.14%, 0.019%, 0.0025% at 2048^3.
+// Small volumes (<= 128^3) receive all the particles too and are comparatively dense.
+constexpr int64_t kNbodyParticles = 229376;
 
 inline uint64_t splitmix(uint64_t z) {
   z += 0x9E3779B97F4A7C15ull;
@@ -100,8 +101,8 @@ struct CosmicWeb {
 };
 
 CosmicWeb makeWeb(uint64_t seed) {
-  constexpr int nodes = 48, halos = 4000;
-  constexpr double alpha = 1.9, r0 = 0.003, tube = 0.006, massCap = 3000, nodeMass = 3000;
+  constexpr int nodes = 64, halos = 6000;
+  constexpr double alpha = 1.9, r0 = 0.003, tube = 0.008, massCap = 3000, nodeMass = 3000;
   CosmicWeb w;
   w.node.resize(nodes);
   for (int i = 0; i < nodes; ++i)
@@ -149,7 +150,7 @@ CosmicWeb makeWeb(uint64_t seed) {
 
 /// Particle i of the fixed set, in [0,1)^3 (reflected at the faces).
 void nbodyParticle(const CosmicWeb& w, uint64_t seed, int64_t i, double* x) {
-  constexpr double field = 0.004, filament = 0.3, tube = 0.006, profile = 1.3;
+  constexpr double field = 0.0, filament = 0.3, tube = 0.008, profile = 1.5;
   const uint64_t n = uint64_t(i);
   const double u = urand(seed, n, 100);
   if (u < field) {

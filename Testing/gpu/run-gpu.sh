@@ -129,11 +129,11 @@ if has bench-large; then
   bench nbody2048 gen:nbody:2048 "naive,grid,lbvh,$kdfast,$hw,$cpucold,${BENCH_2048_KDGPU:-$kdcold}"
 fi
 if has bench-round2; then
-  # Round 2 (the resolution-independent N-body particle set): the GPU builders at 1024^3 and 2048^3,
+  # Round 2 (the resolution-independent N-body particle set): the GPU builders at 256^3..2048^3,
   # then naive at one-voxel steps (the paper does not state its step; ours defaults to half a voxel).
   kd1=${BENCH_ROUND2_KDGPU-kdtree-gpu:deep:mls32:cold}
   r2="naive,naive:hw,grid,grid:hw,lbvh,lbvh:hw,kdtree-gpu-fast:shallow,kdtree-gpu-fast:deep:mls32,kdtree-gpu-fast:deep:mls32:hw,kdtree-gpu-fast:deep:mls128,kdtree-gpu-fast:deep:mls128:hw"
-  bench r2-nbody1024 gen:nbody:1024 "$r2,kdtree-gpu:shallow,hybrid${kd1:+,$kd1}"
+  for n in 256 512 1024; do bench r2-nbody$n gen:nbody:$n "$r2,kdtree-gpu:shallow,hybrid${kd1:+,$kd1}"; done
   bench r2-nbody2048 gen:nbody:2048 "$r2,kdtree-gpu:shallow:cold,hybrid:cold${kd1:+,$kd1}"
   bench r2-nbody2048-step1 gen:nbody:2048 "naive,naive:hw,grid:hw,lbvh:hw" --sample-distance 1
 fi
