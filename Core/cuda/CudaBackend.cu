@@ -117,10 +117,15 @@ __global__ void toFloatKernel(const double* in, float* out, int64_t n) {
 class CudaBackend final : public Backend {
  public:
   CudaBackend() {
-    SS_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
-    SS_CUDA_CHECK(cudaEventCreate(&ev0_));
-    SS_CUDA_CHECK(cudaEventCreate(&ev1_));
-    SS_CUDA_CHECK(cudaMallocHost(&h_flags_, sizeof(Flags)));
+    try {
+      SS_CUDA_CHECK(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking));
+      SS_CUDA_CHECK(cudaEventCreate(&ev0_));
+      SS_CUDA_CHECK(cudaEventCreate(&ev1_));
+      SS_CUDA_CHECK(cudaMallocHost(&h_flags_, sizeof(Flags)));
+    } catch (...) {
+      releaseHandles();  // no destructor runs for a half-built object
+      throw;
+    }
     // Tuning knob for measurements: SPACESKIP_CUDA_BLOCK=WxH (threads per block, default 16x8).
     if (const char* b = std::getenv("SPACESKIP_CUDA_BLOCK")) {
       unsigned w = 0, h = 0;
@@ -132,10 +137,7 @@ class CudaBackend final : public Backend {
   }
   ~CudaBackend() override {
     destroyTexture();
-    if (h_flags_) cudaFreeHost(h_flags_);
-    if (ev0_) cudaEventDestroy(ev0_);
-    if (ev1_) cudaEventDestroy(ev1_);
-    if (stream_) cudaStreamDestroy(stream_);
+    releaseHandles();
   }
 
   BackendKind kind() const override { return BackendKind::CUDA; }
@@ -398,6 +400,7 @@ class CudaBackend final : public Backend {
 
   void ensureTexture() {
     if (tex_) return;
+    destroyTexture();  // an array left by an earlier attempt that failed after allocating it
     cudaChannelFormatDesc desc{};
     cudaTextureReadMode mode = cudaReadModeNormalizedFloat;
     const void* src = d_volume_.get();
@@ -428,7 +431,7 @@ class CudaBackend final : public Backend {
       }
     }
     const cudaExtent extent = make_cudaExtent(size_t(volume_.dims.x), size_t(volume_.dims.y), size_t(volume_.dims.z));
-    SS_CUDA_CHECK(cudaMalloc3DArray(&array_, &desc, extent));
+    SS_CUDA_CHECK(cuda::deviceMalloc3DArray(&array_, &desc, extent, arrayBytes_));
     cudaMemcpy3DParms copy{};
     copy.srcPtr = make_cudaPitchedPtr(const_cast<void*>(src), size_t(volume_.dims.x) * elem, size_t(volume_.dims.x),
                                       size_t(volume_.dims.y));
@@ -450,9 +453,20 @@ class CudaBackend final : public Backend {
 
   void destroyTexture() {
     if (tex_) cudaDestroyTextureObject(tex_);
-    if (array_) cudaFreeArray(array_);
+    cuda::deviceFreeArray(array_, arrayBytes_);
     tex_ = 0;
     array_ = nullptr;
+    arrayBytes_ = 0;
+  }
+
+  void releaseHandles() {
+    if (h_flags_) cudaFreeHost(h_flags_);
+    if (ev0_) cudaEventDestroy(ev0_);
+    if (ev1_) cudaEventDestroy(ev1_);
+    if (stream_) cudaStreamDestroy(stream_);
+    h_flags_ = nullptr;
+    ev0_ = ev1_ = nullptr;
+    stream_ = nullptr;
   }
 
   cudaStream_t stream_ = nullptr;
@@ -460,6 +474,7 @@ class CudaBackend final : public Backend {
   Volume volume_;
   DeviceBuffer<unsigned char> d_volume_;
   cudaArray_t array_ = nullptr;
+  size_t arrayBytes_ = 0;
   cudaTextureObject_t tex_ = 0;
   float texScale_ = 1.f;
   int brick_ = 8;
@@ -511,6 +526,8 @@ bool cudaAvailable(std::string* why) {
   if (why) why->clear();
   return true;
 }
+
+int64_t cudaDeviceBytesInUse() { return cuda::liveDeviceBytes().load(); }
 
 std::unique_ptr<Backend> makeCudaBackend() {
   std::string why;

@@ -6,7 +6,10 @@
 
 #include <cuda_runtime.h>
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
+#include <cstdlib>
 #include <string>
 #include <utility>
 
@@ -31,6 +34,61 @@ namespace spaceskip::cuda {
 /// kernel runs surface at the next synchronizing call, which is checked too).
 #define SS_CUDA_CHECK_LAUNCH(name) SS_CUDA_CHECK(cudaPeekAtLastError())
 
+/// Device bytes currently held by SpaceSkip's allocations (every device allocation goes through
+/// deviceMalloc/deviceMalloc3DArray; CUB's temporary storage too, via DeviceBuffer).
+inline std::atomic<int64_t>& liveDeviceBytes() {
+  static std::atomic<int64_t> bytes{0};
+  return bytes;
+}
+
+/// Testing aid: SPACESKIP_CUDA_MEMORY_LIMIT=<bytes> caps the device memory SpaceSkip may hold; an
+/// allocation that would exceed it fails with cudaErrorMemoryAllocation, exactly as a real
+/// out-of-memory does (so the "volume too large for the device" fallback can be tested on any
+/// GPU). Read at every allocation; unset, empty or unparsable means no cap.
+inline int64_t deviceMemoryLimit() {
+  const char* s = std::getenv("SPACESKIP_CUDA_MEMORY_LIMIT");
+  if (!s || !*s) return -1;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(s, &end, 10);
+  if (end == s || *end != '\0') return -1;
+  return v > uint64_t(INT64_MAX) ? INT64_MAX : int64_t(v);
+}
+
+inline bool overDeviceMemoryLimit(size_t bytes) {
+  const int64_t limit = deviceMemoryLimit();
+  return limit >= 0 && (bytes > uint64_t(limit) || liveDeviceBytes().load() + int64_t(bytes) > limit);
+}
+
+/// cudaMalloc, counted and capped by SPACESKIP_CUDA_MEMORY_LIMIT.
+inline cudaError_t deviceMalloc(void** p, size_t bytes) {
+  *p = nullptr;
+  if (overDeviceMemoryLimit(bytes)) return cudaErrorMemoryAllocation;
+  const cudaError_t e = cudaMalloc(p, bytes);
+  if (e == cudaSuccess) liveDeviceBytes() += int64_t(bytes);
+  return e;
+}
+inline void deviceFree(void* p, size_t bytes) {
+  if (!p) return;
+  cudaFree(p);  // no check: called from destructors
+  liveDeviceBytes() -= int64_t(bytes);
+}
+
+/// cudaMalloc3DArray, counted (width*height*depth elements of the channel size) and capped likewise.
+inline cudaError_t deviceMalloc3DArray(cudaArray_t* a, const cudaChannelFormatDesc* desc, cudaExtent e,
+                                       size_t& bytes) {
+  *a = nullptr;
+  bytes = e.width * e.height * e.depth * size_t((desc->x + desc->y + desc->z + desc->w) / 8);
+  if (overDeviceMemoryLimit(bytes)) return cudaErrorMemoryAllocation;
+  const cudaError_t r = cudaMalloc3DArray(a, desc, e);
+  if (r == cudaSuccess) liveDeviceBytes() += int64_t(bytes);
+  return r;
+}
+inline void deviceFreeArray(cudaArray_t a, size_t bytes) {
+  if (!a) return;
+  cudaFreeArray(a);
+  liveDeviceBytes() -= int64_t(bytes);
+}
+
 /// A plain cudaMalloc'd array (no managed memory); grows only, never shrinks.
 template <class T>
 class DeviceBuffer {
@@ -52,12 +110,12 @@ class DeviceBuffer {
     release();
     if (n == 0) return;
     void* p = nullptr;
-    SS_CUDA_CHECK(cudaMalloc(&p, n * sizeof(T)));
+    SS_CUDA_CHECK(deviceMalloc(&p, n * sizeof(T)));
     ptr_ = static_cast<T*>(p);
     cap_ = n;
   }
   void release() {
-    if (ptr_) cudaFree(ptr_);  // no check: called from destructors
+    deviceFree(ptr_, cap_ * sizeof(T));
     ptr_ = nullptr;
     cap_ = 0;
   }

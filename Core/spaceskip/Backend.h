@@ -35,5 +35,8 @@ std::unique_ptr<Backend> makeCpuBackend();
 std::unique_ptr<Backend> makeCudaBackend();
 /// True when this build has CUDA code and a device answers.
 bool cudaAvailable(std::string* why = nullptr);
+/// Device bytes held right now by all CUDA backends of this process (0 without CUDA). For tests:
+/// after a backend is destroyed, nothing it allocated may remain.
+int64_t cudaDeviceBytesInUse();
 
 }  // namespace spaceskip

@@ -117,6 +117,7 @@ bool cudaAvailable(std::string* why) {
   if (why) *why = "built without CUDA";
   return false;
 }
+int64_t cudaDeviceBytesInUse() { return 0; }
 #endif
 
 }  // namespace spaceskip

@@ -11,8 +11,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -426,7 +428,10 @@ TEST(CudaTrees, FastKdTreeEqualsPaperKdTree) {
   // differs: breadth-first vs depth-first), hence the same rendering speed.
   REQUIRE_CUDA();
   for (const char* shape : {"nbody", "menger", "vessels"}) {
-    Volume v = generateVolume(shape, vec3l{128, 128, 128}, 7);
+    // N-body at 256^3: its fixed particle set is dense at 128^3 (a first version of it gave
+    // one-node trees there on the GPU).
+    const int64_t n = std::string(shape) == "nbody" ? 256 : 128;
+    Volume v = generateVolume(shape, vec3l{n, n, n}, 7);
     TransferFunction tf = tfFor(v, shape == std::string("vessels") ? "coolwarm" : "ramp");
     for (auto [leaf, mls, bins] : {std::tuple{LeafCriterion::Shallow, 0, 4}, std::tuple{LeafCriterion::Deep, 0, 4},
                                     std::tuple{LeafCriterion::Deep, 32, 4}, std::tuple{LeafCriterion::Deep, 128, 4},
@@ -452,5 +457,95 @@ TEST(CudaTrees, FastKdTreeEqualsPaperKdTree) {
       // statistics show the same). N-body must split.
       if (std::string(shape) == "nbody") EXPECT_GT(a.tree.nodes.size(), 1u);
     }
+  }
+}
+
+namespace {
+
+/// Sets SPACESKIP_CUDA_MEMORY_LIMIT for one scope (the CUDA backend reads it at every allocation).
+struct DeviceMemoryLimit {
+  explicit DeviceMemoryLimit(long long bytes) { setenv("SPACESKIP_CUDA_MEMORY_LIMIT", std::to_string(bytes).c_str(), 1); }
+  ~DeviceMemoryLimit() { unsetenv("SPACESKIP_CUDA_MEMORY_LIMIT"); }
+};
+
+bool contains(const std::string& s, const char* what) { return s.find(what) != std::string::npos; }
+
+}  // namespace
+
+// "Volume too large for the device": an out-of-memory anywhere in the CUDA path (here forced by
+// SPACESKIP_CUDA_MEMORY_LIMIT, which fails allocations exactly like cudaErrorMemoryAllocation) must
+// give one clear log message, a CPU backend, the CPU image, and no device memory left behind.
+// Case "volume": the first device allocation (the volume upload in setVolume) fails. Case "render":
+// upload, classification and the LBVH build fit (update() stays on the device), the frame buffers
+// allocated inside render() do not. Limits come from the bytes measured in an unlimited run.
+TEST(CudaBackend, DeviceOutOfMemoryFallsBackToCpu) {
+  REQUIRE_CUDA();
+  Volume v = generateVolume("nbody", vec3l{64, 64, 64}, 4);
+  TransferFunction tf = tfFor(v, "ramp");
+  const BuildParams p = params(BuilderKind::LBVH);
+  const int size = 96;
+  double b[6];
+  v.worldBounds(b);
+  const Camera cam = orbitCamera(b, 30, 20, 1.0, false, 1.0);
+  Built cpu = run(v, tf, p, BackendKind::CPU, 30, 20, false, FilterMode::Exact, size);
+  ASSERT_GT(test::coverage(cpu.img), 0.001) << "test scene must not be empty";
+  ASSERT_EQ(cudaDeviceBytesInUse(), 0);
+
+  // Unlimited: the scene renders on the device; measure what each stage holds.
+  int64_t afterUpdate = 0, afterRender = 0;
+  {
+    Engine e(BackendKind::Auto, [](const std::string& m) { ADD_FAILURE() << "unexpected log: " << m; });
+    e.setVolume(v);
+    e.setTransferFunction(tf);
+    e.setBuildParams(p);
+    e.update();
+    afterUpdate = cudaDeviceBytesInUse();
+    Image img;
+    e.render(cam, size, size, img);
+    afterRender = cudaDeviceBytesInUse();
+    ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+    EXPECT_LE(compareImages(cpu.img, img).maxAbs, 2.f / 255.f);
+  }
+  EXPECT_EQ(cudaDeviceBytesInUse(), 0) << "device memory left after the CUDA backend was destroyed";
+  ASSERT_GE(afterUpdate, int64_t(v.byteSize()));
+  ASSERT_GT(afterRender, afterUpdate) << "render() allocates its frame buffer";
+
+  struct Case {
+    const char* name;
+    int64_t limit;
+    bool updateOnDevice;
+  };
+  for (const Case c : {Case{"volume", int64_t(v.byteSize()) - 1, false},
+                       Case{"render", afterUpdate + (afterRender - afterUpdate) / 2, true}}) {
+    SCOPED_TRACE(c.name);
+    std::vector<std::string> log;
+    Image img;
+    {
+      DeviceMemoryLimit limit(c.limit);
+      Engine e(BackendKind::Auto, [&](const std::string& m) { log.push_back(m); });
+      ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+      e.setVolume(v);
+      e.setTransferFunction(tf);
+      e.setBuildParams(p);
+      e.update();
+      EXPECT_EQ(e.backendKind(), c.updateOnDevice ? BackendKind::CUDA : BackendKind::CPU);
+      EXPECT_EQ(log.size(), c.updateOnDevice ? 0u : 1u);
+      ASSERT_NO_THROW(e.render(cam, size, size, img));
+      EXPECT_EQ(e.backendKind(), BackendKind::CPU);
+      EXPECT_EQ(e.frameStats().backend, "cpu");
+      EXPECT_EQ(cudaDeviceBytesInUse(), 0) << "the failed CUDA backend left device memory allocated";
+      // The engine keeps working on the CPU: a second frame logs nothing new.
+      Image again;
+      e.render(cam, size, size, again);
+      EXPECT_EQ(compareImages(img, again).maxAbs, 0.f);
+    }
+    ASSERT_EQ(log.size(), 1u) << "expected exactly one message, got " << log.size()
+                              << (log.empty() ? std::string() : ": first '" + log[0] + "'");
+    EXPECT_TRUE(contains(log[0], "out of memory")) << log[0];
+    EXPECT_TRUE(contains(log[0], "cudaErrorMemoryAllocation")) << log[0];
+    EXPECT_TRUE(contains(log[0], "falling back to the CPU backend")) << log[0];
+    ASSERT_EQ(img.width, size);
+    ASSERT_EQ(img.rgba.size(), cpu.img.rgba.size());
+    EXPECT_EQ(compareImages(cpu.img, img).maxAbs, 0.f) << "fallback image differs from the CPU image";
   }
 }

@@ -47,7 +47,7 @@ INSTANTIATE_TEST_SUITE_P(Volumes, GridEqualsNaive,
 TEST(Render, GridTakesFarFewerSamplesOnSparseData) {
   // Not a timing assertion (CI machines vary): skipping must take fewer samples for the same
   // image; the speed ratio itself is printed by `spaceskip bench`.
-  Volume v = generateVolume("nbody", vec3l{64, 64, 64});
+  Volume v = generateVolume("nbody", vec3l{256, 256, 256});
   auto tf = TransferFunction::preset("ramp", 0, 255);
   int64_t samples[2];
   Image img[2];
