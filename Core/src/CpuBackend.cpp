@@ -26,7 +26,7 @@ class CpuBackend final : public Backend {
   }
 
   bool classify(const TransferFunction& tf) override {
-    OccupancyGrid o = classify_(tf);
+    OccupancyGrid o = spaceskip::classify(ranges_, tf);
     bool changed = o.occ != occ_.occ || o.dims.x != occ_.dims.x || o.dims.y != occ_.dims.y ||
                    o.dims.z != occ_.dims.z;
     occ_ = std::move(o);
@@ -81,8 +81,6 @@ class CpuBackend final : public Backend {
   Tree tree() override { return tree_; }
 
  private:
-  OccupancyGrid classify_(const TransferFunction& tf) { return spaceskip::classify(ranges_, tf); }
-
   template <class T>
   void run(const FrameView& f, Image& out) {
     ArraySampler<T> s{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y, volume_.dims.z};

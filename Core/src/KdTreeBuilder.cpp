@@ -103,18 +103,26 @@ class KdTreeBuild {
 
   // Serial recursion (the reference, and the tail of every parallel task).
   void split(int index, int depth) {
-    box3i l, r;
-    const box3i node = pool_[size_t(index)].bricks;
-    if (!chooseSplit(node, l, r)) return;
-    if (depth + 1 >= kMaxTreeHeight) {
-      tooDeep_ = true;
-      return;
-    }
-    const int li = append(l), ri = append(r);
-    pool_[size_t(index)].left = li;
-    pool_[size_t(index)].right = ri;
+    int li, ri;
+    if (!splitNode(index, depth, li, ri)) return;
     split(li, depth + 1);
     split(ri, depth + 1);
+  }
+
+  // Splits node `index` if the cost function (or MLS) asks for it: appends both children and
+  // links them; false for a leaf (or when the height bound would be exceeded).
+  bool splitNode(int index, int depth, int& li, int& ri) {
+    box3i l, r;
+    if (!chooseSplit(pool_[size_t(index)].bricks, l, r)) return false;
+    if (depth + 1 >= kMaxTreeHeight) {
+      tooDeep_ = true;
+      return false;
+    }
+    li = append(l);
+    ri = append(r);
+    pool_[size_t(index)].left = li;
+    pool_[size_t(index)].right = ri;
+    return true;
   }
 
   // Task-parallel recursion above the cutoff.
@@ -124,15 +132,8 @@ class KdTreeBuild {
       split(index, depth);
       return;
     }
-    box3i l, r;
-    if (!chooseSplit(node, l, r)) return;
-    if (depth + 1 >= kMaxTreeHeight) {
-      tooDeep_ = true;
-      return;
-    }
-    const int li = append(l), ri = append(r);
-    pool_[size_t(index)].left = li;
-    pool_[size_t(index)].right = ri;
+    int li, ri;
+    if (!splitNode(index, depth, li, ri)) return;
     g.run([this, &g, li, depth] { split(g, li, depth + 1); });
     split(g, ri, depth + 1);
   }

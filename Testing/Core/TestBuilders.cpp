@@ -73,19 +73,7 @@ struct RefKd {
   int64_t rootVol = 0;
   Tree t;
 
-  box3i tight(const box3i& b) const {
-    box3i r{vec3i{1 << 30, 1 << 30, 1 << 30}, vec3i{-1, -1, -1}};
-    bool any = false;
-    for (int z = b.lo.z; z < b.hi.z; ++z)
-      for (int y = b.lo.y; y < b.hi.y; ++y)
-        for (int x = b.lo.x; x < b.hi.x; ++x)
-          if (g.at(x, y, z)) {
-            any = true;
-            r.lo = vec3i{std::min(r.lo.x, x), std::min(r.lo.y, y), std::min(r.lo.z, z)};
-            r.hi = vec3i{std::max(r.hi.x, x + 1), std::max(r.hi.y, y + 1), std::max(r.hi.z, z + 1)};
-          }
-    return any ? r : box3i{b.lo, b.lo};
-  }
+  box3i tight(const box3i& b) const { return test::bruteTightBox(g, b); }
   box3i cells(const box3i& b) const {
     const int B = g.brick;
     return box3i{vec3i{b.lo.x * B, b.lo.y * B, b.lo.z * B},

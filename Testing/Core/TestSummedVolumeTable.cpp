@@ -1,5 +1,6 @@
 // Summed volume table: counts and tight boxes against brute force on random occupancy grids.
 #include "spaceskip/SummedVolumeTable.h"
+#include "TreeInvariants.h"
 
 #include <gtest/gtest.h>
 
@@ -28,20 +29,6 @@ int64_t bruteCount(const OccupancyGrid& g, const box3i& b) {
   return c;
 }
 
-box3i bruteShrink(const OccupancyGrid& g, const box3i& b) {
-  box3i t{vec3i{1 << 30, 1 << 30, 1 << 30}, vec3i{-1, -1, -1}};
-  bool any = false;
-  for (int z = b.lo.z; z < b.hi.z; ++z)
-    for (int y = b.lo.y; y < b.hi.y; ++y)
-      for (int x = b.lo.x; x < b.hi.x; ++x)
-        if (g.at(x, y, z)) {
-          any = true;
-          t.lo = vec3i{std::min(t.lo.x, x), std::min(t.lo.y, y), std::min(t.lo.z, z)};
-          t.hi = vec3i{std::max(t.hi.x, x + 1), std::max(t.hi.y, y + 1), std::max(t.hi.z, z + 1)};
-        }
-  return any ? t : box3i{b.lo, b.lo};
-}
-
 box3i randomBox(vec3i d, std::mt19937& rng) {
   box3i b;
   for (int a = 0; a < 3; ++a) {
@@ -62,7 +49,7 @@ TEST(SummedVolumeTable, CountsAndShrinkMatchBruteForce) {
     for (int i = 0; i < 400; ++i) {
       box3i b = randomBox(g.dims, rng);
       ASSERT_EQ(svt.count(b), bruteCount(g, b)) << "p=" << p << " query " << i;
-      box3i s = svt.shrink(b), r = bruteShrink(g, b);
+      box3i s = svt.shrink(b), r = test::bruteTightBox(g, b);
       for (int a = 0; a < 3; ++a) {
         ASSERT_EQ(s.lo[a], r.lo[a]) << "p=" << p << " query " << i << " axis " << a;
         ASSERT_EQ(s.hi[a], r.hi[a]) << "p=" << p << " query " << i << " axis " << a;

@@ -11,6 +11,22 @@
 
 namespace spaceskip::test {
 
+/// Brute-force tight box (brick coordinates) of the occupied bricks inside `b`; empty at b.lo
+/// when none is occupied. The reference for the SVT's shrink and the reference k-d builder.
+inline box3i bruteTightBox(const OccupancyGrid& g, const box3i& b) {
+  box3i t{vec3i{1 << 30, 1 << 30, 1 << 30}, vec3i{-1, -1, -1}};
+  bool any = false;
+  for (int z = b.lo.z; z < b.hi.z; ++z)
+    for (int y = b.lo.y; y < b.hi.y; ++y)
+      for (int x = b.lo.x; x < b.hi.x; ++x)
+        if (g.at(x, y, z)) {
+          any = true;
+          t.lo = vec3i{std::min(t.lo.x, x), std::min(t.lo.y, y), std::min(t.lo.z, z)};
+          t.hi = vec3i{std::max(t.hi.x, x + 1), std::max(t.hi.y, y + 1), std::max(t.hi.z, z + 1)};
+        }
+  return any ? t : box3i{b.lo, b.lo};
+}
+
 inline bool contains(const box3i& outer, const box3i& inner) {
   for (int a = 0; a < 3; ++a)
     if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
