@@ -51,6 +51,7 @@ const char* kUsage = R"(usage:
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
   --builder B        naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu kdtree-gpu-fast hybrid
+                     distance-grid
   --leaf shallow|deep  --mls N  --bins N  --brick N
   --backend auto|cpu|cuda     --threads N (oneTBB worker limit)
   --tf PRESET|FILE   presets: ramp grayscale coolwarm band spike opaque zero

@@ -1,10 +1,12 @@
 // The CUDA backend: volume upload, range grid and classification kernels, GPU builders, and a
 // one-thread-per-pixel executor of Core's shared renderPixel (exact or hardware trilinear).
 #include "CudaCommon.cuh"
+#include "DistanceField.cuh"
 #include "KdTreeBuilder.cuh"
 #include "LbvhBuilder.cuh"
 #include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
+#include "spaceskip/DistanceField.h"
 
 #include <algorithm>
 #include <chrono>
@@ -134,6 +136,12 @@ class CudaBackend final : public Backend {
         blockY_ = h;
       }
     }
+    // Tuning knob for measurements: SPACESKIP_CUDA_CARVEOUT=0..100 (percent of the unified L1 /
+    // shared memory given to shared memory for the hardware-filtered kernel; 0 = largest L1).
+    if (const char* c = std::getenv("SPACESKIP_CUDA_CARVEOUT")) {
+      const int v = std::atoi(c);
+      if (v >= 0 && v <= 100) carveout_ = v;
+    }
   }
   ~CudaBackend() override {
     destroyTexture();
@@ -151,6 +159,7 @@ class CudaBackend final : public Backend {
     tree_ = cuda::DeviceTree{};
     hostTree_ = Tree{};
     traversal_ = TraversalKind::Naive;
+    d_distField_ = nullptr;
     haveOcc_ = false;
     const size_t bytes = v.byteSize();
     d_volume_.release();
@@ -239,6 +248,7 @@ class CudaBackend final : public Backend {
     tree_.leaves = 0;
     hostTree_ = Tree{};
     hybridGridValid_ = false;
+    d_distField_ = nullptr;
     s.builtOn = "cuda";
     const cuda::BrickGridView g{d_occ_[cur_].get(), bdims_, brick_, cellDims_, occupied_};
     cuda::KdParams kp;
@@ -248,6 +258,9 @@ class CudaBackend final : public Backend {
     switch (p.builder) {
       case BuilderKind::Naive:
       case BuilderKind::Grid: break;
+      case BuilderKind::DistanceGrid:
+        d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, kMaxSkipDistance, dist_, stream_);
+        break;
       case BuilderKind::LBVH: cuda::buildLbvh(g, lbvh_, tree_, stream_); break;
       case BuilderKind::KdTreeGPU: cuda::buildKdTreeGpu(g, kp, kdGpu_, tree_, stream_); break;
       case BuilderKind::KdTreeGPUFast: cuda::buildKdTreeGpuFast(g, kp, kdFast_, tree_, stream_); break;
@@ -284,7 +297,7 @@ class CudaBackend final : public Backend {
     if (traversal_ == TraversalKind::Hybrid && hybridGridValid_)
       f.grid = GridView{d_hybrid_.get(), hybridDims_, hybridBrick_};
     else
-      f.grid = GridView{d_occ_[cur_].get(), bdims_, brick_};
+      f.grid = GridView{d_occ_[cur_].get(), bdims_, brick_, d_distField_};
     f.tree = TreeView{tree_.nodes.get(), tree_.numNodes};
     f.tf = TransferFunctionView{d_table_.get(), tableSize_, tfLo_, tfScale_};
     f.depth = nullptr;
@@ -305,6 +318,9 @@ class CudaBackend final : public Backend {
     SS_CUDA_CHECK(cudaEventRecord(ev0_, stream_));
     if (filter == FilterMode::Hardware) {
       ensureTexture();
+      if (carveout_ >= 0)
+        SS_CUDA_CHECK(cudaFuncSetAttribute(renderKernel<TextureSampler>, cudaFuncAttributePreferredSharedMemoryCarveout,
+                                           carveout_));
       renderKernel<<<grid, block, 0, stream_>>>(f, TextureSampler{tex_, texScale_}, d_image_.get());
     } else {
       switch (volume_.type) {
@@ -502,11 +518,14 @@ class CudaBackend final : public Backend {
   vec3i hybridDims_{0, 0, 0};
   int hybridBrick_ = 16;
   bool hybridGridValid_ = false;
+  cuda::DistanceWorkspace dist_;
+  const uint8_t* d_distField_ = nullptr;  ///< DistanceGrid's field (in dist_) for the current occupancy
   DeviceBuffer<float> d_depth_;
   DeviceBuffer<unsigned> d_counts_;
   DeviceBuffer<vec4f> d_image_;
   double lastDeviceSeconds_ = -1;
   unsigned blockX_ = 16, blockY_ = 8;
+  int carveout_ = -1;  ///< -1: the driver's choice
 };
 
 }  // namespace

@@ -25,14 +25,16 @@ enum class BuilderKind : int {
   KdTreeCPU,      ///< paper 3.2.1 (Vidal et al. 2008), oneTBB
   KdTreeGPU,      ///< paper 3.2.2, CUDA, host-driven recursion
   KdTreeGPUFast,  ///< ours: level-parallel CUDA k-d tree
-  Hybrid          ///< paper 3.3: shallow k-d tree + 16^3 grid
+  Hybrid,         ///< paper 3.3: shallow k-d tree + 16^3 grid
+  DistanceGrid    ///< ours: the Grid DDA leaping through empty space with a distance field
 };
 enum class LeafCriterion : int { Shallow, Deep };
 enum class BackendKind : int { Auto, CPU, CUDA };
 enum class FilterMode : int { Exact, Hardware };
 
 const char* builderName(BuilderKind b);
-/// Accepts CLI names (naive, grid, lbvh, lbvh-cpu, kdtree-cpu, kdtree-gpu, kdtree-gpu-fast, hybrid)
+/// Accepts CLI names (naive, grid, lbvh, lbvh-cpu, kdtree-cpu, kdtree-gpu, kdtree-gpu-fast, hybrid,
+/// distance-grid)
 /// and the VTK property names (Naive, Grid, LBVH, KdTreeCPU, ...), case-insensitively.
 bool parseBuilder(const std::string& s, BuilderKind& out);
 

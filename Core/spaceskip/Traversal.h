@@ -10,6 +10,9 @@ struct GridView {
   const uint8_t* occ;
   vec3i dims;  ///< bricks per axis
   int brick;   ///< cells per brick edge
+  /// Optional (DistanceGrid): per brick 0 when occupied, else the Chebyshev distance in bricks
+  /// to the nearest occupied brick (DistanceField.h). When set, `occ` is not read.
+  const uint8_t* dist = nullptr;
 };
 
 struct TreeView {
@@ -18,7 +21,9 @@ struct TreeView {
 };
 
 /// 3-D DDA (Amanatides & Woo 1987) over the bricks of `g`, restricted to t in [tmin, tmax).
-/// Consecutive occupied bricks are merged into one interval.
+/// Consecutive occupied bricks are merged into one interval. With a distance field, an empty
+/// brick at distance d >= 2 is left together with the (2d-1)^3 empty bricks around it: the ray
+/// jumps to where it exits that cube (proximity clouds), then the DDA restarts there.
 template <class Visit>
 SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin, float tmax,
                           Visit& visit) {
@@ -50,9 +55,9 @@ SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin
   float runStart = -1.f;
   bool inRun = false;
   while (t < tmax) {
-    int axis = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
-    float tExit = ss_min(tNext[axis], tmax);
-    bool occ = g.occ[cell[0] + int64_t(g.dims.x) * (cell[1] + int64_t(g.dims.y) * cell[2])] != 0;
+    const int64_t idx = cell[0] + int64_t(g.dims.x) * (cell[1] + int64_t(g.dims.y) * cell[2]);
+    const int dist = g.dist ? int(g.dist[idx]) : (g.occ[idx] != 0 ? 0 : 1);
+    const bool occ = dist == 0;
     if (occ && !inRun) {
       runStart = t;
       inRun = true;
@@ -60,6 +65,40 @@ SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin
       if (!visit(runStart, t)) return false;
       inRun = false;
     }
+    if (dist >= 2) {
+      // Leave the empty cube [cell - (dist-1), cell + (dist-1)] through its nearest exit face.
+      const int rad = dist - 1;
+      float tJump = INFINITY;
+      int ja = 0;
+      for (int a = 0; a < 3; ++a) {
+        if (step[a] == 0) continue;
+        const float plane = step[a] > 0 ? float(cell[a] + rad + 1) * B : float(cell[a] - rad) * B;
+        const float ta = (plane - r.org[a]) * inv[a];
+        if (ta < tJump) {
+          tJump = ta;
+          ja = a;
+        }
+      }
+      if (!(tJump < tmax)) return true;  // the rest of the ray is empty
+      const vec3f q = r.org + r.dir * tJump;
+      for (int a = 0; a < 3; ++a) {
+        int c;
+        if (a == ja) {
+          c = cell[a] + step[a] * (rad + 1);
+        } else {  // still inside the cube's slab on this axis (clamped against rounding)
+          c = int(floorf(q[a] / B));
+          c = ss_maxi(ss_maxi(cell[a] - rad, 0), ss_mini(c, ss_mini(cell[a] + rad, g.dims[a] - 1)));
+        }
+        if (c < 0 || c >= g.dims[a]) return true;  // left the grid
+        cell[a] = c;
+        if (step[a] > 0) tNext[a] = (float(c + 1) * B - r.org[a]) * inv[a];
+        else if (step[a] < 0) tNext[a] = (float(c) * B - r.org[a]) * inv[a];
+      }
+      t = ss_max(t, tJump);
+      continue;
+    }
+    int axis = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
+    float tExit = ss_max(t, ss_min(tNext[axis], tmax));
     t = tExit;
     cell[axis] += step[axis];
     tNext[axis] += tDelta[axis];

@@ -16,7 +16,8 @@ namespace spaceskip {
 TraversalKind traversalFor(BuilderKind b) {
   switch (b) {
     case BuilderKind::Naive: return TraversalKind::Naive;
-    case BuilderKind::Grid: return TraversalKind::Grid;
+    case BuilderKind::Grid:
+    case BuilderKind::DistanceGrid: return TraversalKind::Grid;
     case BuilderKind::Hybrid: return TraversalKind::Hybrid;
     default: return TraversalKind::Tree;
   }

@@ -1,6 +1,7 @@
 // The oneTBB backend: tiles of pixels run the shared per-ray integrator.
 #include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
+#include "spaceskip/DistanceField.h"
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -21,6 +22,7 @@ class CpuBackend final : public Backend {
   void setVolume(const Volume& v, int brick) override {
     volume_ = v;
     ranges_ = computeRangeGrid(v, brick);
+    dist_.clear();
     occ_ = OccupancyGrid{};
     tree_ = Tree{};
   }
@@ -44,6 +46,8 @@ class CpuBackend final : public Backend {
     traversal_ = traversalFor(p.builder);
     tree_ = Tree{};
     hybridGrid_ = OccupancyGrid{};
+    dist_.clear();
+    if (p.builder == BuilderKind::DistanceGrid) dist_ = computeDistanceField(occ_);
     if (traversal_ == TraversalKind::Tree || traversal_ == TraversalKind::Hybrid) {
       BuildParams q = p;
       if (p.builder == BuilderKind::LBVH) q.builder = BuilderKind::LBVHCPU;
@@ -61,7 +65,7 @@ class CpuBackend final : public Backend {
     f.depth = depth;
     f.traversal = traversal_;
     const OccupancyGrid& g = traversal_ == TraversalKind::Hybrid ? hybridGrid_ : occ_;
-    f.grid = GridView{g.occ.data(), g.dims, g.brick};
+    f.grid = GridView{g.occ.data(), g.dims, g.brick, dist_.empty() ? nullptr : dist_.data()};
     f.tree = TreeView{tree_.nodes.data(), int(tree_.nodes.size())};
     f.tf = TransferFunctionView{table_.data(), int(table_.size()), tfLo_, tfScale_};
     out.width = f.width;
@@ -97,6 +101,7 @@ class CpuBackend final : public Backend {
   RangeGrid ranges_;
   OccupancyGrid occ_;
   OccupancyGrid hybridGrid_;
+  std::vector<uint8_t> dist_;  ///< DistanceGrid's field over occ_
   Tree tree_;
   TraversalKind traversal_ = TraversalKind::Naive;
   std::vector<vec4f> table_;

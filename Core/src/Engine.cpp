@@ -28,6 +28,7 @@ constexpr BuilderName kBuilders[] = {
     {BuilderKind::KdTreeGPU, "KdTreeGPU", "kdtree-gpu"},
     {BuilderKind::KdTreeGPUFast, "KdTreeGPUFast", "kdtree-gpu-fast"},
     {BuilderKind::Hybrid, "Hybrid", "hybrid"},
+    {BuilderKind::DistanceGrid, "DistanceGrid", "distance-grid"},
 };
 
 std::string lower(std::string s) {

@@ -317,6 +317,7 @@ TEST_P(CudaImage, EqualsCpuForEveryBuilder) {
   const std::vector<BuildParams> builders = {
       params(BuilderKind::Naive),
       params(BuilderKind::Grid),
+      params(BuilderKind::DistanceGrid),
       params(BuilderKind::LBVH),
       params(BuilderKind::KdTreeGPU, LeafCriterion::Shallow),
       params(BuilderKind::KdTreeGPU, LeafCriterion::Deep, 32),

@@ -36,6 +36,8 @@ TEST_P(GridEqualsNaive, SeveralCameras) {
   for (auto& cam : cams) {
     expectSame(v, tf, BuilderKind::Grid, cam[0], cam[1], false);
     expectSame(v, tf, BuilderKind::Grid, cam[0], cam[1], true);
+    expectSame(v, tf, BuilderKind::DistanceGrid, cam[0], cam[1], false);
+    expectSame(v, tf, BuilderKind::DistanceGrid, cam[0], cam[1], true);
   }
 }
 

@@ -3,7 +3,7 @@
 # on the CUDA tests, and the benchmarks; writes everything into OUTDIR (see DEVICE.md).
 #
 #   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
-#   PHASE: build test sanitize bench-small bench-large bench-round2 blocks ncu
+#   PHASE: build test sanitize bench-small bench-large bench-round2 bench-round3 profile2048 blocks ncu
 #          (default: build test sanitize bench-small)
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
 #          when present), BENCH_FRAMES (8), SANITIZE_FILTER (gtest filter for the sanitizer runs),
@@ -136,6 +136,39 @@ if has bench-round2; then
   for n in 256 512 1024; do bench r2-nbody$n gen:nbody:$n "$r2,kdtree-gpu:shallow,hybrid${kd1:+,$kd1}"; done
   bench r2-nbody2048 gen:nbody:2048 "$r2,kdtree-gpu:shallow:cold,hybrid:cold${kd1:+,$kd1}"
   bench r2-nbody2048-step1 gen:nbody:2048 "naive,naive:hw,grid:hw,lbvh:hw" --sample-distance 1
+fi
+if has bench-round3; then
+  # Round 3: DistanceGrid (the grid DDA leaping with a distance field) beside the best builders
+  # of round 2, 256^3..2048^3 N-body and the 1024^3 Menger sponge; then one-voxel steps at 2048^3.
+  r3="naive:hw,grid,grid:hw,distance-grid,distance-grid:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw"
+  for n in 256 512 1024 2048; do bench r3-nbody$n gen:nbody:$n "$r3"; done
+  bench r3-menger1024 gen:menger:1024 "$r3"
+  bench r3-nbody2048-step1 gen:nbody:2048 "naive:hw,grid:hw,distance-grid:hw,lbvh:hw" --sample-distance 1
+fi
+if has profile2048; then
+  # Why naive:hw does half the samples/s at 2048^3 that it does at 1024^3: launch shape and
+  # L1/shared carveout sweeps on one generated file, then Nsight Compute sections.
+  vol=$work/nbody_2048x2048x2048_uint8.raw
+  [ -f "$vol" ] || "$cli" generate nbody --dims 2048 2048 2048 -o "$vol" > "$work/generate.log" 2>&1
+  for bs in ${PROFILE_BLOCKS:-16x8 8x8 32x4 8x4 32x2 16x16}; do
+    SPACESKIP_CUDA_BLOCK=$bs bench "p2048-block$bs" "$vol" "naive:hw,distance-grid:hw"
+  done
+  for co in ${PROFILE_CARVEOUTS:-0 100}; do
+    SPACESKIP_CUDA_CARVEOUT=$co bench "p2048-carveout$co" "$vol" "naive:hw"
+  done
+  sections="--section SpeedOfLight --section MemoryWorkloadAnalysis --section MemoryWorkloadAnalysis_Chart --section Occupancy --section WarpStateStats --section SchedulerStats --section LaunchStats"
+  for spec in "naive:$vol" "distance-grid:$vol" "naive:gen:nbody:1024"; do
+    b=${spec%%:*}
+    v=${spec#*:}
+    log "ncu $b $v"
+    timeout 240 ncu --kernel-name regex:renderKernel --launch-count 1 $sections \
+      "$cli" render "$v" --backend cuda --builder "$b" --filter hardware --size 1024x1024 --camera 30,20 \
+      -o "$work/ncu.png" > "$work/ncu-$b-$(basename "$v" | tr ':' '_').log" 2>&1
+    log "ncu rc=$?"
+    cat "$work/ncu-$b-$(basename "$v" | tr ':' '_').log" >> "$work/ncu.log"
+  done
+  cp "$work/ncu.log" "$out/ncu.log" 2>/dev/null
+  rm -f "$vol"
 fi
 if has blocks; then
   # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK), recorded for the notes.
