@@ -103,11 +103,43 @@ struct TextureSampler {
 };
 
 // Launch shape: 2-D grid of 16x8 blocks (SPACESKIP_CUDA_BLOCK overrides), one thread per pixel.
+// One kernel per traversal: a kernel holding every traversal is allocated the registers of the
+// tree traversal (64 per thread, half occupancy), which the naive and grid marches do not need.
+// Hardware-filtered kernels are asked to fit 6 blocks of 256 threads per SM (<= 40 registers):
+// their marches are latency bound on texture fetches, and more warps in flight hide it.
+// The exact samplers need more registers than that without spilling; they get the default.
+constexpr int kMaxRenderThreads = 256;
 template <class Sampler>
-__global__ void renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out) {
+struct RenderMinBlocks {
+  static constexpr int value = 1;
+};
+#ifndef SPACESKIP_CUDA_HW_MIN_BLOCKS
+#define SPACESKIP_CUDA_HW_MIN_BLOCKS 6  // CMake: SPACESKIP_CUDA_HW_MIN_BLOCKS (1 = no register cap)
+#endif
+template <>
+struct RenderMinBlocks<TextureSampler> {
+  static constexpr int value = SPACESKIP_CUDA_HW_MIN_BLOCKS;
+};
+
+template <class Sampler, int Traversal>
+__global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::value) renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= f.width || y >= f.height) return;
-  out[int64_t(y) * f.width + x] = renderPixel(f, s, x, y);
+  out[int64_t(y) * f.width + x] = renderPixel<Sampler, Traversal>(f, s, x, y);
+}
+
+template <class Sampler>
+using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*);
+
+template <class Sampler>
+RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
+  switch (t) {
+    case TraversalKind::Naive: return renderKernel<Sampler, int(TraversalKind::Naive)>;
+    case TraversalKind::Grid: return renderKernel<Sampler, int(TraversalKind::Grid)>;
+    case TraversalKind::Tree: return renderKernel<Sampler, int(TraversalKind::Tree)>;
+    case TraversalKind::Hybrid: return renderKernel<Sampler, int(TraversalKind::Hybrid)>;
+  }
+  return renderKernel<Sampler, int(TraversalKind::Naive)>;
 }
 
 // One thread per voxel: double -> float (textures have no double channel).
@@ -128,16 +160,16 @@ class CudaBackend final : public Backend {
       releaseHandles();  // no destructor runs for a half-built object
       throw;
     }
-    // Tuning knob for measurements: SPACESKIP_CUDA_BLOCK=WxH (threads per block, default 16x8).
+    // Tuning knob for measurements: SPACESKIP_CUDA_BLOCK=WxH (threads per block, default 16x8, at most 256).
     if (const char* b = std::getenv("SPACESKIP_CUDA_BLOCK")) {
       unsigned w = 0, h = 0;
-      if (std::sscanf(b, "%ux%u", &w, &h) == 2 && w * h >= 32 && w * h <= 1024) {
+      if (std::sscanf(b, "%ux%u", &w, &h) == 2 && w * h >= 32 && w * h <= unsigned(kMaxRenderThreads)) {
         blockX_ = w;
         blockY_ = h;
       }
     }
     // Tuning knob for measurements: SPACESKIP_CUDA_CARVEOUT=0..100 (percent of the unified L1 /
-    // shared memory given to shared memory for the hardware-filtered kernel; 0 = largest L1).
+    // shared memory given to shared memory for the render kernels; 0 = largest L1).
     if (const char* c = std::getenv("SPACESKIP_CUDA_CARVEOUT")) {
       const int v = std::atoi(c);
       if (v >= 0 && v <= 100) carveout_ = v;
@@ -318,10 +350,7 @@ class CudaBackend final : public Backend {
     SS_CUDA_CHECK(cudaEventRecord(ev0_, stream_));
     if (filter == FilterMode::Hardware) {
       ensureTexture();
-      if (carveout_ >= 0)
-        SS_CUDA_CHECK(cudaFuncSetAttribute(renderKernel<TextureSampler>, cudaFuncAttributePreferredSharedMemoryCarveout,
-                                           carveout_));
-      renderKernel<<<grid, block, 0, stream_>>>(f, TextureSampler{tex_, texScale_}, d_image_.get());
+      launchRender(f, TextureSampler{tex_, texScale_}, grid, block);
     } else {
       switch (volume_.type) {
         case VoxelType::UInt8: launch<uint8_t>(f, grid, block); break;
@@ -401,7 +430,15 @@ class CudaBackend final : public Backend {
   void launch(const FrameView& f, dim3 grid, dim3 block) {
     ArraySampler<T> s{static_cast<const T*>(static_cast<const void*>(d_volume_.get())), volume_.dims.x,
                       volume_.dims.y, volume_.dims.z};
-    renderKernel<<<grid, block, 0, stream_>>>(f, s, d_image_.get());
+    launchRender(f, s, grid, block);
+  }
+
+  template <class Sampler>
+  void launchRender(const FrameView& f, const Sampler& s, dim3 grid, dim3 block) {
+    RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f.traversal);
+    if (carveout_ >= 0)
+      SS_CUDA_CHECK(cudaFuncSetAttribute(k, cudaFuncAttributePreferredSharedMemoryCarveout, carveout_));
+    k<<<grid, block, 0, stream_>>>(f, s, d_image_.get());
   }
 
   void uploadTree(const Tree& t) {

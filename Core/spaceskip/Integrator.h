@@ -132,7 +132,9 @@ struct TreeLeaf {
 };
 
 /// Premultiplied RGBA of pixel (px, py); row 0 is the bottom row (OpenGL convention).
-template <class Sampler>
+/// `Traversal` >= 0 fixes the traversal at compile time (the CUDA kernels, one per traversal);
+/// -1 reads f.traversal.
+template <class Sampler, int Traversal = -1>
 SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) {
   const float nx = (float(px) + 0.5f) / float(f.width) * 2.f - 1.f;
   const float ny = (float(py) + 0.5f) / float(f.height) * 2.f - 1.f;
@@ -162,7 +164,7 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
 
   IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u};
   if (f.jitter) m.t0 += f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f);
-  switch (f.traversal) {
+  switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
     case TraversalKind::Naive: m(tEnter, tExit); break;
     case TraversalKind::Grid: traverseGrid(f.grid, r, inv, tEnter, tExit, m); break;
     case TraversalKind::Tree: {
