@@ -3,8 +3,9 @@
 # on the CUDA tests, and the benchmarks; writes everything into OUTDIR (see DEVICE.md).
 #
 #   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
-#   PHASE: build test sanitize bench-small bench-large bench-round2 blocks ncu
+#   PHASE: build test sanitize bench-small bench-large bench-round2 bench-sweep blocks ncu
 #          (default: build test sanitize bench-small)
+#          bench-sweep: KdTreeCPU vs KdTreeGPUFast with bins 0 (the same trees) at 256^3..2048^3
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
 #          when present), BENCH_FRAMES (8), SANITIZE_FILTER (gtest filter for the sanitizer runs),
 #          SANITIZE_TOOLS ("memcheck racecheck"), SANITIZE_TIMEOUT (240 s per tool), SANITIZE_DEADLINE
@@ -136,6 +137,17 @@ if has bench-round2; then
   for n in 256 512 1024; do bench r2-nbody$n gen:nbody:$n "$r2,kdtree-gpu:shallow,hybrid${kd1:+,$kd1}"; done
   bench r2-nbody2048 gen:nbody:2048 "$r2,kdtree-gpu:shallow:cold,hybrid:cold${kd1:+,$kd1}"
   bench r2-nbody2048-step1 gen:nbody:2048 "naive,naive:hw,grid:hw,lbvh:hw" --sample-distance 1
+fi
+if has bench-sweep; then
+  # "Same parameters, fps within 5%": bins 0 makes KdTreeGPUFast sweep every brick boundary like
+  # KdTreeCPU, so each kdtree-cpu item and its kdtree-gpu-fast:...:bins0 twin render the same tree
+  # (same nodes/height/leaves in the CSV); their fps must agree. Results go to the usual
+  # bench.log/bench.csv/bench.json (no new files in OUTDIR).
+  sw="kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128"
+  sw="$sw,kdtree-gpu-fast:shallow:bins0,kdtree-gpu-fast:deep:mls32:bins0,kdtree-gpu-fast:deep:mls128:bins0"
+  sw="$sw,kdtree-cpu:deep:mls32:hw,kdtree-gpu-fast:deep:mls32:bins0:hw"
+  for n in 256 512 1024 2048; do bench sweep-nbody$n gen:nbody:$n "$sw"; done
+  bench sweep-menger1024 gen:menger:1024 "$sw"
 fi
 if has blocks; then
   # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK), recorded for the notes.
