@@ -675,6 +675,18 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::SetBinCount(int bins)
+{
+  // 0 is the sweep; 1 (no candidate plane) would make the engine throw, so it clamps to 2.
+  const int v = bins <= 0 ? 0 : std::min(std::max(bins, 2), 64);
+  if (v != this->BinCount)
+  {
+    this->BinCount = v;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);

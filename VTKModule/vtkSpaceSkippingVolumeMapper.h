@@ -98,9 +98,12 @@ public:
 
   ///@{
   /**
-   * Bins of the k-d tree split search (KdTreeGPU/KdTreeGPUFast), 2..64, default 4.
+   * Bins of the k-d tree split search (KdTreeGPU/KdTreeGPUFast), default 4: 2..64 tries
+   * bins - 1 planes per node (the paper's binned method); 0 sweeps every macro-cell boundary
+   * along the node's longest axis, which builds exactly the KdTreeCPU tree (KdTreeCPU always
+   * sweeps and ignores this value). Negative values set 0, 1 sets 2, above 64 sets 64.
    */
-  vtkSetClampMacro(BinCount, int, 2, 64);
+  virtual void SetBinCount(int bins);
   vtkGetMacro(BinCount, int);
   ///@}
 

@@ -45,6 +45,7 @@ const char* kUsage = R"(usage:
   spaceskip bench VOLUME... [--builders b1,b2,...] [--frames N] [--json FILE] [--csv FILE] [options]
       each builder may carry suffixes overriding --leaf/--mls/--bins/--brick, e.g.
       --builders naive,grid,lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid
+      or kdtree-gpu-fast:deep:mls32:bins0 (the sweep: the kdtree-cpu:deep:mls32 tree)
       --build-reps N: report the fastest of N rebuilds (default 1)
       bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only)
 
@@ -53,6 +54,8 @@ options:
   --builder B        naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu kdtree-gpu-fast hybrid
                      distance-grid
   --leaf shallow|deep  --mls N  --bins N  --brick N
+      --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;
+      0 sweeps every brick boundary, the kdtree-cpu tree (kdtree-cpu always sweeps)
   --backend auto|cpu|cuda     --threads N (oneTBB worker limit)
   --tf PRESET|FILE   presets: ramp grayscale coolwarm band spike opaque zero
   --size WxH         (render default 512x512, bench default 1024x1024)
@@ -165,7 +168,10 @@ BuildParams buildParams(const Options& o, const std::string& spec) {
     else if (it.rfind("brick", 0) == 0) p.brick = suffixNumber(it, "brick", spec);
     else throw std::invalid_argument("unknown builder suffix '" + it + "' in '" + spec + "' (shallow deep mlsN binsN brickN)");
   }
-  if (p.maxLeafSize < 0 || p.bins < 2 || p.brick < 1) throw std::invalid_argument("bad --mls/--bins/--brick");
+  if (p.bins < 0 || p.bins == 1)
+    throw std::invalid_argument("bad bins " + std::to_string(p.bins) + " in '" + spec +
+                                "': 0 (sweep every brick boundary) or >= 2");
+  if (p.maxLeafSize < 0 || p.brick < 1) throw std::invalid_argument("bad --mls/--brick");
   return p;
 }
 

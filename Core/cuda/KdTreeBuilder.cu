@@ -9,6 +9,8 @@
 #include <thrust/iterator/transform_iterator.h>
 
 #include <climits>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace spaceskip::cuda {
@@ -227,6 +229,57 @@ __global__ void levelDecideKernel(const box3i* boxes, int n, int levelStart, KdS
   childBoxes[2 * i + 1] = d.right;
 }
 
+// Sweep (bins == 0): up to bricks/step - 1 candidates per node (255 for a 2048^3 root with 8^3
+// bricks), so one warp per node of the level. Lane j evaluates candidates j+1, j+33, ... in
+// increasing order, keeping its first minimum; the warp then reduces (cost, k) to the least cost
+// and, among equal costs, the least k: decideKdSplit's serial rule (first minimum in plane order).
+// Lane 0 recomputes the winner's children (two tight boxes) or takes the MLS split.
+__global__ void levelDecideSweepKernel(const box3i* boxes, int n, int levelStart, KdSplitParams p, SvtView svt,
+                                       Node* nodes, int* flags, box3i* childBoxes) {
+  const int64_t i = (int64_t(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
+  const int lane = threadIdx.x & 31;
+  if (i >= n) return;  // whole warps leave together (blockDim is a multiple of 32)
+  const box3i box = boxes[i];
+  const int axis = longestAxis(box);
+  int64_t best = INT64_MAX;
+  int bestK = INT_MAX;
+  if (!kdHalts(box, p)) {
+    const int count = kdCandidateCount(box, axis, p);
+    for (int k = lane + 1; k <= count; k += 32) {
+      box3i l, r;
+      const int64_t c = kdPlaneCost(box, axis, kdCandidatePlane(box, axis, k, p), svt, l, r);
+      if (c < best) {
+        best = c;
+        bestK = k;
+      }
+    }
+  }
+  for (int o = 16; o > 0; o /= 2) {
+    const int64_t ob = __shfl_down_sync(0xffffffffu, best, o);
+    const int ok = __shfl_down_sync(0xffffffffu, bestK, o);
+    if (ob < best || (ob == best && ok < bestK)) {
+      best = ob;
+      bestK = ok;
+    }
+  }
+  if (lane != 0) return;
+  KdDecision d;
+  if (best != INT64_MAX) {
+    d.split = 1;
+    kdPlaneCost(box, axis, kdCandidatePlane(box, axis, bestK, p), svt, d.left, d.right);
+  } else {
+    d = kdMlsSplit(box, axis, p, svt);
+  }
+  Node node;
+  node.box = box;
+  node.child = -1;
+  node.pad = 0;
+  nodes[levelStart + i] = node;
+  flags[i] = d.split;
+  childBoxes[2 * i] = d.left;
+  childBoxes[2 * i + 1] = d.right;
+}
+
 // One thread per node of the level: links split nodes to their child pair in the next level.
 __global__ void levelEmitKernel(int n, int levelStart, const int* flags, const int* offsets,
                                 const box3i* childBoxes, Node* nodes, box3i* nextBoxes, int* nextSplits) {
@@ -245,7 +298,9 @@ KdSplitParams splitParams(const KdParams& p, int brick, int64_t rootVol) {
   KdSplitParams s;
   s.deep = p.leaf == LeafCriterion::Deep ? 1 : 0;
   s.mls = p.maxLeafSize;
-  s.bins = p.bins < 2 ? 2 : p.bins;
+  if (p.bins < 0 || p.bins == 1)
+    throw std::invalid_argument("k-d tree: bins must be 0 (sweep) or >= 2, got " + std::to_string(p.bins));
+  s.bins = p.bins;
   s.brick = brick;
   s.rootVol = rootVol;
   return s;
@@ -378,9 +433,15 @@ void buildKdTreeGpuFast(const BrickGridView& g, const KdParams& p, KdTreeGpuFast
   while (n > 0) {
     if (size_t(levelStart) + size_t(n) > maxNodes)
       throw BackendError("KdTreeGPUFast: node count exceeded its bound (internal error)");
-    levelDecideKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(
-        ws.levelBoxes[cur].get(), n, levelStart, sp, svt, out.nodes.get(), ws.splitFlags.get(), ws.childBoxes.get());
-    SS_CUDA_CHECK_LAUNCH(levelDecideKernel);
+    if (sp.bins == 0) {
+      levelDecideSweepKernel<<<blocksFor(int64_t(n) * 32, kThreads), kThreads, 0, stream>>>(
+          ws.levelBoxes[cur].get(), n, levelStart, sp, svt, out.nodes.get(), ws.splitFlags.get(), ws.childBoxes.get());
+      SS_CUDA_CHECK_LAUNCH(levelDecideSweepKernel);
+    } else {
+      levelDecideKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(
+          ws.levelBoxes[cur].get(), n, levelStart, sp, svt, out.nodes.get(), ws.splitFlags.get(), ws.childBoxes.get());
+      SS_CUDA_CHECK_LAUNCH(levelDecideKernel);
+    }
     size_t bytes = scanBytes;
     SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp, bytes, ws.splitFlags.get(), ws.splitOffsets.get(), n, stream));
     levelEmitKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(

@@ -3,6 +3,10 @@
 //    candidate child over the region's Morton range, recursion driven by the host.
 //  - KdTreeGPUFast (ours): breadth-first, one kernel pass per level for all nodes, tight boxes
 //    and counts from a 3-D summed volume table over the bricks.
+// bins == 0 (the sweep) builds KdTreeCPU's tree: every brick boundary is a candidate. KdTreeGPUFast
+// evaluates a node's candidates with one warp; KdTreeGPU runs them one by one on the host (two
+// reductions and two synchronizations per candidate, up to 255 candidates per node at 2048^3), so
+// it accepts bins 0 but is slow with it: it is there for tests, not for benchmarks.
 #pragma once
 #include "DeviceTree.cuh"
 #include "KdTreeSplit.cuh"
@@ -13,7 +17,7 @@ namespace spaceskip::cuda {
 struct KdParams {
   LeafCriterion leaf = LeafCriterion::Deep;
   int maxLeafSize = 0;
-  int bins = 4;
+  int bins = 4;  ///< >= 2: bins - 1 planes per node; 0: sweep (KdTreeSplit.cuh); 1 or < 0: std::invalid_argument
 };
 
 struct KdTreeGpuWorkspace {

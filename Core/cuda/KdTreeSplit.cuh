@@ -5,6 +5,11 @@
 // children's tight volumes; a split removing <= 1/1000 of the node volume is rejected. Halting:
 // Shallow = node volume < 10% of the root's, Deep = node volume <= 8^3 cells. MLS (paper 4.3):
 // a leaf longer than MLS cells along its longest axis is split in the middle of that axis.
+//
+// bins == 0 is the sweep: the candidates, cost, halting, tie-breaking and MLS split of KdTreeCPU
+// (Core/src/KdTreeBuilder.cpp, Vidal's plane sweep), so a GPU tree with bins 0 is the KdTreeCPU
+// tree of the same leaf criterion and MLS, node for node (the layout order aside).
+// Header-only and host+device (SS_FUNC): the host tests include it to check exactly that.
 #pragma once
 #include "spaceskip/Math.h"
 
@@ -15,7 +20,7 @@ namespace spaceskip::cuda {
 struct KdSplitParams {
   int deep;         ///< 1: Deep halting, 0: Shallow
   int mls;          ///< 0: none, else max leaf edge in cells
-  int bins;         ///< candidate planes = bins - 1
+  int bins;         ///< candidate planes = bins - 1 (>= 2); 0: sweep (kdCandidateCount)
   int brick;        ///< raster the planes snap to (cells)
   int64_t rootVol;  ///< volume of the root's tight box (cells)
 };
@@ -25,13 +30,92 @@ struct KdDecision {
   box3i left, right;  ///< tight child boxes when split
 };
 
+/// The longest axis, the first one on ties (as KdTreeCPU).
 SS_FUNC int longestAxis(const box3i& b) {
   int lx = b.hi.x - b.lo.x, ly = b.hi.y - b.lo.y, lz = b.hi.z - b.lo.z;
   return lx >= ly ? (lx >= lz ? 0 : 2) : (ly >= lz ? 1 : 2);
 }
 
+/// KdTreeCPU's sweep step in bricks: every brick boundary for bricks of 8 cells or more, else
+/// every ceil(8/brick) bricks (Vidal's raster of 8 voxels).
+SS_FUNC int kdSweepStep(int brick) { return ss_maxi(1, (8 + brick - 1) / brick); }
+
+SS_FUNC bool kdHalts(const box3i& box, const KdSplitParams& p) {
+  const int64_t vol = box.volume();
+  return p.deep ? vol <= 512 : vol < p.rootVol / 10;
+}
+
+/// Candidate planes of a node along `axis`: bins - 1, or for the sweep every step-th brick
+/// boundary strictly inside the node (up to bricks/step - 1, e.g. 255 at 2048^3 with 8^3 bricks).
+SS_FUNC int kdCandidateCount(const box3i& box, int axis, const KdSplitParams& p) {
+  if (p.bins > 0) return p.bins - 1;
+  // Bricks along the axis: the node's lo is on the raster, its hi may be clamped to the volume.
+  const int nb = (box.hi[axis] - box.lo[axis] + p.brick - 1) / p.brick;
+  return ss_maxi(0, nb / kdSweepStep(p.brick) - 1);
+}
+
+/// Position (cells) of candidate k, 1 <= k <= kdCandidateCount, in increasing order of k.
+SS_FUNC int kdCandidatePlane(const box3i& box, int axis, int k, const KdSplitParams& p) {
+  const int lo = box.lo[axis];
+  if (p.bins == 0) return lo + k * kdSweepStep(p.brick) * p.brick;
+  const int dl = ss_maxi((box.hi[axis] - lo) / p.bins, p.brick);
+  return (lo + dl * k) / p.brick * p.brick;
+}
+
+/// Cost of splitting `box` at `pos` along `axis` (sum of the tight children's volumes) and the
+/// children; INT64_MAX when the plane is rejected (on the border, or it removes <= 1/1000 of the
+/// node volume as empty space).
+#ifdef __CUDACC__
+#pragma nv_exec_check_disable
+#endif
+template <class Tight>
+SS_FUNC int64_t kdPlaneCost(const box3i& box, int axis, int pos, Tight& tight, box3i& l, box3i& r) {
+  if (pos <= box.lo[axis] || pos >= box.hi[axis]) return INT64_MAX;  // a plane on the border removes nothing
+  l = box;
+  r = box;
+  l.hi[axis] = pos;
+  r.lo[axis] = pos;
+  l = tight(l);
+  r = tight(r);
+  const int64_t vol = box.volume(), c = l.volume() + r.volume();
+  return vol - c <= vol / 1000 ? INT64_MAX : c;
+}
+
+/// The MLS split of a would-be leaf (d.split = 0 when MLS does not apply). Binned: the middle of
+/// the axis snapped down to the raster, at least one brick in. Sweep: KdTreeCPU's middle brick
+/// boundary, lo + (bricks / 2) bricks; the two differ only for a box clamped to the volume.
+#ifdef __CUDACC__
+#pragma nv_exec_check_disable
+#endif
+template <class Tight>
+SS_FUNC KdDecision kdMlsSplit(const box3i& box, int axis, const KdSplitParams& p, Tight& tight) {
+  KdDecision d;
+  d.split = 0;
+  d.left = d.right = box;
+  const int lo = box.lo[axis], hi = box.hi[axis], len = hi - lo;
+  if (p.mls <= 0 || len <= p.mls) return d;
+  int pos;
+  if (p.bins == 0) {
+    pos = lo + (len + p.brick - 1) / p.brick / 2 * p.brick;  // a one-brick box gives pos == lo: no split
+  } else {
+    pos = (lo + len / 2) / p.brick * p.brick;
+    if (pos <= lo) pos = lo + p.brick;
+  }
+  if (pos > lo && pos < hi) {
+    box3i l = box, r = box;
+    l.hi[axis] = pos;
+    r.lo[axis] = pos;
+    d.split = 1;
+    d.left = tight(l);
+    d.right = tight(r);
+  }
+  return d;
+}
+
 /// `box` is the node's tight box (cells); `tight(region)` returns the tight box of the
-/// occupied bricks inside `region` (empty box when none).
+/// occupied bricks inside `region` (empty box when none). The least cost wins; on ties the
+/// first plane in increasing order (KdTreeCPU's rule). KdTreeGPUFast evaluates the sweep's
+/// candidates in parallel with the same pieces (KdTreeBuilder.cu, levelDecideSweepKernel).
 #ifdef __CUDACC__
 #pragma nv_exec_check_disable
 #endif
@@ -40,24 +124,13 @@ SS_FUNC KdDecision decideKdSplit(const box3i& box, const KdSplitParams& p, Tight
   KdDecision d;
   d.split = 0;
   d.left = d.right = box;
-  const int64_t vol = box.volume();
   const int axis = longestAxis(box);
-  const int lo = box.lo[axis], hi = box.hi[axis], len = hi - lo;
-  const bool halt = p.deep ? vol <= 512 : vol < p.rootVol / 10;
-  if (!halt) {
-    const int dl = ss_maxi(len / p.bins, p.brick);
+  if (!kdHalts(box, p)) {
+    const int count = kdCandidateCount(box, axis, p);
     int64_t best = INT64_MAX;
-    for (int k = 1; k < p.bins; ++k) {
-      int pos = lo + dl * k;
-      pos = pos / p.brick * p.brick;
-      if (pos <= lo || pos >= hi) continue;  // a plane on the border removes nothing
-      box3i l = box, r = box;
-      l.hi[axis] = pos;
-      r.lo[axis] = pos;
-      l = tight(l);
-      r = tight(r);
-      const int64_t c = l.volume() + r.volume();
-      if (vol - c <= vol / 1000) continue;
+    for (int k = 1; k <= count; ++k) {
+      box3i l, r;
+      const int64_t c = kdPlaneCost(box, axis, kdCandidatePlane(box, axis, k, p), tight, l, r);
       if (c < best) {
         best = c;
         d.split = 1;
@@ -67,19 +140,7 @@ SS_FUNC KdDecision decideKdSplit(const box3i& box, const KdSplitParams& p, Tight
     }
     if (d.split) return d;
   }
-  if (p.mls > 0 && len > p.mls) {
-    int pos = (lo + len / 2) / p.brick * p.brick;
-    if (pos <= lo) pos = lo + p.brick;
-    if (pos < hi) {
-      box3i l = box, r = box;
-      l.hi[axis] = pos;
-      r.lo[axis] = pos;
-      d.split = 1;
-      d.left = tight(l);
-      d.right = tight(r);
-    }
-  }
-  return d;
+  return kdMlsSplit(box, axis, p, tight);
 }
 
 }  // namespace spaceskip::cuda

@@ -42,7 +42,11 @@ struct BuildParams {
   BuilderKind builder = BuilderKind::Grid;
   LeafCriterion leaf = LeafCriterion::Deep;
   int maxLeafSize = 0;  ///< 0: none; else leaves' edge <= MLS cells (32 or 128 in the paper)
-  int bins = 4;         ///< candidate planes per node + 1 (KdTreeGPU/KdTreeGPUFast)
+  /// KdTreeGPU/KdTreeGPUFast split candidates: >= 2: bins - 1 planes per node at multiples of
+  /// len/bins (the paper's binned method); 0: sweep, every brick boundary along the longest axis,
+  /// which builds exactly the KdTreeCPU tree. KdTreeCPU ignores it: it always sweeps (= bins 0).
+  /// Engine::setBuildParams throws std::invalid_argument for 1 and negative values.
+  int bins = 4;
   int brick = 8;        ///< macro-cell edge in cells (classification granularity)
   bool operator==(const BuildParams& o) const {
     return builder == o.builder && leaf == o.leaf && maxLeafSize == o.maxLeafSize &&

@@ -17,7 +17,9 @@ constexpr int64_t kKdTreeSerialCutoffBricks = 4096;
 ///  - the root box is the tight box of all occupied bricks (empty occupancy: no nodes);
 ///  - candidate planes run along the node's longest axis at every brick boundary for bricks of
 ///    8 cells or more, else every ceil(8/brick) bricks (every 8 cells for brick 1, 2, 4), placed
-///    relative to the node's low face as in Vidal's code;
+///    relative to the node's low face as in Vidal's code. KdTreeCPU always sweeps and ignores
+///    BuildParams::bins: it is the GPU builders' bins = 0, which give this very tree
+///    (Core/cuda/KdTreeSplit.cuh; TestKdSweep.cpp checks it);
 ///  - cost = volume of the tight left box + volume of the tight right box (cells); a plane is
 ///    rejected when it removes <= 1/1000 of the node volume as empty space; least cost wins;
 ///  - halting: Shallow = node volume < 10% of the root volume, Deep = node volume <= 8^3 cells,

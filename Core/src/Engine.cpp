@@ -181,12 +181,15 @@ void Engine::setTransferFunction(const TransferFunction& tf) {
 }
 
 void Engine::setBuildParams(const BuildParams& p) {
+  // bins 1 would mean no candidate plane at all; rejected rather than silently clamped, since 0
+  // (the sweep) is now a meaningful value next to it.
+  if (p.bins < 0 || p.bins == 1)
+    throw std::invalid_argument("bins must be 0 (sweep every brick boundary) or >= 2, got " + std::to_string(p.bins));
   Impl& d = *impl_;
   if (p.brick != d.build.brick) d.rangesDirty = true;
   if (p != d.build) d.buildDirty = true;
   d.build = p;
   d.build.brick = std::max(1, p.brick);
-  d.build.bins = std::max(2, p.bins);
 }
 
 void Engine::setRenderParams(const RenderParams& p) {

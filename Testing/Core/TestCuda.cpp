@@ -3,6 +3,7 @@
 // no device exists. Skips (GTEST_SKIP) where a device is needed and none answers.
 #include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
+#include "spaceskip/KdTreeBuilder.h"
 #include "TestUtil.h"
 #include "TreeInvariants.h"
 
@@ -324,6 +325,8 @@ TEST_P(CudaImage, EqualsCpuForEveryBuilder) {
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Shallow),
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 32),
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 0, 8),
+      params(BuilderKind::KdTreeGPUFast, LeafCriterion::Shallow, 0, 0),
+      params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 32, 0),
       params(BuilderKind::LBVHCPU),
       params(BuilderKind::KdTreeCPU, LeafCriterion::Deep, 32),
       params(BuilderKind::Hybrid, LeafCriterion::Shallow),
@@ -406,6 +409,8 @@ TEST(CudaTrees, InvariantsHold) {
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep),
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 32),
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 16, 8),
+      params(BuilderKind::KdTreeGPUFast, LeafCriterion::Shallow, 0, 0),
+      params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 32, 0),
   };
   for (auto& [v, preset] : cases) {
     TransferFunction tf = tfFor(v, preset);
@@ -458,6 +463,76 @@ TEST(CudaTrees, FastKdTreeEqualsPaperKdTree) {
       // statistics show the same). N-body must split.
       if (std::string(shape) == "nbody") EXPECT_GT(a.tree.nodes.size(), 1u);
     }
+  }
+}
+
+TEST(CudaTrees, SweepKdTreeEqualsKdTreeCpu) {
+  // bins 0 (the sweep) has KdTreeCPU's candidates, cost, halting, ties and MLS: KdTreeGPUFast
+  // (and, slowly, KdTreeGPU) must build the KdTreeCPU tree of the same parameters on the same
+  // occupancy: same node boxes as a set, node count and height (the layout order differs), so
+  // the same rendering speed. The host side of the decision is TestKdSweep.cpp; this checks the
+  // warp-per-node kernel's parallel evaluation and reduction.
+  REQUIRE_CUDA();
+  struct Case {
+    const char* shape;
+    vec3l dims;
+    int brick;
+    const char* tf;
+    bool paper;  ///< KdTreeGPU too (one host round trip per candidate child: small volumes only)
+  };
+  const Case cases[] = {{"nbody", {256, 256, 256}, 8, "ramp", false}, {"nbody", {100, 77, 90}, 8, "ramp", true},
+                        {"menger", {81, 81, 81}, 8, "ramp", true},     {"vessels", {128, 128, 128}, 4, "coolwarm", false},
+                        {"shell", {70, 61, 66}, 8, "band", true},      {"nbody", {150, 140, 130}, 16, "ramp", true}};
+  const std::tuple<LeafCriterion, int> variants[] = {{LeafCriterion::Shallow, 0}, {LeafCriterion::Deep, 0},
+                                                     {LeafCriterion::Deep, 32}, {LeafCriterion::Deep, 128}};
+  auto key = [](const Node& n) {
+    return std::make_tuple(n.box.lo.x, n.box.lo.y, n.box.lo.z, n.box.hi.x, n.box.hi.y, n.box.hi.z, n.child < 0);
+  };
+  using Key = decltype(key(Node{}));
+  auto keys = [&](const Tree& t) {
+    std::vector<Key> k;
+    for (const Node& n : t.nodes) k.push_back(key(n));
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  int splitting = 0;
+  for (const Case& c : cases) {
+    Volume v = generateVolume(c.shape, c.dims, 7);
+    TransferFunction tf = tfFor(v, c.tf);
+    for (auto [leaf, mls] : variants) {
+      for (BuilderKind k : {BuilderKind::KdTreeGPUFast, BuilderKind::KdTreeGPU}) {
+        if (k == BuilderKind::KdTreeGPU && !c.paper) continue;
+        BuildParams p = params(k, leaf, mls, 0);
+        p.brick = c.brick;
+        SCOPED_TRACE(std::string(c.shape) + " " + std::to_string(c.dims.x) + " brick " + std::to_string(c.brick) + " " +
+                     describe(p));
+        Built g = run(v, tf, p, BackendKind::CUDA, 0, 0, false, FilterMode::Exact, 8);
+        ASSERT_EQ(g.kind, BackendKind::CUDA);
+        const Tree cpu = buildKdTree(g.occ, p);
+        ASSERT_EQ(g.tree.nodes.size(), cpu.nodes.size());
+        EXPECT_EQ(g.tree.height, cpu.height);
+        EXPECT_EQ(g.tree.leaves, cpu.leaves);
+        EXPECT_TRUE(keys(g.tree) == keys(cpu)) << "node boxes differ from KdTreeCPU's";
+        checkTree(g.tree, g.occ, p);
+        splitting += cpu.nodes.size() > 1;
+      }
+    }
+  }
+  EXPECT_GT(splitting, 20) << "the cases must exercise real splits";
+
+  // The image: KdTreeGPUFast bins 0 on the device vs KdTreeCPU on the CPU backend.
+  Volume v = generateVolume("nbody", vec3l{96, 90, 84}, 3);
+  TransferFunction tf = tfFor(v, "ramp");
+  for (auto [leaf, mls] : variants) {
+    Built cpu = run(v, tf, params(BuilderKind::KdTreeCPU, leaf, mls), BackendKind::CPU, 30, 20, false,
+                    FilterMode::Exact, 96);
+    Built gpu = run(v, tf, params(BuilderKind::KdTreeGPUFast, leaf, mls, 0), BackendKind::CUDA, 30, 20, false,
+                    FilterMode::Exact, 96);
+    ASSERT_EQ(gpu.kind, BackendKind::CUDA);
+    ASSERT_GT(test::coverage(cpu.img), 0.001) << "test scene must not be empty";
+    ImageDiff d = compareImages(cpu.img, gpu.img);
+    EXPECT_LE(d.maxAbs, 2.f / 255.f) << describe(params(BuilderKind::KdTreeGPUFast, leaf, mls, 0)) << " psnr " << d.psnr;
+    EXPECT_EQ(gpu.tree.nodes.size(), cpu.tree.nodes.size());
   }
 }
 

@@ -97,6 +97,12 @@ bins_img = shot("prop_bins8.png")
 after = ssptest.stats(disp)
 ok.check(after["BuildCount"] == before["BuildCount"] + 1, "BinCount change rebuilds once")
 ok.check(ssptest.psnr(naive, bins_img) >= 40.0, "BinCount 8 renders the Naive image")
+# 0: the sweep (KdTreeCPU's candidates); 1 has no candidate plane and clamps to 2 in the mapper.
+roundtrip("BinCount", 0, 0)
+sweep_img = shot("prop_bins0.png")
+ok.check(ssptest.stats(disp)["BuildCount"] == after["BuildCount"] + 1, "BinCount 0 rebuilds once")
+ok.check(ssptest.psnr(naive, sweep_img) >= 40.0, "BinCount 0 (sweep) renders the Naive image")
+roundtrip("BinCount", 1, 2)
 roundtrip("BinCount", 4, 4)
 
 # -- SampleDistance: changes the sampling (image and work), not the hierarchy ----------------

@@ -3,8 +3,10 @@
 # on the CUDA tests, and the benchmarks; writes everything into OUTDIR (see DEVICE.md).
 #
 #   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
-#   PHASE: build test sanitize bench-small bench-large bench-round2 bench-round3 profile2048 blocks ncu
+#   PHASE: build test sanitize bench-small bench-large bench-round2 bench-round3 bench-sweep regcap
+#          profile2048 blocks ncu
 #          (default: build test sanitize bench-small)
+#          bench-sweep: KdTreeCPU vs KdTreeGPUFast with bins 0 (the same trees) at 256^3..2048^3
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
 #          when present), BENCH_FRAMES (8), SANITIZE_FILTER (gtest filter for the sanitizer runs),
 #          SANITIZE_TOOLS ("memcheck racecheck"), SANITIZE_TIMEOUT (240 s per tool), SANITIZE_DEADLINE
@@ -141,9 +143,26 @@ if has bench-round3; then
   # Round 3: DistanceGrid (the grid DDA leaping with a distance field) beside the best builders
   # of round 2, 256^3..2048^3 N-body and the 1024^3 Menger sponge; then one-voxel steps at 2048^3.
   r3="naive:hw,grid,grid:hw,distance-grid,distance-grid:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw"
+  r3="$r3,grid:brick16:hw,distance-grid:brick16:hw,distance-grid:brick4:hw"
   for n in 256 512 1024 2048; do bench r3-nbody$n gen:nbody:$n "$r3"; done
   bench r3-menger1024 gen:menger:1024 "$r3"
   bench r3-nbody2048-step1 gen:nbody:2048 "naive:hw,grid:hw,distance-grid:hw,lbvh:hw" --sample-distance 1
+fi
+if has regcap; then
+  # The texture kernels' register cap (SPACESKIP_CUDA_HW_MIN_BLOCKS, default 6 blocks of 256
+  # threads = 40 registers) against no cap (1): a second build, the same items at 1024^3/2048^3.
+  log "configure + build without the register cap in $build-cap1"
+  cmake -S "$src" -B "$build-cap1" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSPACESKIP_ENABLE_CUDA=ON \
+    -DSPACESKIP_ENABLE_PARAVIEW=OFF -DCMAKE_CUDA_ARCHITECTURES=90 -DSPACESKIP_CUDA_HW_MIN_BLOCKS=1 \
+    -DSPACESKIP_ENABLE_TESTING=OFF > "$work/build-cap1.log" 2>&1 && ninja -C "$build-cap1" spaceskip >> "$work/build-cap1.log" 2>&1
+  log "build rc=$?"
+  rc_items="naive:hw,grid:hw,distance-grid:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw"
+  for n in 1024 2048; do
+    bench regcap6-nbody$n gen:nbody:$n "$rc_items"
+    cli0=$cli; cli=$build-cap1/Core/spaceskip
+    bench regcap1-nbody$n gen:nbody:$n "$rc_items"
+    cli=$cli0
+  done
 fi
 if has profile2048; then
   # Why naive:hw does half the samples/s at 2048^3 that it does at 1024^3: launch shape and
@@ -169,6 +188,17 @@ if has profile2048; then
   done
   cp "$work/ncu.log" "$out/ncu.log" 2>/dev/null
   rm -f "$vol"
+fi
+if has bench-sweep; then
+  # "Same parameters, fps within 5%": bins 0 makes KdTreeGPUFast sweep every brick boundary like
+  # KdTreeCPU, so each kdtree-cpu item and its kdtree-gpu-fast:...:bins0 twin render the same tree
+  # (same nodes/height/leaves in the CSV); their fps must agree. Results go to the usual
+  # bench.log/bench.csv/bench.json (no new files in OUTDIR).
+  sw="kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128"
+  sw="$sw,kdtree-gpu-fast:shallow:bins0,kdtree-gpu-fast:deep:mls32:bins0,kdtree-gpu-fast:deep:mls128:bins0"
+  sw="$sw,kdtree-cpu:deep:mls32:hw,kdtree-gpu-fast:deep:mls32:bins0:hw"
+  for n in 256 512 1024 2048; do bench sweep-nbody$n gen:nbody:$n "$sw"; done
+  bench sweep-menger1024 gen:menger:1024 "$sw"
 fi
 if has blocks; then
   # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK), recorded for the notes.
