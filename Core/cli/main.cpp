@@ -11,6 +11,7 @@
 #include <ctime>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -47,7 +48,8 @@ const char* kUsage = R"(usage:
       --builders naive,grid,lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid
       or kdtree-gpu-fast:deep:mls32:bins0 (the sweep: the kdtree-cpu:deep:mls32 tree)
       --build-reps N: report the fastest of N rebuilds (default 1)
-      bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only)
+      bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only),
+      :resN (CUDA: persistent launch with N blocks per SM, SPACESKIP_CUDA_RESIDENT; res0 = plain)
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
@@ -287,6 +289,7 @@ struct BenchItem {
   std::string spec;  ///< the item without bench-only suffixes
   int filter = -1;   ///< -1: --filter, else a FilterMode
   bool cold = false;
+  std::string resident;  ///< `resN`: SPACESKIP_CUDA_RESIDENT=N for this item (CUDA launch shape)
 };
 
 BenchItem benchItem(const std::string& item) {
@@ -295,6 +298,8 @@ BenchItem benchItem(const std::string& item) {
     if (part == "hw") it.filter = int(FilterMode::Hardware);
     else if (part == "exact") it.filter = int(FilterMode::Exact);
     else if (part == "cold") it.cold = true;
+    else if (part.size() > 3 && part.rfind("res", 0) == 0 && part.find_first_not_of("0123456789", 3) == std::string::npos)
+      it.resident = part.substr(3);
     else it.spec += (it.spec.empty() ? "" : ":") + part;
   }
   return it;
@@ -352,6 +357,9 @@ int cmdBench(const Options& o) {
         engine.update();
         if (rep == 0 || engine.buildStats().seconds < s.seconds) s = engine.buildStats();
       }
+      const char* residentBefore = std::getenv("SPACESKIP_CUDA_RESIDENT");
+      const std::string residentSaved = residentBefore ? residentBefore : "";
+      if (!item.resident.empty()) setenv("SPACESKIP_CUDA_RESIDENT", item.resident.c_str(), 1);
       double b6[6];
       v.worldBounds(b6);
       Image img;
@@ -373,6 +381,10 @@ int cmdBench(const Options& o) {
       counted.countSamples = true;
       engine.setRenderParams(counted);
       engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
+      if (!item.resident.empty()) {
+        if (residentBefore) setenv("SPACESKIP_CUDA_RESIDENT", residentSaved.c_str(), 1);
+        else unsetenv("SPACESKIP_CUDA_RESIDENT");
+      }
       const double samples = double(engine.frameStats().samples);
       const double gsps = samples * kernelFps * 1e-9;
       // Logical voxel traffic of trilinear sampling: 8 voxels per sample (mostly cache hits).

@@ -105,31 +105,54 @@ struct TextureSampler {
 // Launch shape: 2-D grid of 16x8 blocks (SPACESKIP_CUDA_BLOCK overrides), one thread per pixel.
 // One kernel per traversal: a kernel holding every traversal is allocated the registers of the
 // tree traversal (64 per thread, half occupancy), which the naive and grid marches do not need.
-// Hardware-filtered kernels are asked to fit 6 blocks of 256 threads per SM (<= 40 registers):
-// their marches are latency bound on texture fetches, and more warps in flight hide it.
-// The exact samplers need more registers than that without spilling; they get the default.
+// SPACESKIP_CUDA_HW_MIN_BLOCKS > 1 asks the hardware-filtered kernels to fit that many blocks of
+// 256 threads per SM (a register cap). Measured on the H100 (round 3): 6 (40 registers) made
+// every ESS kernel 4-7% slower than no cap, so the default is 1 (no cap).
 constexpr int kMaxRenderThreads = 256;
+constexpr int kDefaultResidentBlocks = 0;  ///< plain launch unless SPACESKIP_CUDA_RESIDENT says otherwise
 template <class Sampler>
 struct RenderMinBlocks {
   static constexpr int value = 1;
 };
 #ifndef SPACESKIP_CUDA_HW_MIN_BLOCKS
-#define SPACESKIP_CUDA_HW_MIN_BLOCKS 6  // CMake: SPACESKIP_CUDA_HW_MIN_BLOCKS (1 = no register cap)
+#define SPACESKIP_CUDA_HW_MIN_BLOCKS 1  // CMake: SPACESKIP_CUDA_HW_MIN_BLOCKS (1 = no register cap)
 #endif
 template <>
 struct RenderMinBlocks<TextureSampler> {
   static constexpr int value = SPACESKIP_CUDA_HW_MIN_BLOCKS;
 };
 
+// Tiles of blockDim pixels. Without `tileCounter` block (i, j) renders tile (i, j). With it the
+// launch is persistent: a fixed number of resident blocks take tiles in row-major order from the
+// counter until none are left, which bounds the warps in flight (the volume's cache working set)
+// and balances blocks whose rays cost very different amounts.
 template <class Sampler, int Traversal>
-__global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::value) renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out) {
-  const int x = blockIdx.x * blockDim.x + threadIdx.x, y = blockIdx.y * blockDim.y + threadIdx.y;
-  if (x >= f.width || y >= f.height) return;
-  out[int64_t(y) * f.width + x] = renderPixel<Sampler, Traversal>(f, s, x, y);
+__global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::value)
+    renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out,
+                 unsigned* tileCounter) {
+  const unsigned tilesX = (unsigned(f.width) + blockDim.x - 1) / blockDim.x;
+  auto tile = [&](unsigned tx, unsigned ty) {
+    const int x = int(tx * blockDim.x + threadIdx.x), y = int(ty * blockDim.y + threadIdx.y);
+    if (x < f.width && y < f.height) out[int64_t(y) * f.width + x] = renderPixel<Sampler, Traversal>(f, s, x, y);
+  };
+  if (!tileCounter) {
+    tile(blockIdx.x, blockIdx.y);
+    return;
+  }
+  const unsigned numTiles = tilesX * ((unsigned(f.height) + blockDim.y - 1) / blockDim.y);
+  __shared__ unsigned next;
+  for (;;) {
+    if (threadIdx.x == 0 && threadIdx.y == 0) next = atomicAdd(tileCounter, 1u);
+    __syncthreads();
+    const unsigned t = next;
+    __syncthreads();  // everyone has read `next` before thread 0 overwrites it
+    if (t >= numTiles) return;
+    tile(t % tilesX, t / tilesX);
+  }
 }
 
 template <class Sampler>
-using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*);
+using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*);
 
 template <class Sampler>
 RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
@@ -170,6 +193,12 @@ class CudaBackend final : public Backend {
     }
     // Tuning knob for measurements: SPACESKIP_CUDA_CARVEOUT=0..100 (percent of the unified L1 /
     // shared memory given to shared memory for the render kernels; 0 = largest L1).
+    int dev = 0;
+    if (cudaGetDevice(&dev) != cudaSuccess ||
+        cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
+      (void)cudaGetLastError();
+      numSMs_ = 1;
+    }
     if (const char* c = std::getenv("SPACESKIP_CUDA_CARVEOUT")) {
       const int v = std::atoi(c);
       if (v >= 0 && v <= 100) carveout_ = v;
@@ -435,10 +464,22 @@ class CudaBackend final : public Backend {
 
   template <class Sampler>
   void launchRender(const FrameView& f, const Sampler& s, dim3 grid, dim3 block) {
+    // SPACESKIP_CUDA_RESIDENT=N: persistent launch with N blocks per SM taking tiles from a
+    // counter (0: one block per tile, the plain launch). Read per frame (bench items set it).
+    residentBlocks_ = kDefaultResidentBlocks;
+    if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks_ = std::max(0, std::atoi(r));
     RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f.traversal);
     if (carveout_ >= 0)
       SS_CUDA_CHECK(cudaFuncSetAttribute(k, cudaFuncAttributePreferredSharedMemoryCarveout, carveout_));
-    k<<<grid, block, 0, stream_>>>(f, s, d_image_.get());
+    if (residentBlocks_ <= 0) {
+      k<<<grid, block, 0, stream_>>>(f, s, d_image_.get(), nullptr);
+      return;
+    }
+    d_tileCounter_.reserve(1);
+    SS_CUDA_CHECK(cudaMemsetAsync(d_tileCounter_.get(), 0, sizeof(unsigned), stream_));
+    const unsigned tiles = grid.x * grid.y;
+    const unsigned blocks = std::min(tiles, unsigned(residentBlocks_) * unsigned(numSMs_));
+    k<<<blocks, block, 0, stream_>>>(f, s, d_image_.get(), d_tileCounter_.get());
   }
 
   void uploadTree(const Tree& t) {
@@ -563,6 +604,9 @@ class CudaBackend final : public Backend {
   double lastDeviceSeconds_ = -1;
   unsigned blockX_ = 16, blockY_ = 8;
   int carveout_ = -1;  ///< -1: the driver's choice
+  int residentBlocks_ = 0;  ///< > 0: persistent launch with this many blocks per SM
+  int numSMs_ = 1;
+  DeviceBuffer<unsigned> d_tileCounter_;
 };
 
 }  // namespace

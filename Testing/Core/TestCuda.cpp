@@ -625,3 +625,34 @@ TEST(CudaBackend, DeviceOutOfMemoryFallsBackToCpu) {
     EXPECT_EQ(compareImages(cpu.img, img).maxAbs, 0.f) << "fallback image differs from the CPU image";
   }
 }
+
+TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
+  // SPACESKIP_CUDA_RESIDENT switches the render kernels to a persistent launch (blocks taking
+  // tiles from a counter); every pixel must still be rendered once, with the same result. A
+  // 100x70 image leaves partial tiles, and 1 block per SM leaves each block many tiles.
+  REQUIRE_CUDA();
+  Volume v = generateVolume("nbody", vec3l{96, 96, 96});
+  TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
+  double b[6];
+  v.worldBounds(b);
+  for (BuilderKind k : {BuilderKind::Naive, BuilderKind::DistanceGrid, BuilderKind::LBVH}) {
+    for (FilterMode filter : {FilterMode::Exact, FilterMode::Hardware}) {
+      Image img[2];
+      for (int i = 0; i < 2; ++i) {
+        if (i == 1) setenv("SPACESKIP_CUDA_RESIDENT", "1", 1);
+        Engine e(BackendKind::CUDA);
+        unsetenv("SPACESKIP_CUDA_RESIDENT");
+        e.setVolume(v);
+        e.setTransferFunction(tf);
+        e.setBuildParams(params(k));
+        RenderParams rp;
+        rp.filter = filter;
+        e.setRenderParams(rp);
+        e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
+        ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+      }
+      ASSERT_GT(test::coverage(img[0]), 0.001);
+      EXPECT_EQ(compareImages(img[0], img[1]).maxAbs, 0.f) << builderName(k);
+    }
+  }
+}

@@ -4,7 +4,7 @@
 #
 #   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
 #   PHASE: build test sanitize bench-small bench-large bench-round2 bench-round3 bench-sweep regcap
-#          profile2048 blocks ncu
+#          resident profile2048 blocks ncu
 #          (default: build test sanitize bench-small)
 #          bench-sweep: KdTreeCPU vs KdTreeGPUFast with bins 0 (the same trees) at 256^3..2048^3
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
@@ -163,6 +163,15 @@ if has regcap; then
     bench regcap1-nbody$n gen:nbody:$n "$rc_items"
     cli=$cli0
   done
+fi
+if has resident; then
+  # Persistent launch (SPACESKIP_CUDA_RESIDENT=N blocks per SM, bench suffix :resN) against the
+  # plain launch: bounds the warps in flight (the texture cache's working set) and balances tiles.
+  rs="naive:hw,naive:hw:res4,naive:hw:res6,naive:hw:res8,naive:hw:res12,naive:hw:res16"
+  rs="$rs,grid:hw,grid:hw:res8,grid:hw:res16,distance-grid:hw,distance-grid:hw:res8,distance-grid:hw:res16"
+  rs="$rs,lbvh:hw,lbvh:hw:res8,lbvh:hw:res16"
+  rs="$rs,distance-grid:brick4:hw,distance-grid:brick4:hw:res8,distance-grid:brick4:hw:res16"
+  for n in 1024 2048; do bench res-nbody$n gen:nbody:$n "$rs"; done
 fi
 if has profile2048; then
   # Why naive:hw does half the samples/s at 2048^3 that it does at 1024^3: launch shape and
