@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <type_traits>
 #include <vector>
 
 namespace spaceskip {
@@ -109,7 +110,13 @@ struct TextureSampler {
 // 256 threads per SM (a register cap). Measured on the H100 (round 3): 6 (40 registers) made
 // every ESS kernel 4-7% slower than no cap, so the default is 1 (no cap).
 constexpr int kMaxRenderThreads = 256;
-constexpr int kDefaultResidentBlocks = 0;  ///< plain launch unless SPACESKIP_CUDA_RESIDENT says otherwise
+// Default launch of the hardware-filtered kernels: plain for volumes up to kLargeTextureBytes; a
+// persistent launch with kLargeTextureResident blocks of 128 threads per SM above. Measured on
+// the H100 (Testing/results/cuda-h100-round3): naive:hw at 2048^3 (8 GiB) runs fastest with 6
+// blocks per SM (more warps in flight thrash the texture path), at 1024^3 (1 GiB) with all 16;
+// the skipping kernels do not care either way.
+constexpr size_t kLargeTextureBytes = size_t(2) << 30;
+constexpr int kLargeTextureResident = 6;
 template <class Sampler>
 struct RenderMinBlocks {
   static constexpr int value = 1;
@@ -466,7 +473,9 @@ class CudaBackend final : public Backend {
   void launchRender(const FrameView& f, const Sampler& s, dim3 grid, dim3 block) {
     // SPACESKIP_CUDA_RESIDENT=N: persistent launch with N blocks per SM taking tiles from a
     // counter (0: one block per tile, the plain launch). Read per frame (bench items set it).
-    residentBlocks_ = kDefaultResidentBlocks;
+    residentBlocks_ = std::is_same<Sampler, TextureSampler>::value && arrayBytes_ > kLargeTextureBytes
+                          ? std::max(1, kLargeTextureResident * 128 / int(block.x * block.y))
+                          : 0;
     if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks_ = std::max(0, std::atoi(r));
     RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f.traversal);
     if (carveout_ >= 0)

@@ -4,7 +4,7 @@
 #
 #   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
 #   PHASE: build test sanitize bench-small bench-large bench-round2 bench-round3 bench-sweep regcap
-#          resident profile2048 blocks ncu
+#          resident bench-final3 profile2048 blocks ncu
 #          (default: build test sanitize bench-small)
 #          bench-sweep: KdTreeCPU vs KdTreeGPUFast with bins 0 (the same trees) at 256^3..2048^3
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
@@ -172,6 +172,20 @@ if has resident; then
   rs="$rs,lbvh:hw,lbvh:hw:res8,lbvh:hw:res16"
   rs="$rs,distance-grid:brick4:hw,distance-grid:brick4:hw:res8,distance-grid:brick4:hw:res16"
   for n in 1024 2048; do bench res-nbody$n gen:nbody:$n "$rs"; done
+fi
+if has bench-final3; then
+  # Round 3 final table: the default launch (persistent, 6 blocks/SM, for hardware-filtered
+  # textures over 2 GiB) beside the plain one (:res0), DistanceGrid at bricks 8 and 4, and the
+  # round-2 best builders; then naive:hw at 2048^3 repeated (plain vs default vs 5/7 blocks/SM).
+  f3="naive,naive:hw:res0,naive:hw,grid:hw,distance-grid,distance-grid:hw,distance-grid:brick4,distance-grid:brick4:hw"
+  f3="$f3,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw"
+  for n in 256 512 1024 2048; do bench f3-nbody$n gen:nbody:$n "$f3"; done
+  bench f3-menger1024 gen:menger:1024 "$f3"
+  frames0=$frames
+  frames=16
+  bench f3-nbody2048-naive-repeats gen:nbody:2048 \
+    "naive:hw:res0,naive:hw,naive:hw:res0,naive:hw,naive:hw:res5,naive:hw:res7,naive:hw:res0,naive:hw"
+  frames=$frames0
 fi
 if has profile2048; then
   # Why naive:hw does half the samples/s at 2048^3 that it does at 1024^3: launch shape and
