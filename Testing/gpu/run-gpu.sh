@@ -4,7 +4,7 @@
 #
 #   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
 #   PHASE: build test sanitize bench-small bench-large bench-round2 bench-round3 bench-sweep regcap
-#          resident bench-final3 profile2048 blocks ncu
+#          resident bench-final3 bench-menger3 profile2048 blocks ncu
 #          (default: build test sanitize bench-small)
 #          bench-sweep: KdTreeCPU vs KdTreeGPUFast with bins 0 (the same trees) at 256^3..2048^3
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
@@ -186,6 +186,11 @@ if has bench-final3; then
   bench f3-nbody2048-naive-repeats gen:nbody:2048 \
     "naive:hw:res0,naive:hw,naive:hw:res0,naive:hw,naive:hw:res5,naive:hw:res7,naive:hw:res0,naive:hw"
   frames=$frames0
+fi
+if has bench-menger3; then
+  # The Menger sponge (40.7% occupied): which structure is fastest when little space is empty.
+  bench m3-menger1024 gen:menger:1024 \
+    "naive:hw,kdtree-gpu-fast:shallow:hw,kdtree-cpu:shallow:hw,grid:hw,grid:brick16:hw,distance-grid:brick16:hw,kdtree-gpu-fast:deep:mls128:hw,kdtree-gpu-fast:deep:mls32:hw,hybrid:hw"
 fi
 if has profile2048; then
   # Why naive:hw does half the samples/s at 2048^3 that it does at 1024^3: launch shape and
