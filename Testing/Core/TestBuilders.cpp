@@ -43,19 +43,7 @@ OccupancyGrid randomGrid(vec3i cellDims, int brick, double p, unsigned seed, boo
   return g;
 }
 
-TransferFunction randomTF(unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
-  std::vector<TFPoint> pts;
-  pts.push_back({0.0, u(rng), u(rng), u(rng), 0.f});
-  double v = 0;
-  while (v < 255) {
-    v += 10 + 60 * u(rng);
-    float a = u(rng) < 0.5f ? 0.f : u(rng);
-    pts.push_back({std::min(v, 255.0), u(rng), u(rng), u(rng), a});
-  }
-  return TransferFunction::fromPoints(pts, 0, 255, 256);
-}
+using test::randomTF;
 
 BuildParams kd(LeafCriterion leaf, int mls = 0, int brick = 8) {
   BuildParams p;

@@ -15,18 +15,6 @@ using namespace spaceskip;
 
 namespace {
 
-OccupancyGrid grid(vec3i dims, double p, unsigned seed) {
-  OccupancyGrid g;
-  g.brick = 8;
-  g.dims = dims;
-  g.cellDims = vec3i{dims.x * 8, dims.y * 8, dims.z * 8};
-  g.occ.assign(size_t(g.size()), 0);
-  std::mt19937 rng(seed);
-  std::bernoulli_distribution b(p);
-  for (auto& o : g.occ) o = b(rng) ? 1 : 0;
-  for (auto o : g.occ) g.occupied += o;
-  return g;
-}
 
 std::vector<uint8_t> bruteForce(const OccupancyGrid& g, int cap) {
   std::vector<uint8_t> d(size_t(g.size()));
@@ -51,7 +39,7 @@ TEST(DistanceField, EqualsBruteForceChebyshevDistance) {
   for (vec3i dims : shapes)
     for (double p : {0.0, 0.002, 0.03, 0.4, 1.0})
       for (int cap : {kMaxSkipDistance, 5, 1}) {
-        OccupancyGrid g = grid(dims, p, seed++);
+        OccupancyGrid g = test::randomBrickGrid(dims, p, seed++);
         const auto field = computeDistanceField(g, cap);
         const auto ref = bruteForce(g, cap);
         ASSERT_EQ(field.size(), ref.size());
@@ -75,20 +63,10 @@ TEST(DistanceField, LeapingIsLosslessAndTakesTheGridsSamples) {
   };
   const Cam cams[] = {{0, 0, false}, {0, 90, false}, {33, 21, false}, {200, -60, true}, {90, 0, true}};
   for (const Cam& c : cams) {
-    Image img[2];
+    const Camera cam = orbitCamera(b, c.az, c.el, 1, c.persp, 1);
     int64_t samples[2];
-    int i = 0;
-    for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid}) {
-      Engine e(BackendKind::CPU);
-      e.setVolume(v);
-      e.setTransferFunction(tf);
-      e.setBuildParams(test::builder(k));
-      RenderParams rp;
-      rp.countSamples = true;
-      e.setRenderParams(rp);
-      e.render(orbitCamera(b, c.az, c.el, 1, c.persp, 1), 96, 96, img[i]);
-      samples[i++] = e.frameStats().samples;
-    }
+    Image img[2] = {test::renderCounting(v, tf, BuilderKind::Grid, cam, 96, samples[0]),
+                    test::renderCounting(v, tf, BuilderKind::DistanceGrid, cam, 96, samples[1])};
     ASSERT_GT(test::coverage(img[0]), 0.001);
     EXPECT_EQ(samples[0], samples[1]) << "az " << c.az << " el " << c.el;
     EXPECT_LE(compareImages(img[0], img[1]).maxAbs, 1.f / 255.f) << "az " << c.az << " el " << c.el;
@@ -97,15 +75,11 @@ TEST(DistanceField, LeapingIsLosslessAndTakesTheGridsSamples) {
   const double eye[3] = {0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])};
   const double at[3] = {b[1], b[3], b[5]}, up[3] = {0, 1, 0};
   Camera inside = lookAtCamera(eye, at, up, true, 60, 1, 0.1, 1000);
-  Image img[3];
-  int i = 0;
-  for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid}) {
-    Engine e(BackendKind::CPU);
-    e.setVolume(v);
-    e.setTransferFunction(tf);
-    e.setBuildParams(test::builder(k));
-    e.render(inside, 96, 96, img[i++]);
-  }
+  int64_t samples[3];
+  Image img[3] = {test::renderCounting(v, tf, BuilderKind::Naive, inside, 96, samples[0]),
+                  test::renderCounting(v, tf, BuilderKind::Grid, inside, 96, samples[1]),
+                  test::renderCounting(v, tf, BuilderKind::DistanceGrid, inside, 96, samples[2])};
+  EXPECT_EQ(samples[1], samples[2]);
   ASSERT_GT(test::coverage(img[0]), 0.001);
   EXPECT_LE(compareImages(img[0], img[2]).maxAbs, 1.f / 255.f);
   EXPECT_LE(compareImages(img[1], img[2]).maxAbs, 1.f / 255.f);

@@ -3,6 +3,7 @@
 // must build the KdTreeCPU tree node for node, for procedural volumes, random TFs, several brick
 // sizes, volumes that are not a multiple of the brick (clamped boxes), and every leaf criterion.
 // KdTreeGPU and KdTreeGPUFast run that same decision (TestCuda.cpp checks them on a device).
+#include "TestUtil.h"
 #include "TreeInvariants.h"
 
 #include "cuda/KdTreeSplit.cuh"
@@ -124,19 +125,7 @@ bool sameTree(const Tree& a, const Tree& b, const std::string& what, bool expect
   return same;
 }
 
-TransferFunction randomTF(unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.f, 1.f);
-  std::vector<TFPoint> pts;
-  pts.push_back({0.0, u(rng), u(rng), u(rng), 0.f});
-  double v = 0;
-  while (v < 255) {
-    v += 10 + 60 * u(rng);
-    const float a = u(rng) < 0.5f ? 0.f : u(rng);
-    pts.push_back({std::min(v, 255.0), u(rng), u(rng), u(rng), a});
-  }
-  return TransferFunction::fromPoints(pts, 0, 255, 256);
-}
+using test::randomTF;
 
 std::vector<BuildParams> sweepVariants(int brick) {
   return {kd(LeafCriterion::Shallow, 0, 0, brick), kd(LeafCriterion::Deep, 0, 0, brick),

@@ -51,22 +51,12 @@ TEST(Render, GridTakesFarFewerSamplesOnSparseData) {
   // image; the speed ratio itself is printed by `spaceskip bench`.
   Volume v = generateVolume("nbody", vec3l{256, 256, 256});
   auto tf = TransferFunction::preset("ramp", 0, 255);
+  double b[6];
+  v.worldBounds(b);
+  const Camera cam = orbitCamera(b, 10, 10, 1, false, 1);
   int64_t samples[2];
-  Image img[2];
-  int i = 0;
-  for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid}) {
-    Engine e(BackendKind::CPU);
-    e.setVolume(v);
-    e.setTransferFunction(tf);
-    e.setBuildParams(test::builder(k));
-    RenderParams rp;
-    rp.countSamples = true;
-    e.setRenderParams(rp);
-    double b[6];
-    v.worldBounds(b);
-    e.render(orbitCamera(b, 10, 10, 1, false, 1), 64, 64, img[i]);
-    samples[i++] = e.frameStats().samples;
-  }
+  Image img[2] = {test::renderCounting(v, tf, BuilderKind::Naive, cam, 64, samples[0]),
+                  test::renderCounting(v, tf, BuilderKind::Grid, cam, 64, samples[1])};
   EXPECT_GT(samples[0], 0);
   EXPECT_LT(samples[1] * 2, samples[0]) << "naive " << samples[0] << " grid " << samples[1];
   EXPECT_LE(compareImages(img[0], img[1]).maxAbs, 1.f / 255.f);

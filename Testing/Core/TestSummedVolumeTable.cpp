@@ -2,6 +2,8 @@
 #include "spaceskip/SummedVolumeTable.h"
 #include "TreeInvariants.h"
 
+#include "TestUtil.h"
+
 #include <gtest/gtest.h>
 
 #include <random>
@@ -9,17 +11,7 @@
 using namespace spaceskip;
 
 namespace {
-OccupancyGrid randomGrid(vec3i dims, double p, unsigned seed) {
-  OccupancyGrid g;
-  g.brick = 8;
-  g.dims = dims;
-  g.cellDims = vec3i{dims.x * 8, dims.y * 8, dims.z * 8};
-  g.occ.resize(size_t(g.size()));
-  std::mt19937 rng(seed);
-  std::bernoulli_distribution b(p);
-  for (auto& o : g.occ) g.occupied += (o = b(rng) ? 1 : 0);
-  return g;
-}
+using test::randomBrickGrid;
 
 int64_t bruteCount(const OccupancyGrid& g, const box3i& b) {
   int64_t c = 0;
@@ -42,7 +34,7 @@ box3i randomBox(vec3i d, std::mt19937& rng) {
 
 TEST(SummedVolumeTable, CountsAndShrinkMatchBruteForce) {
   for (double p : {0.002, 0.05, 0.5, 1.0}) {
-    OccupancyGrid g = randomGrid(vec3i{23, 17, 31}, p, unsigned(p * 1000) + 7);
+    OccupancyGrid g = randomBrickGrid(vec3i{23, 17, 31}, p, unsigned(p * 1000) + 7);
     SummedVolumeTable svt(g);
     EXPECT_EQ(svt.count(box3i{vec3i{0, 0, 0}, g.dims}), g.occupied);
     std::mt19937 rng(42);
@@ -59,7 +51,7 @@ TEST(SummedVolumeTable, CountsAndShrinkMatchBruteForce) {
 }
 
 TEST(SummedVolumeTable, EmptyAndSingleBrick) {
-  OccupancyGrid g = randomGrid(vec3i{9, 9, 9}, 0.0, 1);
+  OccupancyGrid g = randomBrickGrid(vec3i{9, 9, 9}, 0.0, 1);
   SummedVolumeTable svt(g);
   EXPECT_EQ(svt.count(box3i{vec3i{0, 0, 0}, g.dims}), 0);
   EXPECT_TRUE(svt.shrink(box3i{vec3i{0, 0, 0}, g.dims}).empty());
