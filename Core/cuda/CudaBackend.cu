@@ -402,12 +402,17 @@ class CudaBackend final : public Backend {
     out.width = f.width;
     out.height = f.height;
     out.rgba.resize(pixels);
-    SS_CUDA_CHECK(cudaMemcpyAsync(out.rgba.data(), d_image_.get(), pixels * sizeof(vec4f), cudaMemcpyDeviceToHost,
-                                  stream_));
+    // Through a pinned staging buffer (DMA at full link speed, then a parallel host copy): about
+    // twice as fast as a copy into the caller's pageable vector. Without pinned memory, direct.
+    const size_t imageBytes = pixels * sizeof(vec4f);
+    const bool staged = ensureStage(imageBytes);
+    SS_CUDA_CHECK(cudaMemcpyAsync(staged ? h_stage_ : static_cast<void*>(out.rgba.data()), d_image_.get(), imageBytes,
+                                  cudaMemcpyDeviceToHost, stream_));
     if (hostCounts)
       SS_CUDA_CHECK(cudaMemcpyAsync(hostCounts, d_counts_.get(), pixels * sizeof(unsigned), cudaMemcpyDeviceToHost,
                                     stream_));
     SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    if (staged) parallelCopy(out.rgba.data(), h_stage_, imageBytes);
     float ms = 0;
     SS_CUDA_CHECK(cudaEventElapsedTime(&ms, ev0_, ev1_));
     lastDeviceSeconds_ = double(ms) * 1e-3;
@@ -562,7 +567,26 @@ class CudaBackend final : public Backend {
     arrayBytes_ = 0;
   }
 
+  /// Grows the pinned staging buffer to `bytes`; false (direct copies) when pinned memory is
+  /// not available.
+  bool ensureStage(size_t bytes) {
+    if (stageBytes_ >= bytes) return true;
+    if (h_stage_) cudaFreeHost(h_stage_);
+    h_stage_ = nullptr;
+    stageBytes_ = 0;
+    if (cudaMallocHost(&h_stage_, bytes) != cudaSuccess) {
+      (void)cudaGetLastError();
+      h_stage_ = nullptr;
+      return false;
+    }
+    stageBytes_ = bytes;
+    return true;
+  }
+
   void releaseHandles() {
+    if (h_stage_) cudaFreeHost(h_stage_);
+    h_stage_ = nullptr;
+    stageBytes_ = 0;
     if (h_flags_) cudaFreeHost(h_flags_);
     if (ev0_) cudaEventDestroy(ev0_);
     if (ev1_) cudaEventDestroy(ev1_);
@@ -590,6 +614,8 @@ class CudaBackend final : public Backend {
   DeviceBuffer<float> d_sparse_;
   DeviceBuffer<Flags> d_flags_;
   Flags* h_flags_ = nullptr;
+  void* h_stage_ = nullptr;  ///< pinned copy of the last frame's image on its way to the caller
+  size_t stageBytes_ = 0;
   OccupancyGrid hostOcc_;
   bool hostOccValid_ = false;
   DeviceBuffer<vec4f> d_table_;

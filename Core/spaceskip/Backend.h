@@ -31,6 +31,8 @@ class Backend {
 };
 
 std::unique_ptr<Backend> makeCpuBackend();
+/// memcpy split over oneTBB workers (the CUDA backend's pinned staging buffer -> the caller's image).
+void parallelCopy(void* dst, const void* src, size_t bytes);
 /// Throws BackendError when built without CUDA or when no usable device exists.
 std::unique_ptr<Backend> makeCudaBackend();
 /// True when this build has CUDA code and a device answers.

@@ -6,7 +6,9 @@
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstring>
 
 namespace spaceskip {
 
@@ -111,6 +113,20 @@ class CpuBackend final : public Backend {
 }  // namespace
 
 std::unique_ptr<Backend> makeCpuBackend() { return std::make_unique<CpuBackend>(); }
+
+void parallelCopy(void* dst, const void* src, size_t bytes) {
+  constexpr size_t kChunk = size_t(1) << 20;
+  if (bytes <= kChunk) {
+    std::memcpy(dst, src, bytes);
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, (bytes + kChunk - 1) / kChunk), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t c = r.begin(); c != r.end(); ++c) {
+      const size_t off = c * kChunk;
+      std::memcpy(static_cast<char*>(dst) + off, static_cast<const char*>(src) + off, std::min(kChunk, bytes - off));
+    }
+  });
+}
 
 #ifndef SPACESKIP_HAVE_CUDA
 std::unique_ptr<Backend> makeCudaBackend() {
