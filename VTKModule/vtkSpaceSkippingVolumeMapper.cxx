@@ -40,6 +40,10 @@ namespace
 // Table resolution of the transfer function, sampled over the data's scalar range (what
 // vtkGPUVolumeRayCastMapper does by default, ColorRangeType == SCALAR).
 constexpr int kTableSize = 1024;
+// BuilderTypes are cast to spaceskip::BuilderKind: the two enums must stay in the same order.
+static_assert(static_cast<int>(spaceskip::BuilderKind::Hybrid) == vtkSpaceSkippingVolumeMapper::Hybrid &&
+    static_cast<int>(spaceskip::BuilderKind::DistanceGrid) == vtkSpaceSkippingVolumeMapper::DistanceGrid,
+  "vtkSpaceSkippingVolumeMapper::BuilderTypes out of step with spaceskip::BuilderKind");
 // Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
 constexpr double kErtThreshold = 0.99;
 
@@ -562,7 +566,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     bp.leaf = static_cast<spaceskip::LeafCriterion>(this->LeafCriterion);
     bp.maxLeafSize = this->MaxLeafSize;
     bp.bins = this->BinCount;
-    bp.brick = engine.buildParams().brick;
+    // A new size makes the engine recompute the value ranges, re-classify and rebuild.
+    bp.brick = this->MacroCellSize;
     engine.setBuildParams(bp);
     spaceskip::RenderParams rp = engine.renderParams();
     rp.sampleDistance = this->SampleDistance;
@@ -695,6 +700,7 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << "\n";
   os << indent << "MaxLeafSize: " << this->MaxLeafSize << "\n";
   os << indent << "BinCount: " << this->BinCount << "\n";
+  os << indent << "MacroCellSize: " << this->MacroCellSize << "\n";
   os << indent << "SampleDistance: " << this->SampleDistance << "\n";
   os << indent << "Backend: "
      << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";

@@ -46,7 +46,8 @@ public:
     KdTreeCPU,
     KdTreeGPU,
     KdTreeGPUFast,
-    Hybrid
+    Hybrid,
+    DistanceGrid
   };
   enum LeafCriterionTypes
   {
@@ -63,9 +64,11 @@ public:
   ///@{
   /**
    * The hierarchy builder (default Grid). Builders a backend cannot run fall back, with a
-   * logged warning, to the closest one it can (see GetBuilderUsed()).
+   * logged warning, to the closest one it can (see GetBuilderUsed()). DistanceGrid is the Grid
+   * DDA leaping through empty space with a capped Chebyshev distance field over the macro cells
+   * (CPU and CUDA); it is fastest on very sparse data with MacroCellSize 4.
    */
-  vtkSetClampMacro(Builder, int, Naive, Hybrid);
+  vtkSetClampMacro(Builder, int, Naive, DistanceGrid);
   vtkGetMacro(Builder, int);
   void SetBuilderToNaive() { this->SetBuilder(Naive); }
   void SetBuilderToGrid() { this->SetBuilder(Grid); }
@@ -75,6 +78,7 @@ public:
   void SetBuilderToKdTreeGPU() { this->SetBuilder(KdTreeGPU); }
   void SetBuilderToKdTreeGPUFast() { this->SetBuilder(KdTreeGPUFast); }
   void SetBuilderToHybrid() { this->SetBuilder(Hybrid); }
+  void SetBuilderToDistanceGrid() { this->SetBuilder(DistanceGrid); }
   const char* GetBuilderAsString();
   ///@}
 
@@ -105,6 +109,16 @@ public:
    */
   virtual void SetBinCount(int bins);
   vtkGetMacro(BinCount, int);
+  ///@}
+
+  ///@{
+  /**
+   * Edge of the macro cells in voxels used for classification and skipping (default 8, the
+   * paper's; clamped to [1, 64]); 4 suits very sparse data with DistanceGrid. A change redoes the
+   * per-cell value ranges, the classification and the hierarchy (the image stays the same).
+   */
+  vtkSetClampMacro(MacroCellSize, int, 1, 64);
+  vtkGetMacro(MacroCellSize, int);
   ///@}
 
   ///@{
@@ -176,6 +190,7 @@ protected:
   int LeafCriterion = Deep;
   int MaxLeafSize = 0;
   int BinCount = 4;
+  int MacroCellSize = 8;
   double SampleDistance = 0.0;
   int Backend = Auto;
   vtkTypeBool EarlyRayTermination = 1;

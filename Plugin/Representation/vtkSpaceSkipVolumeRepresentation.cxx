@@ -55,6 +55,14 @@ int vtkSpaceSkipVolumeRepresentation::GetBinCount()
 {
   return this->SpaceSkipMapper->GetBinCount();
 }
+void vtkSpaceSkipVolumeRepresentation::SetMacroCellSize(int v)
+{
+  this->SpaceSkipMapper->SetMacroCellSize(v);
+}
+int vtkSpaceSkipVolumeRepresentation::GetMacroCellSize()
+{
+  return this->SpaceSkipMapper->GetMacroCellSize();
+}
 void vtkSpaceSkipVolumeRepresentation::SetSampleDistance(double v)
 {
   this->SpaceSkipMapper->SetSampleDistance(v);

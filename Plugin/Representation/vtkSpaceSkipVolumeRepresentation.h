@@ -39,6 +39,8 @@ public:
   int GetMaxLeafSize();
   void SetBinCount(int bins);
   int GetBinCount();
+  void SetMacroCellSize(int size);
+  int GetMacroCellSize();
   void SetSampleDistance(double distance);
   double GetSampleDistance();
   void SetBackend(int backend);

@@ -19,7 +19,7 @@ ok.check("Volume" in types, "the stock 'Volume' type is still offered")
 
 enums = {
     "Builder": ["Naive", "Grid", "LBVH", "LBVHCPU", "KdTreeCPU", "KdTreeGPU", "KdTreeGPUFast",
-                "Hybrid"],
+                "Hybrid", "DistanceGrid"],
     "LeafCriterion": ["Shallow", "Deep"],
     "Backend": ["Auto", "CPU", "CUDA"],
 }
@@ -29,7 +29,8 @@ for name, entries in enums.items():
     if prop is not None:
         ok.check(list(prop.Available) == entries, "%s entries %s" % (name, list(prop.Available)))
 
-ranges = {"MaxLeafSize": (0, 1024), "BinCount": (0, 64)}  # BinCount 0: the sweep
+ranges = {"MaxLeafSize": (0, 1024), "BinCount": (0, 64),  # BinCount 0: the sweep
+          "MacroCellSize": (1, 64)}
 for name, (lo, hi) in ranges.items():
     dom = disp.GetProperty(name).SMProperty.GetDomain("range")
     ok.check(dom is not None and dom.GetMinimum(0) == lo and dom.GetMaximum(0) == hi,
@@ -37,11 +38,13 @@ for name, (lo, hi) in ranges.items():
 dom = disp.GetProperty("SampleDistance").SMProperty.GetDomain("range")
 ok.check(dom is not None and dom.GetMinimumExists(0) and dom.GetMinimum(0) == 0.0,
          "SampleDistance range domain min 0")
+ok.check(disp.GetPropertyValue("MacroCellSize") == 8, "MacroCellSize defaults to 8 (%r)"
+         % disp.GetPropertyValue("MacroCellSize"))
 ok.check(disp.GetProperty("EarlyRayTermination").SMProperty.GetDomain("bool") is not None,
          "EarlyRayTermination boolean domain")
 
-for name in ["Builder", "LeafCriterion", "MaxLeafSize", "BinCount", "SampleDistance", "Backend",
-             "EarlyRayTermination"]:
+for name in ["Builder", "LeafCriterion", "MaxLeafSize", "BinCount", "MacroCellSize",
+             "SampleDistance", "Backend", "EarlyRayTermination"]:
     smprop = disp.GetProperty(name).SMProperty
     doc = smprop.GetDocumentation()
     ok.check(doc is not None and len(doc.GetDescription() or "") > 40,

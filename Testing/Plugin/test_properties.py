@@ -1,6 +1,7 @@
 """Every mapper property round-trips (proxy -> representation -> mapper and back) and changes
 the rendering the way it should: builders change the hierarchy but not the image; the leaf
-criterion and the max leaf size change the k-d tree; the sample distance changes the image but
+criterion and the max leaf size change the k-d tree; the macro-cell size re-classifies but keeps
+the image; the sample distance changes the image but
 not the hierarchy; the backend is the one asked for (or the documented CPU fallback); early ray
 termination keeps the image and saves time on an opaque volume."""
 from paraview.simple import *
@@ -47,7 +48,8 @@ for i, name in enumerate(names):
         ok.check(s["BuildCount"] == before["BuildCount"] + 1,
                  "Builder %s: exactly one rebuild (%d -> %d)" % (name, before["BuildCount"],
                                                                s["BuildCount"]))
-    if s["BuilderUsed"] == name and name not in ("Naive", "Grid"):
+    # Naive, Grid and DistanceGrid march the macro-cell grid itself: no tree to report.
+    if s["BuilderUsed"] == name and name not in ("Naive", "Grid", "DistanceGrid"):
         ok.check(s["NodeCount"] >= 1 and s["LeafCount"] >= 1,
                  "Builder %s: hierarchy reported (%d nodes, %d leaves, height %d)"
                  % (name, s["NodeCount"], s["LeafCount"], s["TreeHeight"]))
@@ -55,6 +57,35 @@ for i, name in enumerate(names):
         print("note: Builder %s fell back to %s on this machine" % (name, s["BuilderUsed"]))
     ok.check(0.0 < s["Occupancy"] < 1.0, "Builder %s: occupancy %.3f in (0, 1)"
              % (name, s["Occupancy"]))
+
+# -- MacroCellSize: 4^3 cells (DistanceGrid's best on sparse data) re-classify, image stays ----
+disp.Builder = "DistanceGrid"
+shot("prop_dg_cell8.png")
+before = ssptest.stats(disp)
+roundtrip("MacroCellSize", 4, 4)
+cell4_img = shot("prop_dg_cell4.png")
+after = ssptest.stats(disp)
+ok.check(after["BuilderUsed"] == "DistanceGrid",
+         "DistanceGrid ran with MacroCellSize 4 (ran %s)" % after["BuilderUsed"])
+ok.check(after["ClassifyCount"] == before["ClassifyCount"] + 1
+         and after["BuildCount"] == before["BuildCount"] + 1,
+         "MacroCellSize change re-classifies and rebuilds once (classify %d -> %d, build %d -> %d)"
+         % (before["ClassifyCount"], after["ClassifyCount"], before["BuildCount"],
+            after["BuildCount"]))
+# Each 8^3 cell is the union of eight 4^3 cells: the finer grid leaves less of the shell occupied.
+ok.check(0.0 < after["Occupancy"] < before["Occupancy"],
+         "4^3 cells: smaller occupied fraction (%.4f < %.4f)" % (after["Occupancy"],
+                                                              before["Occupancy"]))
+diff = abs(naive - cell4_img).max()
+ok.check(diff <= 1, "DistanceGrid, MacroCellSize 4 renders the Naive image (max %d/255, PSNR %.2f dB)"
+         % (diff, ssptest.psnr(naive, cell4_img)))
+roundtrip("MacroCellSize", 0, 1)  # the mapper clamps to [1, 64]
+roundtrip("MacroCellSize", 100, 64)
+roundtrip("MacroCellSize", 8, 8)
+cell8_img = shot("prop_dg_cell8_again.png")
+ok.check(ssptest.stats(disp)["ClassifyCount"] == after["ClassifyCount"] + 1,
+         "back to MacroCellSize 8 re-classifies once")
+ok.check(abs(naive - cell8_img).max() <= 1, "MacroCellSize 8 again renders the Naive image")
 
 # -- LeafCriterion and MaxLeafSize: the k-d tree's shape ---------------------------------------
 disp.Builder = "KdTreeCPU"
