@@ -38,7 +38,7 @@ simple.ResetCamera(view)
 simple.GetActiveCamera().Dolly(1.6)
 
 print("%-14s %-8s %10s %10s %8s %8s %12s" % ("builder", "backend", "build_ms", "frame_ms", "nodes", "height", "wall_fps"))
-for builder in ["Naive", "Grid", "LBVH", "KdTreeCPU", "KdTreeGPUFast", "Hybrid"]:
+for builder in ["Naive", "Grid", "DistanceGrid", "LBVH", "KdTreeCPU", "KdTreeGPUFast", "Hybrid"]:
     rep.Builder = builder
     simple.Render(view)  # builds the hierarchy
     frames, t0 = 3, time.perf_counter()
