@@ -212,13 +212,9 @@ __global__ void rootKernel(SvtView svt, box3i* out) {
   out[0] = svt(all);
 }
 
-// One thread per node of the level: writes the node's box and decides leaf or split.
-__global__ void levelDecideKernel(const box3i* boxes, int n, int levelStart, KdSplitParams p, SvtView svt,
-                                  Node* nodes, int* flags, box3i* childBoxes) {
-  const int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i >= n) return;
-  const box3i box = boxes[i];
-  KdDecision d = decideKdSplit(box, p, svt);
+// Stores node i of the level (its box, no children yet) and its split decision.
+__device__ void storeDecision(int64_t i, int levelStart, const box3i& box, const KdDecision& d, Node* nodes, int* flags,
+                              box3i* childBoxes) {
   Node node;
   node.box = box;
   node.child = -1;
@@ -227,6 +223,15 @@ __global__ void levelDecideKernel(const box3i* boxes, int n, int levelStart, KdS
   flags[i] = d.split;
   childBoxes[2 * i] = d.left;
   childBoxes[2 * i + 1] = d.right;
+}
+
+// One thread per node of the level: writes the node's box and decides leaf or split.
+__global__ void levelDecideKernel(const box3i* boxes, int n, int levelStart, KdSplitParams p, SvtView svt,
+                                  Node* nodes, int* flags, box3i* childBoxes) {
+  const int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  const box3i box = boxes[i];
+  storeDecision(i, levelStart, box, decideKdSplit(box, p, svt), nodes, flags, childBoxes);
 }
 
 // Sweep (bins == 0): up to bricks/step - 1 candidates per node (255 for a 2048^3 root with 8^3
@@ -270,14 +275,7 @@ __global__ void levelDecideSweepKernel(const box3i* boxes, int n, int levelStart
   } else {
     d = kdMlsSplit(box, axis, p, svt);
   }
-  Node node;
-  node.box = box;
-  node.child = -1;
-  node.pad = 0;
-  nodes[levelStart + i] = node;
-  flags[i] = d.split;
-  childBoxes[2 * i] = d.left;
-  childBoxes[2 * i + 1] = d.right;
+  storeDecision(i, levelStart, box, d, nodes, flags, childBoxes);
 }
 
 // One thread per node of the level: links split nodes to their child pair in the next level.
