@@ -108,7 +108,7 @@ struct TextureSampler {
 // tree traversal (64 per thread, half occupancy), which the naive and grid marches do not need.
 // SPACESKIP_CUDA_HW_MIN_BLOCKS > 1 asks the hardware-filtered kernels to fit that many blocks of
 // 256 threads per SM (a register cap). Measured on the H100 (round 3): 6 (40 registers) made
-// every ESS kernel 4-7% slower than no cap, so the default is 1 (no cap).
+// every ESS kernel 4-11% slower than no cap, so the default is 1 (no cap).
 constexpr int kMaxRenderThreads = 256;
 // Default launch of the hardware-filtered kernels: plain for volumes up to kLargeTextureBytes; a
 // persistent launch with kLargeTextureResident blocks of 128 threads per SM above. Measured on
@@ -198,14 +198,14 @@ class CudaBackend final : public Backend {
         blockY_ = h;
       }
     }
-    // Tuning knob for measurements: SPACESKIP_CUDA_CARVEOUT=0..100 (percent of the unified L1 /
-    // shared memory given to shared memory for the render kernels; 0 = largest L1).
     int dev = 0;
     if (cudaGetDevice(&dev) != cudaSuccess ||
         cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
       (void)cudaGetLastError();
       numSMs_ = 1;
     }
+    // Tuning knob for measurements: SPACESKIP_CUDA_CARVEOUT=0..100 (percent of the unified L1 /
+    // shared memory given to shared memory for the render kernels; 0 = largest L1).
     if (const char* c = std::getenv("SPACESKIP_CUDA_CARVEOUT")) {
       const int v = std::atoi(c);
       if (v >= 0 && v <= 100) carveout_ = v;
@@ -478,21 +478,21 @@ class CudaBackend final : public Backend {
   void launchRender(const FrameView& f, const Sampler& s, dim3 grid, dim3 block) {
     // SPACESKIP_CUDA_RESIDENT=N: persistent launch with N blocks per SM taking tiles from a
     // counter (0: one block per tile, the plain launch). Read per frame (bench items set it).
-    residentBlocks_ = std::is_same<Sampler, TextureSampler>::value && arrayBytes_ > kLargeTextureBytes
-                          ? std::max(1, kLargeTextureResident * 128 / int(block.x * block.y))
-                          : 0;
-    if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks_ = std::max(0, std::atoi(r));
+    int residentBlocks = std::is_same<Sampler, TextureSampler>::value && arrayBytes_ > kLargeTextureBytes
+                             ? std::max(1, kLargeTextureResident * 128 / int(block.x * block.y))
+                             : 0;
+    if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks = std::max(0, std::atoi(r));
     RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f.traversal);
     if (carveout_ >= 0)
       SS_CUDA_CHECK(cudaFuncSetAttribute(k, cudaFuncAttributePreferredSharedMemoryCarveout, carveout_));
-    if (residentBlocks_ <= 0) {
+    if (residentBlocks <= 0) {
       k<<<grid, block, 0, stream_>>>(f, s, d_image_.get(), nullptr);
       return;
     }
     d_tileCounter_.reserve(1);
     SS_CUDA_CHECK(cudaMemsetAsync(d_tileCounter_.get(), 0, sizeof(unsigned), stream_));
     const unsigned tiles = grid.x * grid.y;
-    const unsigned blocks = std::min(tiles, unsigned(residentBlocks_) * unsigned(numSMs_));
+    const unsigned blocks = std::min(tiles, unsigned(residentBlocks) * unsigned(numSMs_));
     k<<<blocks, block, 0, stream_>>>(f, s, d_image_.get(), d_tileCounter_.get());
   }
 
@@ -639,7 +639,6 @@ class CudaBackend final : public Backend {
   double lastDeviceSeconds_ = -1;
   unsigned blockX_ = 16, blockY_ = 8;
   int carveout_ = -1;  ///< -1: the driver's choice
-  int residentBlocks_ = 0;  ///< > 0: persistent launch with this many blocks per SM
   int numSMs_ = 1;
   DeviceBuffer<unsigned> d_tileCounter_;
 };

@@ -32,24 +32,18 @@ SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin
   vec3f p = r.org + r.dir * tmin;
   int cell[3], step[3];
   float tNext[3], tDelta[3];
+  // Where the ray leaves cell c along axis a (the cell's far face in the step direction).
+  auto exitOf = [&](int a, int c) {
+    return step[a] == 0 ? INFINITY : (float(step[a] > 0 ? c + 1 : c) * B - r.org[a]) * inv[a];
+  };
   for (int a = 0; a < 3; ++a) {
     int c = int(floorf(p[a] / B));
     c = ss_maxi(0, ss_mini(c, g.dims[a] - 1));
     cell[a] = c;
-    float d = r.dir[a];
-    if (d > 0.f) {
-      step[a] = 1;
-      tNext[a] = (float(c + 1) * B - r.org[a]) * inv[a];
-      tDelta[a] = B * inv[a];
-    } else if (d < 0.f) {
-      step[a] = -1;
-      tNext[a] = (float(c) * B - r.org[a]) * inv[a];
-      tDelta[a] = -B * inv[a];
-    } else {
-      step[a] = 0;
-      tNext[a] = INFINITY;
-      tDelta[a] = INFINITY;
-    }
+    const float d = r.dir[a];
+    step[a] = d > 0.f ? 1 : d < 0.f ? -1 : 0;
+    tDelta[a] = step[a] == 0 ? INFINITY : float(step[a]) * B * inv[a];
+    tNext[a] = exitOf(a, c);
   }
   float t = tmin;
   float runStart = -1.f;
@@ -71,9 +65,7 @@ SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin
       float tJump = INFINITY;
       int ja = 0;
       for (int a = 0; a < 3; ++a) {
-        if (step[a] == 0) continue;
-        const float plane = step[a] > 0 ? float(cell[a] + rad + 1) * B : float(cell[a] - rad) * B;
-        const float ta = (plane - r.org[a]) * inv[a];
+        const float ta = exitOf(a, cell[a] + step[a] * rad);  // the cube's far face on axis a
         if (ta < tJump) {
           tJump = ta;
           ja = a;
@@ -91,8 +83,7 @@ SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin
         }
         if (c < 0 || c >= g.dims[a]) return true;  // left the grid
         cell[a] = c;
-        if (step[a] > 0) tNext[a] = (float(c + 1) * B - r.org[a]) * inv[a];
-        else if (step[a] < 0) tNext[a] = (float(c) * B - r.org[a]) * inv[a];
+        tNext[a] = exitOf(a, c);
       }
       t = ss_max(t, tJump);
       continue;
