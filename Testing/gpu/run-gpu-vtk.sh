@@ -12,7 +12,8 @@
 #          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024)
 #   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), DEADLINE (epoch seconds: phases that would
 #          start after it are skipped), MEMCHECK_TESTS, BENCH_BUILDERS, VTK_GPU (1: also time
-#          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks)
+#          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks), REQUIRE_NVIDIA_GL (set: stop
+#          when only Mesa works)
 #
 # OUTDIR receives at most 8 files (the device tool's limit): env.txt, tests.log, memcheck.log,
 # bench.log, bench.csv, cli-bench.log, cli-bench.csv, logs.tgz (everything).
@@ -53,15 +54,34 @@ log "bundle unpacked ($(cat "$B/vtk/COMMIT" 2>/dev/null | head -1))"
 [ -x /usr/bin/xkbcomp ] || cp "$B/x/bin/xkbcomp" /usr/bin/xkbcomp
 dpy=${XDISPLAY:-77}
 export DISPLAY=:$dpy
-LD_LIBRARY_PATH=$B/x/lib LIBGL_DRIVERS_PATH=$B/x/lib/dri \
-  "$B/x/bin/Xvfb" :$dpy -screen 0 1280x1024x24 -nolisten tcp -noreset -xkbdir "$B/x/share/xkb" \
-  > "$work/xvfb.log" 2>&1 &
-xpid=$!
-for _ in $(seq 50); do [ -S /tmp/.X11-unix/X$dpy ] && break; sleep 0.2; done
-log "Xvfb pid $xpid socket $(ls /tmp/.X11-unix/X$dpy 2>&1)"
+start_xvfb() {  # [extra Xvfb options]
+  LD_LIBRARY_PATH=$B/x/lib LIBGL_DRIVERS_PATH=$B/x/lib/dri \
+    "$B/x/bin/Xvfb" :$dpy -screen 0 1280x1024x24 -nolisten tcp -noreset -xkbdir "$B/x/share/xkb" "$@" \
+    >> "$work/xvfb.log" 2>&1 &
+  xpid=$!
+  for _ in $(seq 50); do [ -S /tmp/.X11-unix/X$dpy ] && break; sleep 0.2; done
+  log "Xvfb $* pid $xpid socket $(ls /tmp/.X11-unix/X$dpy 2>&1)"
+}
+stop_xvfb() {
+  kill $xpid 2>/dev/null
+  wait $xpid 2>/dev/null
+  rm -f /tmp/.X11-unix/X$dpy /tmp/.X$dpy-lock
+}
+start_xvfb
 
 # --- GL for the clients: NVIDIA first, Mesa (llvmpipe, bundled) as the fallback ---------------
-export LD_LIBRARY_PATH=$B/vtk/lib
+# NVIDIA's GLX vendor library: where the machine keeps it (its loader path is kept after ours).
+sys_ldpath=${LD_LIBRARY_PATH:-}
+nvglx=$( (ldconfig -p | awk '/libGLX_nvidia\.so\.0/ {print $NF}'; for d in ${sys_ldpath//:/ } \
+  /usr/local/nvidia/lib64 /usr/local/nvidia/lib /usr/lib/x86_64-linux-gnu /usr/lib64; do
+  ls "$d"/libGLX_nvidia.so.0 2>/dev/null; done) | head -1)
+nvdir=${nvglx:+$(dirname "$nvglx")}
+{
+  echo "LD_LIBRARY_PATH at start: $sys_ldpath"
+  echo "libGLX_nvidia: ${nvglx:-not found}"
+  ls -la /usr/local/nvidia/lib64 2>/dev/null | grep -iE "GLX|EGL|libGL|nvidia-gl|glcore|tls" | head -12
+} >> "$work/env.txt"
+export LD_LIBRARY_PATH=$B/vtk/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
 export __GLX_VENDOR_LIBRARY_NAME=nvidia
 bench=$B/vtk/bin/spaceskip_window_bench
 tests=$B/vtk/bin/vtkSpaceSkipCxxTests
@@ -71,14 +91,31 @@ if probe && grep -q "GL_RENDERER.*NVIDIA" "$work/probe.log"; then
   gl="NVIDIA GL (__GLX_VENDOR_LIBRARY_NAME=nvidia)"
 else
   cp "$work/probe.log" "$work/probe-nvidia.log"
-  unset __GLX_VENDOR_LIBRARY_NAME
-  export LD_LIBRARY_PATH=$B/vtk/lib:$B/x/lib LIBGL_DRIVERS_PATH=$B/x/lib/dri
-  probe
-  gl="FALLBACK: Mesa (NVIDIA GL failed: see probe-nvidia.log)"
+  LD_DEBUG=libs probe 2>/dev/null; grep -iE "GLX_nvidia|glcore|libGLX|error" "$work/probe.log" | head -20 > "$work/probe-nvidia-ld.log"
+  # Indirect GLX allowed: does NVIDIA's client want it on a non-NVIDIA server?
+  stop_xvfb
+  start_xvfb +iglx
+  if probe && grep -q "GL_RENDERER.*NVIDIA" "$work/probe.log"; then
+    gl="NVIDIA GL (__GLX_VENDOR_LIBRARY_NAME=nvidia, Xvfb +iglx)"
+  else
+    cp "$work/probe.log" "$work/probe-nvidia-iglx.log"
+    stop_xvfb
+    start_xvfb
+    unset __GLX_VENDOR_LIBRARY_NAME
+    export LD_LIBRARY_PATH=$B/vtk/lib:$B/x/lib${sys_ldpath:+:$sys_ldpath} LIBGL_DRIVERS_PATH=$B/x/lib/dri
+    probe
+    gl="FALLBACK: Mesa (NVIDIA GL failed: see probe-nvidia*.log)"
+  fi
 fi
 log "client GL: $gl; $(grep GL_RENDERER "$work/probe.log")"
 { echo "client GL: $gl"; grep GL_RENDERER "$work/probe.log"; } >> "$work/env.txt"
 cp "$work/env.txt" "$out/env.txt"
+if [ -n "${REQUIRE_NVIDIA_GL:-}" ] && [ "${gl#FALLBACK}" != "$gl" ]; then
+  log "REQUIRE_NVIDIA_GL set and NVIDIA GL failed: stopping"
+  stop_xvfb
+  tar -C "$work" --exclude=bundle -czf "$out/logs.tgz" . 2>/dev/null
+  exit 3
+fi
 
 # --- the VTK mapper tests, CUDA forced --------------------------------------------------------
 cxx=$src/VTKModule/Testing/Cxx/CMakeLists.txt
@@ -153,7 +190,7 @@ has bench-nbody1024 && window_bench nbody 1024 "${vg[@]}"
 has bench-nbody2048 && window_bench nbody 2048
 has bench-menger1024 && window_bench menger 1024 "${vg[@]}"
 
-kill $xpid 2>/dev/null
+stop_xvfb
 tar -C "$work" --exclude=bundle -czf "$out/logs.tgz" . 2>/dev/null
 log "done, status=$status"
 exit $status
