@@ -2,7 +2,7 @@
 # Packs, on the development machine (Debian 12 + ParaView 5.11), what the VTK mapper tests and the
 # window benchmark need on a GPU machine that has no VTK, X server or GL loader (DEVICE.md):
 #   .vtkbundle/vtk.tar.xz  bin/: vtkSpaceSkipCxxTests, spaceskip_window_bench, spaceskip (CLI);
-#                          lib/: libvtkSpaceSkip.so (built with CUDA) + the closure of shared
+#                          lib/: libvtkSpaceSkip.so (built with CUDA), libEGL (glvnd) + the closure of shared
 #                          libraries they load (ldd), minus glibc and libstdc++/libgcc_s (the
 #                          GPU machine's own are newer);
 #   .vtkbundle/x.tar.xz    Xvfb + xkbcomp + xkb data, Mesa's swrast_dri.so (Xvfb's GLX needs a
@@ -56,6 +56,8 @@ for exe in bin/vtkSpaceSkipCxxTests bin/spaceskip_window_bench Core/spaceskip; d
 done
 cp -L "$build/lib/libvtkSpaceSkip.so" "$v/lib/"
 copy_libs "$v/lib" "$v/bin/"* "$build/lib/libvtkSpaceSkip.so"
+# glvnd's libEGL, dlopen()ed by the window benchmark's --egl mode (NVIDIA's headless EGL).
+cp -L "$multiarch/libEGL.so.1" "$v/lib/"
 strip --strip-unneeded "$v/bin/"* "$v/lib/libvtkSpaceSkip.so"*
 (cd "$src" && git rev-parse HEAD 2>/dev/null; git -C "$src" status --short | head -20) > "$v/COMMIT" || true
 tar -C "$stage" -cf - vtk | xz -9 -T2 > "$out/vtk.tar.xz.tmp"

@@ -13,7 +13,7 @@
 #   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), DEADLINE (epoch seconds: phases that would
 #          start after it are skipped), MEMCHECK_TESTS, BENCH_BUILDERS, VTK_GPU (1: also time
 #          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks), REQUIRE_NVIDIA_GL (set: stop
-#          when only Mesa works)
+#          when only Mesa works), BENCH_N (every benchmark at this size instead: quick checks)
 #
 # OUTDIR receives at most 8 files (the device tool's limit): env.txt, tests.log, memcheck.log,
 # bench.log, bench.csv, cli-bench.log, cli-bench.csv, logs.tgz (everything).
@@ -165,13 +165,13 @@ fi
 # --- window benchmark + the CLI's kernel timings, same volume, builders, camera and TF ---------
 wb=${BENCH_BUILDERS:-Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4}
 cb=naive,grid,lbvh,lbvh-cpu,kdtree-cpu:mls32,kdtree-gpu-fast:mls32,hybrid,distance-grid,distance-grid:brick4
-window_bench() {  # SHAPE N [--vtk-gpu]
-  local shape=$1 n=$2
+window_bench() {  # SHAPE N [--vtk-gpu] [--egl]
+  local shape=$1 n=${BENCH_N:-$2}
   shift 2
   late && { log "skip bench $shape$n (deadline)"; return; }
   log "window bench $shape $n^3 $*"
   SPACESKIP_BACKEND=cuda timeout 420 "$bench" --shape "$shape" --dims "$n" --frames "$frames" \
-    --size 1024 --builders "$wb" --csv "$out/bench.csv" "$@" >> "$work/bench.log" 2>&1
+    --size 1024 --builders "$wb" --csv "$out/bench.csv" --png "$work/frame" "$@" >> "$work/bench.log" 2>&1
   log "window bench rc=$?"
   cp "$work/bench.log" "$out/bench.log"
   log "CLI bench gen:$shape:$n"
@@ -186,8 +186,26 @@ window_bench() {  # SHAPE N [--vtk-gpu]
 }
 vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
+# The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
+# vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024; then
+  egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
+  [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
+  if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
+      > "$work/probe-egl.log" 2>&1 && grep -q "GL_RENDERER.*NVIDIA" "$work/probe-egl.log"; then
+    vg+=(--egl)
+    wgl="NVIDIA EGL ($egl_json), vtkGenericOpenGLRenderWindow on a pbuffer"
+  else
+    wgl="the tests' X window ($gl): NVIDIA EGL failed, see probe-egl.log"
+  fi
+  log "window benchmark GL: $wgl; $(grep GL_RENDERER "$work/probe-egl.log")"
+  { echo "window benchmark GL: $wgl"; grep GL_RENDERER "$work/probe-egl.log"; } >> "$work/env.txt"
+  cp "$work/env.txt" "$out/env.txt"
+fi
 has bench-nbody1024 && window_bench nbody 1024 "${vg[@]}"
-has bench-nbody2048 && window_bench nbody 2048
+v2=()
+for a in "${vg[@]}"; do [ "$a" = --vtk-gpu ] || v2+=("$a"); done
+has bench-nbody2048 && window_bench nbody 2048 "${v2[@]}"
 has bench-menger1024 && window_bench menger 1024 "${vg[@]}"
 
 stop_xvfb

@@ -7,12 +7,19 @@
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
 //       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN]] [--vtk-gpu] [--csv FILE]
+//       [--egl] [--png PREFIX (the last timed frame of each item)]
+// --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
+// headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
+// config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
+#include "vtkCallbackCommand.h"
 #include "vtkCamera.h"
 #include "vtkColorTransferFunction.h"
+#include "vtkGenericOpenGLRenderWindow.h"
 #include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkPNGWriter.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
 #include "vtkRenderWindow.h"
@@ -22,24 +29,141 @@
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
+#include "vtkWindowToImageFilter.h"
 #include "vtk_glew.h"
 
 #include "spaceskip/Generators.h"
+
+#include <X11/Xlib.h>
+#include <dlfcn.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+// GLEW's glewInit() ends with its GLX part, which fails without a current GLX context's display
+// (an EGL context has none). This definition, exported from the executable, interposes libGLX's
+// and hands GLEW a plain X connection in --egl mode; otherwise it forwards to libGLX.
+static Display* gEglModeDisplay = nullptr;
+extern "C" __attribute__((visibility("default"))) Display* glXGetCurrentDisplay()
+{
+  if (gEglModeDisplay)
+  {
+    return gEglModeDisplay;
+  }
+  using Fn = Display* (*)();
+  static Fn real = reinterpret_cast<Fn>(dlsym(RTLD_NEXT, "glXGetCurrentDisplay"));
+  return real ? real() : nullptr;
+}
+// GLEW loads glXGetCurrentDisplay through glXGetProcAddressARB: hand it the one above.
+extern "C" __attribute__((visibility("default"))) void* glXGetProcAddressARB(const unsigned char* name)
+{
+  if (gEglModeDisplay && std::strcmp(reinterpret_cast<const char*>(name), "glXGetCurrentDisplay") == 0)
+  {
+    return reinterpret_cast<void*>(&glXGetCurrentDisplay);
+  }
+  using Fn = void* (*)(const unsigned char*);
+  static Fn real = reinterpret_cast<Fn>(dlsym(RTLD_NEXT, "glXGetProcAddressARB"));
+  return real ? real(name) : nullptr;
+}
+
 namespace
 {
+// EGL through dlopen (no EGL headers or link dependency for CI): an OpenGL 3.2+ context on a
+// pbuffer, made current for good.
+bool MakeEglContext(int w, int h, std::string& why)
+{
+  void* lib = dlopen("libEGL.so.1", RTLD_NOW | RTLD_GLOBAL);
+  if (!lib)
+  {
+    why = "no libEGL.so.1";
+    return false;
+  }
+  using Ptr = void*;
+  using Int = int32_t;
+  auto sym = [&](const char* n) { return dlsym(lib, n); };
+  auto getProc = reinterpret_cast<void* (*)(const char*)>(sym("eglGetProcAddress"));
+  auto getDisplay = reinterpret_cast<Ptr (*)(Ptr)>(sym("eglGetDisplay"));
+  auto initialize = reinterpret_cast<unsigned (*)(Ptr, Int*, Int*)>(sym("eglInitialize"));
+  auto chooseConfig = reinterpret_cast<unsigned (*)(Ptr, const Int*, Ptr*, Int, Int*)>(sym("eglChooseConfig"));
+  auto createPbuffer = reinterpret_cast<Ptr (*)(Ptr, Ptr, const Int*)>(sym("eglCreatePbufferSurface"));
+  auto bindApi = reinterpret_cast<unsigned (*)(unsigned)>(sym("eglBindAPI"));
+  auto createContext = reinterpret_cast<Ptr (*)(Ptr, Ptr, Ptr, const Int*)>(sym("eglCreateContext"));
+  auto makeCurrent = reinterpret_cast<unsigned (*)(Ptr, Ptr, Ptr, Ptr)>(sym("eglMakeCurrent"));
+  auto getError = reinterpret_cast<Int (*)()>(sym("eglGetError"));
+  if (!getDisplay || !initialize || !chooseConfig || !createPbuffer || !bindApi || !createContext ||
+    !makeCurrent || !getError || !getProc)
+  {
+    why = "libEGL.so.1 lacks EGL 1.4 entry points";
+    return false;
+  }
+  Ptr dpy = nullptr;
+  Int major = 0, minor = 0;
+  // The first device (EGL_EXT_platform_device), else the default display.
+  auto queryDevices = reinterpret_cast<unsigned (*)(Int, Ptr*, Int*)>(getProc("eglQueryDevicesEXT"));
+  auto platformDisplay = reinterpret_cast<Ptr (*)(unsigned, Ptr, const Int*)>(getProc("eglGetPlatformDisplayEXT"));
+  Ptr devices[8];
+  Int nDevices = 0;
+  if (queryDevices && platformDisplay && queryDevices(8, devices, &nDevices) && nDevices > 0)
+  {
+    dpy = platformDisplay(0x313F /* EGL_PLATFORM_DEVICE_EXT */, devices[0], nullptr);
+  }
+  if (!dpy || !initialize(dpy, &major, &minor))
+  {
+    dpy = getDisplay(nullptr /* EGL_DEFAULT_DISPLAY */);
+    if (!dpy || !initialize(dpy, &major, &minor))
+    {
+      why = "eglInitialize failed, error 0x" + std::to_string(getError());
+      return false;
+    }
+  }
+  const Int cfgAttribs[] = { 0x3033 /* SURFACE_TYPE */, 0x0001 /* PBUFFER_BIT */, 0x3024, 8, 0x3023, 8,
+    0x3022, 8, 0x3021, 8, 0x3025 /* DEPTH */, 24, 0x3040 /* RENDERABLE_TYPE */, 0x0008 /* OPENGL_BIT */,
+    0x3038 /* NONE */ };
+  Ptr cfg = nullptr;
+  Int n = 0;
+  if (!chooseConfig(dpy, cfgAttribs, &cfg, 1, &n) || n < 1)
+  {
+    why = "eglChooseConfig found no OpenGL pbuffer config";
+    return false;
+  }
+  const Int pbAttribs[] = { 0x3057 /* WIDTH */, w, 0x3056 /* HEIGHT */, h, 0x3038 };
+  Ptr surf = createPbuffer(dpy, cfg, pbAttribs);
+  bindApi(0x30A2 /* EGL_OPENGL_API */);
+  const Int ctxAttribs[] = { 0x3098 /* MAJOR */, 3, 0x30FB /* MINOR */, 2, 0x30FD /* PROFILE_MASK */,
+    0x1 /* CORE */, 0x3038 };
+  Ptr ctx = createContext(dpy, cfg, nullptr, ctxAttribs);
+  if (!surf || !ctx || !makeCurrent(dpy, surf, surf, ctx))
+  {
+    why = "EGL pbuffer/context/make-current failed, error 0x" + std::to_string(getError());
+    return false;
+  }
+  return true;
+}
+
 using Clock = std::chrono::steady_clock;
+
+// The window's last frame as PNG (evidence of what the timed frames showed).
+void SavePng(vtkRenderWindow* win, const std::string& path)
+{
+  vtkNew<vtkWindowToImageFilter> w2i;
+  w2i->SetInput(win);
+  w2i->ReadFrontBufferOff();
+  w2i->ShouldRerenderOff();
+  w2i->Update();
+  vtkNew<vtkPNGWriter> png;
+  png->SetFileName(path.c_str());
+  png->SetInputConnection(w2i->GetOutputPort());
+  png->Write();
+}
 double Since(Clock::time_point t0)
 {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -161,10 +285,10 @@ void Orbit(vtkRenderer* ren, const double b[6], double az, double el)
 
 int main(int argc, char* argv[])
 {
-  std::string shape = "nbody", csvPath, builders =
+  std::string shape = "nbody", csvPath, pngPrefix, builders =
     "Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4";
   int n = 256, frames = 16, size = 1024, edits = 4;
-  bool vtkGpu = false;
+  bool vtkGpu = false, egl = false;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -183,8 +307,12 @@ int main(int argc, char* argv[])
       edits = std::max(0, std::atoi(next().c_str()));
     else if (a == "--vtk-gpu")
       vtkGpu = true;
+    else if (a == "--egl")
+      egl = true;
     else if (a == "--csv")
       csvPath = next();
+    else if (a == "--png")
+      pngPrefix = next();
     else
     {
       std::cerr << "unknown argument " << a << "\n";
@@ -234,7 +362,41 @@ int main(int argc, char* argv[])
 
   vtkNew<vtkRenderer> ren;
   ren->SetBackground(0, 0, 0);
-  vtkNew<vtkRenderWindow> win;
+  vtkSmartPointer<vtkRenderWindow> win;
+  if (egl)
+  {
+    std::string why;
+    gEglModeDisplay = XOpenDisplay(nullptr);
+    if (!gEglModeDisplay || !MakeEglContext(size, size, why))
+    {
+      std::fprintf(stderr, "--egl: %s\n", gEglModeDisplay ? why.c_str() : "no X display for GLEW");
+      return 3;
+    }
+    auto gw = vtkSmartPointer<vtkGenericOpenGLRenderWindow>::New();
+    // The context is always current: answer the window's questions so.
+    vtkNew<vtkCallbackCommand> answer;
+    answer->SetCallback([](vtkObject*, unsigned long event, void*, void* data) {
+      if (event == vtkCommand::WindowIsCurrentEvent)
+        *static_cast<bool*>(data) = true;
+      else if (event == vtkCommand::WindowSupportsOpenGLEvent || event == vtkCommand::WindowIsDirectEvent)
+        *static_cast<int*>(data) = 1;
+    });
+    gw->AddObserver(vtkCommand::WindowIsCurrentEvent, answer);
+    gw->AddObserver(vtkCommand::WindowSupportsOpenGLEvent, answer);
+    gw->AddObserver(vtkCommand::WindowIsDirectEvent, answer);
+    gw->SetSize(size, size);
+    gw->SetReadyForRendering(true);
+    if (!gw->InitializeFromCurrentContext())
+    {
+      std::fprintf(stderr, "--egl: VTK could not initialize from the EGL context\n");
+      return 3;
+    }
+    win = gw;
+  }
+  else
+  {
+    win = vtkSmartPointer<vtkRenderWindow>::New();
+  }
   win->SetMultiSamples(0);
   win->SetSize(size, size);
   win->AddRenderer(ren);
@@ -243,8 +405,9 @@ int main(int argc, char* argv[])
   auto* ogl = vtkOpenGLRenderWindow::SafeDownCast(win);
   const char* glr = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   const char* glv = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
-  std::printf("GL_RENDERER %s | GL_VENDOR %s | window %dx%d%s\n", glr ? glr : "?",
-    glv ? glv : "?", size, size, ogl ? "" : " (not OpenGL?)");
+  std::printf("GL_RENDERER %s | GL_VENDOR %s | %s %dx%d%s\n", glr ? glr : "?", glv ? glv : "?",
+    egl ? "vtkGenericOpenGLRenderWindow on an EGL pbuffer" : "X window", size, size,
+    ogl ? "" : " (not OpenGL?)");
 
   std::ofstream csv;
   if (!csvPath.empty())
@@ -317,6 +480,10 @@ int main(int argc, char* argv[])
       comp += mapper->GetLastCompositeSeconds();
     }
     const double k = 1e3 / frames;
+    if (!pngPrefix.empty())
+    {
+      SavePng(win, pngPrefix + "-" + ds + "-" + it.label.substr(0, it.label.find(':')) + ".png");
+    }
     // Opacity edits that move the threshold (changing the occupied cells) and back: edit ->
     // end of the first new frame, with the classification and rebuild it needed.
     double edit = 0, editClassify = 0, editBuild = 0;
@@ -369,6 +536,10 @@ int main(int argc, char* argv[])
     {
       Orbit(ren, b, 360.0 * f / frames, 15);
       wall += TimedRender(win);
+    }
+    if (!pngPrefix.empty())
+    {
+      SavePng(win, pngPrefix + "-" + ds + "-vtkGPUVolumeRayCastMapper.png");
     }
     double edit = 0;
     for (int e = 0; e < edits; ++e)
