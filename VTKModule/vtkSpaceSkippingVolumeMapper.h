@@ -155,6 +155,17 @@ public:
 
   ///@{
   /**
+   * Upload the image to the window rounded to 8 bits per channel (default on: the window's
+   * colour buffer has 8 bits, and the upload is a quarter of the 32-bit float image's); off
+   * uploads 32-bit floats and blends those.
+   */
+  vtkSetMacro(EightBitComposite, vtkTypeBool);
+  vtkGetMacro(EightBitComposite, vtkTypeBool);
+  vtkBooleanMacro(EightBitComposite, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -223,6 +234,7 @@ protected:
   double SampleDistance = 0.0;
   int Backend = Auto;
   vtkTypeBool EarlyRayTermination = 1;
+  vtkTypeBool EightBitComposite = 1;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;
