@@ -8,8 +8,9 @@
 # timings for the same cases. Writes everything into OUTDIR.
 #
 #   Testing/gpu/run-gpu-vtk.sh OUTDIR [PHASE...]
-#   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048
-#          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024)
+#   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-float bench-ert
+#          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024
+#          bench-float bench-ert)
 #   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), DEADLINE (epoch seconds: phases that would
 #          start after it are skipped), MEMCHECK_TESTS, BENCH_BUILDERS, VTK_GPU (1: also time
 #          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks), REQUIRE_NVIDIA_GL (set: stop
@@ -20,7 +21,7 @@
 set -uo pipefail
 out=${1:?usage: run-gpu-vtk.sh OUTDIR [PHASE...]}
 shift
-phases=${*:-tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024}
+phases=${*:-tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024 bench-float bench-ert}
 src=$(cd "$(dirname "$0")/../.." && pwd)
 bundle=${BUNDLE:-$src/.vtkbundle}
 mkdir -p "$out"
@@ -171,9 +172,10 @@ window_bench() {  # SHAPE N [--vtk-gpu] [--egl]
   late && { log "skip bench $shape$n (deadline)"; return; }
   log "window bench $shape $n^3 $*"
   SPACESKIP_BACKEND=cuda timeout 420 "$bench" --shape "$shape" --dims "$n" --frames "$frames" \
-    --size 1024 --builders "$wb" --csv "$out/bench.csv" --png "$work/frame" "$@" >> "$work/bench.log" 2>&1
+    --size 1024 --builders "${ITEMS:-$wb}" --csv "$out/bench.csv" --png "$work/frame" "$@" >> "$work/bench.log" 2>&1
   log "window bench rc=$?"
   cp "$work/bench.log" "$out/bench.log"
+  [ -n "${ITEMS:-}" ] && return  # a variant of a case benched above: no second CLI run
   log "CLI bench gen:$shape:$n"
   timeout 300 "$cli" bench "gen:$shape:$n" --backend cuda --builders "$cb" --size 1024x1024 \
     --frames "$frames" --csv "$work/cli-$shape$n.csv" >> "$work/cli-bench.log" 2>&1
@@ -207,6 +209,13 @@ v2=()
 for a in "${vg[@]}"; do [ "$a" = --vtk-gpu ] || v2+=("$a"); done
 has bench-nbody2048 && window_bench nbody 2048 "${v2[@]}"
 has bench-menger1024 && window_bench menger 1024 "${vg[@]}"
+# The 32-bit float image upload (the mapper's EightBitComposite off) against the default 8-bit one.
+has bench-float && ITEMS=Grid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --float-composite
+# Early ray termination on (VTK's mapper cannot turn it off): like for like with its rows above.
+if has bench-ert; then
+  ITEMS=Naive,Grid,KdTreeGPUFast:mls32,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --ert
+  ITEMS=Naive,Grid,KdTreeGPUFast:mls32,Hybrid window_bench menger 1024 "${v2[@]}" --ert
+fi
 
 stop_xvfb
 tar -C "$work" --exclude=bundle -czf "$out/logs.tgz" . 2>/dev/null

@@ -7,7 +7,7 @@
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
 //       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN]] [--vtk-gpu] [--csv FILE]
-//       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite]
+//       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
 // --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
 // headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
 // config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
@@ -288,7 +288,7 @@ int main(int argc, char* argv[])
   std::string shape = "nbody", csvPath, pngPrefix, builders =
     "Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4";
   int n = 256, frames = 16, size = 1024, edits = 4;
-  bool vtkGpu = false, egl = false, floatComposite = false;
+  bool vtkGpu = false, egl = false, floatComposite = false, ert = false;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -311,6 +311,8 @@ int main(int argc, char* argv[])
       egl = true;
     else if (a == "--float-composite")
       floatComposite = true;
+    else if (a == "--ert")
+      ert = true;
     else if (a == "--csv")
       csvPath = next();
     else if (a == "--png")
@@ -329,6 +331,14 @@ int main(int argc, char* argv[])
     {
       std::cerr << "bad builder item " << s << "\n";
       return 2;
+    }
+    if (floatComposite)
+    {
+      it.label += "+float-composite";
+    }
+    if (ert)
+    {
+      it.label += "+ert";
     }
     items.push_back(it);
   }
@@ -445,7 +455,9 @@ int main(int argc, char* argv[])
   ren->AddVolume(volume);
   vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
   mapper->SetInputData(image);
-  mapper->EarlyRayTerminationOff();
+  // The paper's protocol has no early ray termination; --ert turns it on (at 0.99, as VTK's
+  // vtkGPUVolumeRayCastMapper always does) for a like-for-like comparison with VTK's mapper.
+  mapper->SetEarlyRayTermination(ert);
   mapper->SetEightBitComposite(!floatComposite);
   std::printf("composite: %s image upload\n", floatComposite ? "32-bit float" : "8-bit");
   volume->SetMapper(mapper);
