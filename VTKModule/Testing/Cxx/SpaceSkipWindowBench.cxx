@@ -498,7 +498,9 @@ int main(int argc, char* argv[])
     const double k = 1e3 / frames;
     if (!pngPrefix.empty())
     {
-      SavePng(win, pngPrefix + "-" + ds + "-" + it.label.substr(0, it.label.find(':')) + ".png");
+      std::string name = it.label;
+      std::replace(name.begin(), name.end(), ':', '_');
+      SavePng(win, pngPrefix + "-" + ds + "-" + name + ".png");
     }
     // Opacity edits that move the threshold (changing the occupied cells) and back: edit ->
     // end of the first new frame, with the classification and rebuild it needed.
