@@ -34,7 +34,6 @@
 
 #include "spaceskip/Generators.h"
 
-#include <X11/Xlib.h>
 #include <dlfcn.h>
 
 #include <algorithm>
@@ -52,14 +51,15 @@
 // GLEW's glewInit() ends with its GLX part, which fails without a current GLX context's display
 // (an EGL context has none). This definition, exported from the executable, interposes libGLX's
 // and hands GLEW a plain X connection in --egl mode; otherwise it forwards to libGLX.
-static Display* gEglModeDisplay = nullptr;
-extern "C" __attribute__((visibility("default"))) Display* glXGetCurrentDisplay()
+// (Xlib is dlopen()ed too, so no X11 headers are needed: a Display* is a void* here.)
+static void* gEglModeDisplay = nullptr;
+extern "C" __attribute__((visibility("default"))) void* glXGetCurrentDisplay()
 {
   if (gEglModeDisplay)
   {
     return gEglModeDisplay;
   }
-  using Fn = Display* (*)();
+  using Fn = void* (*)();
   static Fn real = reinterpret_cast<Fn>(dlsym(RTLD_NEXT, "glXGetCurrentDisplay"));
   return real ? real() : nullptr;
 }
@@ -378,7 +378,9 @@ int main(int argc, char* argv[])
   if (egl)
   {
     std::string why;
-    gEglModeDisplay = XOpenDisplay(nullptr);
+    void* xlib = dlopen("libX11.so.6", RTLD_NOW | RTLD_GLOBAL);
+    auto openDisplay = xlib ? reinterpret_cast<void* (*)(const char*)>(dlsym(xlib, "XOpenDisplay")) : nullptr;
+    gEglModeDisplay = openDisplay ? openDisplay(nullptr) : nullptr;
     if (!gEglModeDisplay || !MakeEglContext(size, size, why))
     {
       std::fprintf(stderr, "--egl: %s\n", gEglModeDisplay ? why.c_str() : "no X display for GLEW");
