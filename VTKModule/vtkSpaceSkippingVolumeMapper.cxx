@@ -32,6 +32,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#ifdef SPACESKIP_HAVE_CUDA
+// CUDA-GL interop for GPUComposite (runtime API only: no kernel here; GLEW already blocks gl.h).
+#include <cuda_gl_interop.h>
+#include <cuda_runtime_api.h>
+#endif
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -185,6 +191,13 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
 
   spaceskip::Image Image;
   std::vector<unsigned char> Image8; // the image rounded to 8 bits for upload (EightBitComposite)
+  // GPUComposite: a float RGBA texture registered with CUDA, filled from the engine's device image.
+  vtkSmartPointer<vtkTextureObject> InteropTexture;
+  void* InteropResource = nullptr; // cudaGraphicsResource_t
+  int InteropSize[2] = { 0, 0 };
+  bool InteropFailed = false; // once failed (e.g. GL on Mesa, another GPU): host path from then on
+  std::string InteropProblem;
+  std::string CompositePath = "none";
   std::vector<float> Depth;
   vtkSmartPointer<vtkTextureObject> Texture;
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
@@ -195,6 +208,91 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   bool WarnedBlend = false;
   bool WarnedClip = false;
   bool WarnedDepthRead = false;
+
+  void ReleaseInterop()
+  {
+#ifdef SPACESKIP_HAVE_CUDA
+    if (this->InteropResource)
+    {
+      cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->InteropResource));
+      cudaGetLastError(); // a failure here (context gone) must not reach the engine's checks
+    }
+#endif
+    this->InteropResource = nullptr;
+    this->InteropSize[0] = this->InteropSize[1] = 0;
+  }
+
+  // Copies the engine's device image into InteropTexture; false (with the reason) on any failure.
+  bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, int w, int h)
+  {
+#ifdef SPACESKIP_HAVE_CUDA
+    auto failed = [this](const char* what, cudaError_t e) {
+      this->InteropProblem = std::string(what) + ": " + cudaGetErrorString(e);
+      cudaGetLastError();
+      return false;
+    };
+    if (!this->InteropTexture || this->InteropSize[0] != w || this->InteropSize[1] != h)
+    {
+      this->ReleaseInterop();
+      if (!this->InteropTexture)
+      {
+        this->InteropTexture = vtkSmartPointer<vtkTextureObject>::New();
+      }
+      this->InteropTexture->SetContext(renWin);
+      this->InteropTexture->SetMinificationFilter(vtkTextureObject::Nearest);
+      this->InteropTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
+      this->InteropTexture->SetWrapS(vtkTextureObject::ClampToEdge);
+      this->InteropTexture->SetWrapT(vtkTextureObject::ClampToEdge);
+      if (!this->InteropTexture->Allocate2D(
+            static_cast<unsigned>(w), static_cast<unsigned>(h), 4, VTK_FLOAT))
+      {
+        this->InteropProblem = "could not allocate the float texture";
+        return false;
+      }
+      cudaGraphicsResource_t r = nullptr;
+      const cudaError_t e = cudaGraphicsGLRegisterImage(&r, this->InteropTexture->GetHandle(),
+        GL_TEXTURE_2D, cudaGraphicsRegisterFlagsWriteDiscard);
+      if (e != cudaSuccess)
+      {
+        return failed("cudaGraphicsGLRegisterImage", e);
+      }
+      this->InteropResource = r;
+      this->InteropSize[0] = w;
+      this->InteropSize[1] = h;
+    }
+    cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(this->InteropResource);
+    cudaError_t e = cudaGraphicsMapResources(1, &r, nullptr);
+    if (e != cudaSuccess)
+    {
+      return failed("cudaGraphicsMapResources", e);
+    }
+    cudaArray_t array = nullptr;
+    e = cudaGraphicsSubResourceGetMappedArray(&array, r, 0, 0);
+    if (e == cudaSuccess)
+    {
+      const size_t row = static_cast<size_t>(w) * 4 * sizeof(float);
+      e = cudaMemcpy2DToArray(array, 0, 0, image, row, row, static_cast<size_t>(h),
+        cudaMemcpyDeviceToDevice);
+    }
+    const cudaError_t u = cudaGraphicsUnmapResources(1, &r, nullptr);
+    if (e != cudaSuccess)
+    {
+      return failed("copy into the GL texture", e);
+    }
+    if (u != cudaSuccess)
+    {
+      return failed("cudaGraphicsUnmapResources", u);
+    }
+    return true;
+#else
+    (void)renWin;
+    (void)image;
+    (void)w;
+    (void)h;
+    this->InteropProblem = "built without CUDA";
+    return false;
+#endif
+  }
 
   void ResetVolume()
   {
@@ -234,7 +332,10 @@ vtkSpaceSkippingVolumeMapper::vtkSpaceSkippingVolumeMapper()
 }
 
 //------------------------------------------------------------------------------
-vtkSpaceSkippingVolumeMapper::~vtkSpaceSkippingVolumeMapper() = default;
+vtkSpaceSkippingVolumeMapper::~vtkSpaceSkippingVolumeMapper()
+{
+  this->Internals->ReleaseInterop();
+}
 
 //------------------------------------------------------------------------------
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderAsString()
@@ -312,6 +413,10 @@ const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
 {
   return this->Internals->BuilderUsed.c_str();
 }
+const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
+{
+  return this->Internals->CompositePath.c_str();
+}
 int vtkSpaceSkippingVolumeMapper::GetBuildCount()
 {
   return this->Internals->Counts().builds;
@@ -347,6 +452,12 @@ void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
   {
     d.Resolve->ReleaseGraphicsResources(win);
     d.Resolve = nullptr;
+  }
+  d.ReleaseInterop();
+  if (d.InteropTexture)
+  {
+    d.InteropTexture->ReleaseGraphicsResources(win);
+    d.InteropTexture = nullptr;
   }
   this->Superclass::ReleaseGraphicsResources(win);
 }
@@ -704,6 +815,10 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.DepthSeconds = SecondsSince(t0);
 
     const int buildsBefore = engine.counters().builds;
+    // GPUComposite: the CUDA backend leaves the image on the device for the interop copy below.
+    const bool wantInterop = this->GPUComposite && !d.InteropFailed &&
+      engine.backendKind() == spaceskip::BackendKind::CUDA;
+    engine.setImageOnDevice(wantInterop);
     t0 = std::chrono::steady_clock::now();
     engine.render(camera, width, height, d.Image, depth);
     d.EngineSeconds = SecondsSince(t0);
@@ -721,7 +836,29 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       width, height, engine.frameStats().seconds, engine.frameStats().backend.c_str());
     d.BackendUsed = engine.frameStats().backend;
     d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
-    if (d.Report && d.Reported != d.BackendUsed + d.BuilderUsed)
+    t0 = std::chrono::steady_clock::now();
+    vtkTextureObject* image = nullptr;
+    if (const void* deviceImage = engine.deviceImage())
+    {
+      if (d.CopyToInteropTexture(renWin, deviceImage, width, height))
+      {
+        image = d.InteropTexture;
+        d.CompositePath = "gpu";
+      }
+      else
+      {
+        // Not this GL (Mesa, another device) or a CUDA error: the host path from now on, and
+        // this frame again through host memory.
+        vtkVLogF(vtkLogger::VERBOSITY_INFO,
+          "vtkSpaceSkippingVolumeMapper: CUDA-GL interop unavailable (%s); the image goes "
+          "through host memory", d.InteropProblem.c_str());
+        d.InteropFailed = true;
+        d.ReleaseInterop();
+        engine.setImageOnDevice(false);
+        engine.render(camera, width, height, d.Image, depth);
+      }
+    }
+    if (d.Report && d.Reported != d.BackendUsed + d.BuilderUsed + d.CompositePath)
     {
       // What actually ran, for logs of test and benchmark runs on other machines.
       const GLubyte* glRenderer = glGetString(GL_RENDERER);
@@ -729,11 +866,11 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       std::cout << "SpaceSkip: backend " << d.BackendUsed << ", builder " << d.BuilderUsed
                 << ", GL_RENDERER " << (glRenderer ? reinterpret_cast<const char*>(glRenderer) : "?")
                 << ", GL_VENDOR " << (glVendor ? reinterpret_cast<const char*>(glVendor) : "?")
+                << ", image " << (image ? "on the GPU (CUDA-GL interop)" : "through host memory")
+                << (d.InteropFailed ? " (interop: " + d.InteropProblem + ")" : std::string())
                 << std::endl;
-      d.Reported = d.BackendUsed + d.BuilderUsed;
+      d.Reported = d.BackendUsed + d.BuilderUsed + d.CompositePath;
     }
-
-    t0 = std::chrono::steady_clock::now();
 
     // Composite: premultiplied RGBA over what is drawn, (ONE, ONE_MINUS_SRC_ALPHA).
     if (!d.Texture)
@@ -745,7 +882,11 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.Texture->SetMagnificationFilter(vtkTextureObject::Nearest);
     d.Texture->SetWrapS(vtkTextureObject::ClampToEdge);
     d.Texture->SetWrapT(vtkTextureObject::ClampToEdge);
-    if (this->EightBitComposite)
+    if (image)
+    {
+      // Drawn below from the interop texture.
+    }
+    else if (this->EightBitComposite)
     {
       // The window holds 8 bits per channel: round the premultiplied image to 8 bits here (a
       // quarter of the float image's upload, which cost ~5 ms per 1024^2 frame on an H100).
@@ -768,6 +909,11 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     {
       d.Texture->Create2DFromRaw(static_cast<unsigned>(width), static_cast<unsigned>(height), 4,
         VTK_FLOAT, d.Image.rgba.data());
+    }
+    if (!image)
+    {
+      image = d.Texture;
+      d.CompositePath = "host";
     }
 
     if (!d.Quad)
@@ -797,10 +943,10 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     ostate->vtkglDisable(GL_DEPTH_TEST);
     ostate->vtkglDepthMask(GL_FALSE);
-    d.Texture->Activate();
-    d.Quad->Program->SetUniformi("ssImage", d.Texture->GetTextureUnit());
+    image->Activate();
+    d.Quad->Program->SetUniformi("ssImage", image->GetTextureUnit());
     d.Quad->Render();
-    d.Texture->Deactivate();
+    image->Deactivate();
     d.CompositeSeconds = SecondsSince(t0);
     d.MapperSeconds = SecondsSince(tRender);
     d.LastProblem.clear();
@@ -838,6 +984,8 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";
   os << indent << "EarlyRayTermination: " << (this->EarlyRayTermination ? "On" : "Off") << "\n";
   os << indent << "EightBitComposite: " << (this->EightBitComposite ? "On" : "Off") << "\n";
+  os << indent << "GPUComposite: " << (this->GPUComposite ? "On" : "Off") << "\n";
+  os << indent << "CompositePathUsed: " << this->Internals->CompositePath << "\n";
   os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
   os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";

@@ -166,6 +166,20 @@ public:
 
   ///@{
   /**
+   * Keep the image on the GPU (default on): with the CUDA backend and the window's OpenGL on the
+   * same NVIDIA device, the frame is copied from CUDA memory into a GL texture (CUDA-GL interop)
+   * instead of going down to host memory and up again. When interop is not possible (another GL
+   * such as Mesa, another device, a CUDA error) the mapper says so once at INFO verbosity and
+   * uses host memory from then on. GetCompositePathUsed(): "gpu", "host" or "none".
+   */
+  vtkSetMacro(GPUComposite, vtkTypeBool);
+  vtkGetMacro(GPUComposite, vtkTypeBool);
+  vtkBooleanMacro(GPUComposite, vtkTypeBool);
+  const char* GetCompositePathUsed();
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -235,6 +249,7 @@ protected:
   int Backend = Auto;
   vtkTypeBool EarlyRayTermination = 1;
   vtkTypeBool EightBitComposite = 1;
+  vtkTypeBool GPUComposite = 1;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;

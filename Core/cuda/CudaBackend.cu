@@ -401,6 +401,17 @@ class CudaBackend final : public Backend {
     SS_CUDA_CHECK(cudaEventRecord(ev1_, stream_));
     out.width = f.width;
     out.height = f.height;
+    if (imageOnDevice_ && !hostCounts) {
+      // The caller draws d_image_ itself (CUDA-GL interop): no download.
+      out.rgba.clear();
+      SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
+      float ms = 0;
+      SS_CUDA_CHECK(cudaEventElapsedTime(&ms, ev0_, ev1_));
+      lastDeviceSeconds_ = double(ms) * 1e-3;
+      deviceImageValid_ = true;
+      return;
+    }
+    deviceImageValid_ = false;
     out.rgba.resize(pixels);
     // Through a pinned staging buffer (DMA at full link speed, then a parallel host copy): about
     // twice as fast as a copy into the caller's pageable vector. Without pinned memory, direct.
@@ -419,6 +430,12 @@ class CudaBackend final : public Backend {
   }
 
   double lastFrameDeviceSeconds() const override { return lastDeviceSeconds_; }
+  bool setImageOnDevice(bool on) override {
+    imageOnDevice_ = on;
+    deviceImageValid_ = false;
+    return true;
+  }
+  const void* deviceImage() const override { return deviceImageValid_ ? d_image_.get() : nullptr; }
 
   const OccupancyGrid& occupancy() override {
     if (!hostOccValid_) {
@@ -615,6 +632,8 @@ class CudaBackend final : public Backend {
   DeviceBuffer<Flags> d_flags_;
   Flags* h_flags_ = nullptr;
   void* h_stage_ = nullptr;  ///< pinned copy of the last frame's image on its way to the caller
+  bool imageOnDevice_ = false;     ///< setImageOnDevice(): leave the image in d_image_
+  bool deviceImageValid_ = false;  ///< the last render() left its image in d_image_
   size_t stageBytes_ = 0;
   OccupancyGrid hostOcc_;
   bool hostOccValid_ = false;

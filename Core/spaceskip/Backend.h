@@ -24,6 +24,12 @@ class Backend {
   virtual void build(const BuildParams& p, BuildStats& stats) = 0;
   /// `f` carries camera, box, sampling; the backend fills pointers and traversal kind.
   virtual void render(FrameView f, FilterMode filter, const float* depth, Image& out) = 0;
+  /// When `on` (and supported: returns whether it is), render() leaves the image in device memory
+  /// (deviceImage()) and gives `out` only its size: for callers that draw it with CUDA-GL interop.
+  virtual bool setImageOnDevice(bool /*on*/) { return false; }
+  /// The last frame's premultiplied RGBA (one float4 per pixel, row 0 at the bottom) in device
+  /// memory while setImageOnDevice(true) is in effect, else nullptr.
+  virtual const void* deviceImage() const { return nullptr; }
   /// Seconds the last render() spent in device work (CUDA events), -1 when not measured.
   virtual double lastFrameDeviceSeconds() const { return -1; }
   virtual const OccupancyGrid& occupancy() = 0;

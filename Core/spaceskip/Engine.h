@@ -133,6 +133,14 @@ class Engine {
   /// geometry per pixel, in [0,1], row 0 at the bottom.
   void render(const Camera& cam, int width, int height, Image& out, const float* depth = nullptr);
 
+  /// CUDA: keep each frame's image in device memory (deviceImage()) instead of downloading it;
+  /// render()'s Image then gets only its size. Returns false (and changes nothing) when the
+  /// backend cannot; a fallback to the CPU backend turns it off.
+  bool setImageOnDevice(bool on);
+  /// The last frame's premultiplied RGBA, float4 per pixel, row 0 at the bottom, in device memory
+  /// (valid until the next render), or nullptr when the image went to the host.
+  const void* deviceImage() const;
+
   const BuildStats& buildStats() const;
   const FrameStats& frameStats() const;
   const Counters& counters() const;

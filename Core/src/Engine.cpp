@@ -256,6 +256,9 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   ++d.counters.frames;
 }
 
+bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }
+const void* Engine::deviceImage() const { return impl_->backend->deviceImage(); }
+
 const BuildStats& Engine::buildStats() const { return impl_->stats; }
 const FrameStats& Engine::frameStats() const { return impl_->frame; }
 const Counters& Engine::counters() const { return impl_->counters; }

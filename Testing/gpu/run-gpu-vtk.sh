@@ -8,9 +8,10 @@
 # timings for the same cases. Writes everything into OUTDIR.
 #
 #   Testing/gpu/run-gpu-vtk.sh OUTDIR [PHASE...]
-#   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-float bench-ert
+#   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
+#          bench-ert
 #          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024
-#          bench-float bench-ert)
+#          bench-host bench-float bench-ert)
 #   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), DEADLINE (epoch seconds: phases that would
 #          start after it are skipped), MEMCHECK_TESTS, BENCH_BUILDERS, VTK_GPU (1: also time
 #          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks), REQUIRE_NVIDIA_GL (set: stop
@@ -21,7 +22,7 @@
 set -uo pipefail
 out=${1:?usage: run-gpu-vtk.sh OUTDIR [PHASE...]}
 shift
-phases=${*:-tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024 bench-float bench-ert}
+phases=${*:-tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024 bench-host bench-float bench-ert}
 src=$(cd "$(dirname "$0")/../.." && pwd)
 bundle=${BUNDLE:-$src/.vtkbundle}
 mkdir -p "$out"
@@ -209,8 +210,10 @@ v2=()
 for a in "${vg[@]}"; do [ "$a" = --vtk-gpu ] || v2+=("$a"); done
 has bench-nbody2048 && window_bench nbody 2048 "${v2[@]}"
 has bench-menger1024 && window_bench menger 1024 "${vg[@]}"
-# The 32-bit float image upload (the mapper's EightBitComposite off) against the default 8-bit one.
-has bench-float && ITEMS=Grid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --float-composite
+# The image through host memory (GPUComposite off; 8-bit, then 32-bit float upload) against the
+# default CUDA-GL interop path.
+has bench-host && ITEMS=Grid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --host-composite
+has bench-float && ITEMS=Grid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --host-composite --float-composite
 # Early ray termination on (VTK's mapper cannot turn it off): like for like with its rows above.
 if has bench-ert; then
   ITEMS=Naive,Grid,KdTreeGPUFast:mls32,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --ert

@@ -8,6 +8,7 @@
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
 //       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN]] [--vtk-gpu] [--csv FILE]
 //       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
+//       [--host-composite (GPUComposite off)]
 // --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
 // headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
 // config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
@@ -151,6 +152,37 @@ bool MakeEglContext(int w, int h, std::string& why)
 
 using Clock = std::chrono::steady_clock;
 
+// The window's current RGBA frame.
+vtkSmartPointer<vtkImageData> Grab(vtkRenderWindow* win)
+{
+  vtkNew<vtkWindowToImageFilter> w2i;
+  w2i->SetInput(win);
+  w2i->ReadFrontBufferOff();
+  w2i->ShouldRerenderOff();
+  w2i->Update();
+  auto img = vtkSmartPointer<vtkImageData>::New();
+  img->DeepCopy(w2i->GetOutput());
+  return img;
+}
+
+int MaxDiff(vtkImageData* a, vtkImageData* b)
+{
+  vtkDataArray* x = a->GetPointData()->GetScalars();
+  vtkDataArray* y = b->GetPointData()->GetScalars();
+  if (!x || !y || x->GetNumberOfValues() != y->GetNumberOfValues())
+  {
+    return 256;
+  }
+  const auto* p = static_cast<const unsigned char*>(x->GetVoidPointer(0));
+  const auto* q = static_cast<const unsigned char*>(y->GetVoidPointer(0));
+  int m = 0;
+  for (vtkIdType i = 0; i < x->GetNumberOfValues(); ++i)
+  {
+    m = std::max(m, std::abs(int(p[i]) - int(q[i])));
+  }
+  return m;
+}
+
 // The window's last frame as PNG (evidence of what the timed frames showed).
 void SavePng(vtkRenderWindow* win, const std::string& path)
 {
@@ -288,7 +320,7 @@ int main(int argc, char* argv[])
   std::string shape = "nbody", csvPath, pngPrefix, builders =
     "Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4";
   int n = 256, frames = 16, size = 1024, edits = 4;
-  bool vtkGpu = false, egl = false, floatComposite = false, ert = false;
+  bool vtkGpu = false, egl = false, floatComposite = false, ert = false, hostComposite = false;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -313,6 +345,8 @@ int main(int argc, char* argv[])
       floatComposite = true;
     else if (a == "--ert")
       ert = true;
+    else if (a == "--host-composite")
+      hostComposite = true;
     else if (a == "--csv")
       csvPath = next();
     else if (a == "--png")
@@ -339,6 +373,10 @@ int main(int argc, char* argv[])
     if (ert)
     {
       it.label += "+ert";
+    }
+    if (hostComposite)
+    {
+      it.label += "+host";
     }
     items.push_back(it);
   }
@@ -461,6 +499,7 @@ int main(int argc, char* argv[])
   // vtkGPUVolumeRayCastMapper always does) for a like-for-like comparison with VTK's mapper.
   mapper->SetEarlyRayTermination(ert);
   mapper->SetEightBitComposite(!floatComposite);
+  mapper->SetGPUComposite(!hostComposite);
   std::printf("composite: %s image upload\n", floatComposite ? "32-bit float" : "8-bit");
   volume->SetMapper(mapper);
   bool firstOfAll = true;
@@ -498,6 +537,22 @@ int main(int argc, char* argv[])
       comp += mapper->GetLastCompositeSeconds();
     }
     const double k = 1e3 / frames;
+    const std::string path = mapper->GetCompositePathUsed();
+    std::string check;
+    if (path == "gpu")
+    {
+      // The interop image against the host path's, same camera.
+      Orbit(ren, b, 0, 15);
+      TimedRender(win);
+      auto gpuShot = Grab(win);
+      mapper->GPUCompositeOff();
+      TimedRender(win);
+      auto hostShot = Grab(win);
+      mapper->GPUCompositeOn();
+      check = ", gpu vs host image max diff " + std::to_string(MaxDiff(gpuShot, hostShot)) + "/255";
+    }
+    std::printf("  %s: image %s%s\n", it.label.c_str(),
+      path == "gpu" ? "on the GPU (CUDA-GL interop)" : "through host memory", check.c_str());
     if (!pngPrefix.empty())
     {
       std::string name = it.label;
