@@ -42,6 +42,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -234,6 +235,15 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
     if (!this->InteropTexture || this->InteropSize[0] != w || this->InteropSize[1] != h)
     {
       this->ReleaseInterop();
+      // Only NVIDIA's GL can share with CUDA: do not even ask another (the failing call would
+      // show up as an API error in compute-sanitizer).
+      const char* vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
+      if (!vendor || !std::strstr(vendor, "NVIDIA"))
+      {
+        this->InteropProblem = std::string("the window's OpenGL is ") +
+          (vendor ? vendor : "unknown") + "'s, not NVIDIA's";
+        return false;
+      }
       if (!this->InteropTexture)
       {
         this->InteropTexture = vtkSmartPointer<vtkTextureObject>::New();
