@@ -64,6 +64,18 @@ struct RenderParams {
   bool countSamples = false;   ///< statistics: FrameStats::samples (costs a per-pixel buffer)
 };
 
+/// Bounds on the work per ray (so a typo in Sample Distance cannot freeze ParaView's GUI).
+/// The step is at least the smallest voxel spacing / kMinStepsPerVoxel, and a ray through the
+/// whole volume box takes at most kMaxSamplesPerRay samples (which also keeps every sample
+/// index exact in float).
+constexpr double kMinStepsPerVoxel = 16;
+constexpr double kMaxSamplesPerRay = double(1 << 20);
+
+/// The sample distance the engine renders with for `requested` world units (<= 0: half the
+/// smallest spacing), after the bounds above. When a bound applied, `note` (if given) says
+/// what was clamped and why; otherwise it is left empty.
+double effectiveSampleDistance(const Volume& v, double requested, std::string* note = nullptr);
+
 struct BuildStats {
   BuilderKind builder = BuilderKind::Naive;
   std::string builtOn;       ///< "cpu" or "cuda"
@@ -139,7 +151,12 @@ class Engine {
   /// Host copies for tests and statistics (downloaded from the device if needed).
   const OccupancyGrid& occupancy();
   Tree tree();
+  /// The sample distance rendered with, after effectiveSampleDistance's bounds.
   double sampleDistance() const;
+  /// Floating-point volumes whose magnitudes lie outside [2^-60, 2^60] are sampled through an
+  /// exact power-of-two rescale (a float copy); values are multiplied by 2^valueExponent()
+  /// (0 when not rescaled).
+  int valueExponent() const;
 
  private:
   struct Impl;

@@ -27,6 +27,17 @@ struct FrameView {
   unsigned* sampleCount;   ///< optional per-pixel count of samples taken (statistics)
 };
 
+/// A voxel as the integrator samples it. +-Inf becomes +-2^100: above every finite value (the
+/// engine rescales floating volumes into [2^-60, 2^60]), so it takes the end entry of the table,
+/// and trilinear weights never form Inf - Inf = NaN next to it. NaN stays NaN.
+SS_FUNC float voxelValue(float v) {
+  const float big = 1.2676506e30f;  // 2^100
+  return v > big ? big : (v < -big ? -big : v);
+}
+SS_FUNC float voxelValue(double v) { return voxelValue(float(v)); }
+template <class T>
+SS_FUNC float voxelValue(T v) { return float(v); }
+
 /// Exact trilinear sampling in float from a linear voxel array (clamped at the border).
 template <class T>
 struct ArraySampler {
@@ -34,7 +45,7 @@ struct ArraySampler {
   int64_t nx, ny, nz;
 
   SS_FUNC float fetch(int64_t i, int64_t j, int64_t k) const {
-    return float(data[i + nx * (j + ny * k)]);
+    return voxelValue(data[i + nx * (j + ny * k)]);
   }
   SS_FUNC static void axis(float p, int64_t n, int64_t& i0, int64_t& i1, float& f) {
     float x = ss_clamp(p, 0.f, float(n - 1));
@@ -78,23 +89,25 @@ SS_FUNC vec3f unproject(const float* m, float x, float y, float z) {
 }
 
 /// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
-/// never before `nextK`, so adjacent intervals never take a sample twice.
+/// never before `nextK`, so adjacent intervals never take a sample twice. Sample indices are
+/// 64-bit: the engine bounds a ray to kMaxSamplesPerRay samples, but an index computed from a
+/// far interval end must never wrap (a tiny step once overflowed int and drew nothing).
 template <class Sampler>
 struct IntervalMarcher {
   const FrameView* f;
   const Sampler* s;
   Ray ray;
   float t0;
-  int nextK;
+  int64_t nextK;
   vec4f acc;
   unsigned samples;
 
   SS_FUNC bool operator()(float a, float b) {
     const float dt = f->dt;
-    int kBegin = int(ceilf((a - t0) / dt));
-    int kEnd = int(ceilf((b - t0) / dt));
+    int64_t kBegin = int64_t(ceilf((a - t0) / dt));
+    int64_t kEnd = int64_t(ceilf((b - t0) / dt));
     if (kBegin < nextK) kBegin = nextK;
-    for (int k = kBegin; k < kEnd; ++k) {
+    for (int64_t k = kBegin; k < kEnd; ++k) {
       float t = t0 + float(k) * dt;
       vec4f c = lookup(f->tf, s->sample(ray.org + ray.dir * t));
       if (c.w > 0.f) {

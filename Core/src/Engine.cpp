@@ -7,6 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <cstdio>
+#include <limits>
+#include <set>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace spaceskip {
 
@@ -54,12 +61,81 @@ bool parseBuilder(const std::string& s, BuilderKind& out) {
   return false;
 }
 
+namespace {
+// Largest finite |v| of a floating-point voxel array, in parallel (0 when none is finite).
+template <class T>
+double maxFiniteMagnitude(const T* p, int64_t n) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, n, int64_t(1) << 16), 0.0,
+      [p](const tbb::blocked_range<int64_t>& r, double m) {
+        for (int64_t i = r.begin(); i < r.end(); ++i) {
+          const double a = std::fabs(double(p[i]));
+          if (a > m && std::isfinite(a)) m = a;
+        }
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
+}
+
+template <class T>
+void scaleToFloat(const T* in, float* out, int64_t n, int exponent) {
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, n, int64_t(1) << 16), [=](const tbb::blocked_range<int64_t>& r) {
+    for (int64_t i = r.begin(); i < r.end(); ++i) out[i] = float(std::ldexp(double(in[i]), exponent));
+  });
+}
+}  // namespace
+
+double effectiveSampleDistance(const Volume& v, double requested, std::string* note) {
+  const double minSpacing = std::min({v.spacing[0], v.spacing[1], v.spacing[2]});
+  const double voxel = minSpacing > 0 && std::isfinite(minSpacing) ? minSpacing : 1.0;
+  const bool automatic = !(requested > 0) || !std::isfinite(requested);
+  double dt = automatic ? 0.5 * voxel : requested;
+  const vec3i cd = v.cellDims();
+  const double ex = cd.x * v.spacing[0], ey = cd.y * v.spacing[1], ez = cd.z * v.spacing[2];
+  const double diagonal = std::sqrt(ex * ex + ey * ey + ez * ez);
+  const double floorDt = voxel / kMinStepsPerVoxel, capDt = diagonal / kMaxSamplesPerRay;
+  std::string why;
+  if (dt < floorDt) {
+    dt = floorDt;
+    why = "below the floor of 1/" + std::to_string(int(kMinStepsPerVoxel)) + " of the smallest voxel spacing";
+  }
+  if (dt < capDt) {
+    dt = capDt;
+    why = "more than " + std::to_string(int64_t(kMaxSamplesPerRay)) + " samples along the volume's diagonal";
+  }
+  if (note) {
+    note->clear();
+    if (!why.empty()) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "sample distance %g %s: using %g world units (%s)", requested,
+                    "clamped", dt, why.c_str());
+      *note = buf;
+    }
+  }
+  return dt;
+}
+
+namespace {
+// The voxel-to-table mapping in float for the integrator: lo and entries-per-unit, finite and
+// overflow-free for any finite range (ranges are clamped to float; empty ones get one unit).
+void tableMapping(const TransferFunction& tf, int size, float& lo, float& scale) {
+  const double big = double(std::numeric_limits<float>::max());
+  double a = std::isfinite(tf.rangeMin) ? std::clamp(tf.rangeMin, -big, big) : 0.0;
+  double b = std::isfinite(tf.rangeMax) ? std::clamp(tf.rangeMax, -big, big) : a + 1.0;
+  double width = b - a;
+  if (!(width > 0)) width = std::max(std::fabs(a) * 1e-6, 1e-30);
+  lo = float(a);
+  scale = float(std::min(double(size - 1) / width, big));
+}
+}  // namespace
+
 struct Engine::Impl {
   BackendKind requested;
   std::unique_ptr<Backend> backend;
   std::function<void(const std::string&)> log = [](const std::string& m) { std::cerr << "spaceskip: " << m << "\n"; };
 
   Volume volume;
+  int valueExponent = 0;  ///< voxel values (and so the TF range) times 2^this; see setVolume
   bool haveVolume = false;
   TransferFunction tf;
   bool haveTF = false;
@@ -79,21 +155,35 @@ struct Engine::Impl {
     try {
       backend = makeCudaBackend();
     } catch (const BackendError& e) {
-      if (requested == BackendKind::CUDA) log(std::string("CUDA backend unavailable (") + e.what() + "); using the CPU backend");
+      if (requested == BackendKind::CUDA) warn(std::string("CUDA backend unavailable (") + e.what() + "); using the CPU backend");
       backend = makeCpuBackend();
     }
   }
 
+  // Each distinct message is said once per engine: a soak of TF edits or builder switches must
+  // not repeat the same fallback hundreds of times in ParaView's output window.
+  std::set<std::string> said;
+  void warn(const std::string& m) {
+    if (said.insert(m).second) log(m);
+  }
+
   void fallBackToCpu(const std::string& why) {
-    log("CUDA backend failed (" + why + "); falling back to the CPU backend");
+    warn("CUDA backend failed (" + why + "); falling back to the CPU backend");
     backend = makeCpuBackend();
     rangesDirty = opacityDirty = buildDirty = tableDirty = true;
   }
 
+  TransferFunction scaledTF() const {
+    if (valueExponent == 0) return tf;
+    TransferFunction t = tf;
+    t.rangeMin = std::ldexp(t.rangeMin, valueExponent);
+    t.rangeMax = std::ldexp(t.rangeMax, valueExponent);
+    return t;
+  }
+
   double dt() const {
-    if (render.sampleDistance > 0) return render.sampleDistance;
-    double s = std::min({volume.spacing[0], volume.spacing[1], volume.spacing[2]});
-    return 0.5 * (s > 0 ? s : 1.0);
+    std::string note;
+    return effectiveSampleDistance(volume, render.sampleDistance, &note);
   }
 
   void update() {
@@ -108,7 +198,7 @@ struct Engine::Impl {
     }
     if (opacityDirty) {
       auto t0 = Clock::now();
-      bool changed = backend->classify(tf);
+      bool changed = backend->classify(scaledTF());
       stats.classifySeconds = since(t0);
       ++counters.classifications;
       opacityDirty = false;
@@ -117,16 +207,19 @@ struct Engine::Impl {
     }
     if (tableDirty || colorDirty) {
       if (!tableDirty) ++counters.colorUpdates;
-      const float lo = float(tf.rangeMin);
-      const float scale = float(double(tf.table.size() - 1) / std::max(tf.rangeMax - tf.rangeMin, 1e-30));
-      backend->setTransferTable(correctedTable(tf, float(dt())), lo, scale);
+      std::string note;
+      const double step = effectiveSampleDistance(volume, render.sampleDistance, &note);
+      if (!note.empty()) warn(note);
+      float lo, scale;
+      tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
+      backend->setTransferTable(correctedTable(tf, float(step)), lo, scale);
       tableDirty = colorDirty = false;
     }
     if (buildDirty) {
       BuildParams p = build;
       bool gpuOnly = p.builder == BuilderKind::KdTreeGPU || p.builder == BuilderKind::KdTreeGPUFast;
       if (gpuOnly && backend->kind() != BackendKind::CUDA) {
-        log(std::string("builder ") + builderName(p.builder) + " needs the CUDA backend; building KdTreeCPU with the same parameters");
+        warn(std::string("builder ") + builderName(p.builder) + " needs the CUDA backend; building KdTreeCPU with the same parameters");
         p.builder = BuilderKind::KdTreeCPU;
       }
       BuildStats s;
@@ -134,7 +227,7 @@ struct Engine::Impl {
         backend->build(p, s);
       } catch (const BackendError& e) {
         if (backend->kind() == BackendKind::CUDA) throw;
-        log(std::string(e.what()) + "; using the Grid traversal");
+        warn(std::string(e.what()) + "; using the Grid traversal");
         p.builder = BuilderKind::Grid;
         backend->build(p, s);
       }
@@ -166,6 +259,30 @@ void Engine::setLogger(std::function<void(const std::string&)> log) { impl_->log
 void Engine::setVolume(const Volume& v) {
   validate(v);
   impl_->volume = v;
+  impl_->valueExponent = 0;
+  // The integrator samples in float: magnitudes near the ends of double's (or float's) range
+  // would overflow trilinear interpolation or the table mapping (+-1e308 gave a blank image),
+  // and denormal-scale data would collapse to one table entry. Such volumes are sampled from a
+  // float copy scaled by an exact power of two; the TF range is scaled alike, so the image is
+  // the one of the unscaled data. NaN stays NaN and +-Inf stays +-Inf in the copy.
+  if (v.type == VoxelType::Float32 || v.type == VoxelType::Float64) {
+    const int64_t n = v.voxelCount();
+    const double m = v.type == VoxelType::Float32 ? maxFiniteMagnitude(static_cast<const float*>(v.data), n)
+                                                  : maxFiniteMagnitude(static_cast<const double*>(v.data), n);
+    if (m > 0 && (m > 0x1p60 || m < 0x1p-60)) {
+      int e = 0;
+      std::frexp(m, &e);
+      auto copy = std::make_shared<std::vector<unsigned char>>(size_t(n) * sizeof(float));
+      float* out = reinterpret_cast<float*>(copy->data());
+      // m * 2^-e lies in [0.5, 1); ldexp is exact and reaches denormal scales a factor can't.
+      if (v.type == VoxelType::Float32) scaleToFloat(static_cast<const float*>(v.data), out, n, -e);
+      else scaleToFloat(static_cast<const double*>(v.data), out, n, -e);
+      impl_->volume.type = VoxelType::Float32;
+      impl_->volume.storage = copy;
+      impl_->volume.data = copy->data();
+      impl_->valueExponent = -e;
+    }
+  }
   impl_->haveVolume = true;
   impl_->rangesDirty = true;
   impl_->tableDirty = true;  // the default sample distance follows the spacing
@@ -216,11 +333,21 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   update();
   Impl& d = *impl_;
   FrameView f{};
+  // The kernels march in float in a frame relative to the volume's origin: both matrices are
+  // composed with the origin shift here in double, so georeferenced data (origin 1e6..1e7,
+  // where a float ulp is ~1 world unit) renders exactly like the same volume at the origin.
   mat4 vp = multiply(cam.proj, cam.view), ivp;
   if (!invert(vp, ivp)) throw std::invalid_argument("camera matrix is singular");
-  for (int i = 0; i < 16; ++i) f.invViewProj[i] = float(ivp.m[i]);
+  mat4 toOrigin = identity4();
+  Volume atOrigin = d.volume;
+  for (int i = 0; i < 3; ++i) {
+    toOrigin.m[12 + i] = -d.volume.origin[i];
+    atOrigin.origin[i] = 0;
+  }
+  const mat4 ivpRel = multiply(toOrigin, ivp);
+  for (int i = 0; i < 16; ++i) f.invViewProj[i] = float(ivpRel.m[i]);
   mat4 w2i;
-  if (!invert(d.volume.indexToWorld(), w2i)) throw std::invalid_argument("volume direction/spacing is singular");
+  if (!invert(atOrigin.indexToWorld(), w2i)) throw std::invalid_argument("volume direction/spacing is singular");
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) f.worldToIndex[r * 4 + c] = float(w2i.m[c * 4 + r]);
   f.width = width;
@@ -268,5 +395,6 @@ Tree Engine::tree() {
   return impl_->backend->tree();
 }
 double Engine::sampleDistance() const { return impl_->dt(); }
+int Engine::valueExponent() const { return impl_->valueExponent; }
 
 }  // namespace spaceskip

@@ -19,7 +19,9 @@ TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double l
   tf.rangeMax = hi;
   tf.table.resize(size_t(size));
   for (int i = 0; i < size; ++i) {
-    double v = size == 1 ? lo : lo + (hi - lo) * double(i) / double(size - 1);
+    // lo*(1-t) + hi*t and halved differences: no overflow for ranges as wide as +-1e308.
+    const double t = size == 1 ? 0.0 : double(i) / double(size - 1);
+    double v = lo * (1.0 - t) + hi * t;
     auto it = std::lower_bound(pts.begin(), pts.end(), v, [](const TFPoint& p, double x) { return p.value < x; });
     TFPoint p;
     if (it == pts.begin()) p = pts.front();
@@ -27,7 +29,7 @@ TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double l
     else {
       const TFPoint& a = *(it - 1);
       const TFPoint& b = *it;
-      double f = b.value > a.value ? (v - a.value) / (b.value - a.value) : 0.0;
+      double f = b.value > a.value ? (0.5 * v - 0.5 * a.value) / (0.5 * b.value - 0.5 * a.value) : 0.0;
       auto mix = [f](float x, float y) { return float(x + (y - x) * f); };
       p = TFPoint{v, mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b), mix(a.a, b.a)};
     }
@@ -37,8 +39,7 @@ TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double l
 }
 
 TransferFunction TransferFunction::preset(const std::string& name, double lo, double hi, int size) {
-  const double w = hi - lo;
-  auto at = [&](double f) { return lo + f * w; };
+  auto at = [&](double f) { return lo * (1.0 - f) + hi * f; };
   std::vector<TFPoint> p;
   if (name == "ramp") {
     p = {{at(0.0), 0.2f, 0.3f, 0.9f, 0.f}, {at(0.1), 0.2f, 0.3f, 0.9f, 0.f},
