@@ -30,6 +30,7 @@
 #include "spaceskip/Engine.h"
 
 #include <algorithm>
+#include <set>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -136,6 +137,10 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
 
   // One message per distinct problem, not one per frame.
   std::string LastProblem;
+  // Warnings (engine fallbacks, clamps) already said by this mapper: each cause once, also
+  // across the engines that backend switches create.
+  std::set<std::string> Said;
+  double SampleDistanceUsed = 0;
 
   std::string BackendUsed = "none";
   std::string BuilderUsed = "none";
@@ -234,6 +239,17 @@ const char* vtkSpaceSkippingVolumeMapper::GetBackendUsed()
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
 {
   return this->Internals->BuilderUsed.c_str();
+}
+double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
+{
+  return this->Internals->SampleDistanceUsed;
+}
+void vtkSpaceSkippingVolumeMapper::WarnOnce(const std::string& message)
+{
+  if (this->Internals->Said.insert(message).second)
+  {
+    vtkWarningMacro(<< message);
+  }
 }
 int vtkSpaceSkippingVolumeMapper::GetBuildCount()
 {
@@ -426,12 +442,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       fail(std::string("cannot create the SpaceSkip engine: ") + e.what());
       return;
     }
-    d.Engine->setLogger([this](const std::string& m) { vtkWarningWithObjectMacro(this, << m); });
+    d.Engine->setLogger([this](const std::string& m) { this->WarnOnce(m); });
     d.EngineBackend = this->Backend;
     if (this->Backend == CUDA && d.Engine->backendKind() != spaceskip::BackendKind::CUDA)
     {
-      vtkWarningMacro(<< "CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
-                         "without CUDA); using the CPU backend");
+      this->WarnOnce("CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
+                     "without CUDA); using the CPU backend");
     }
     d.ResetVolume();
     d.ResetTF();
@@ -626,6 +642,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       width, height, engine.frameStats().seconds, engine.frameStats().backend.c_str());
     d.BackendUsed = engine.frameStats().backend;
     d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
+    d.SampleDistanceUsed = engine.sampleDistance();
 
     // Composite: premultiplied RGBA over what is drawn, (ONE, ONE_MINUS_SRC_ALPHA).
     if (!d.Texture)

@@ -23,6 +23,7 @@
 #include "vtkVolumeMapper.h"
 
 #include <memory> // For std::unique_ptr
+#include <string> // For WarnOnce
 
 class vtkOpenGLRenderWindow;
 class vtkRenderer;
@@ -166,6 +167,9 @@ public:
   const char* GetBackendUsed();
   /// The builder that actually ran (after fallbacks), as a name; "none" before the first build.
   const char* GetBuilderUsed();
+  /// The sample distance of the last frame in world units, after the engine's bounds (at least
+  /// 1/16 of the smallest spacing, at most 2^20 samples per ray); 0 before the first frame.
+  double GetSampleDistanceUsed();
   ///@}
 
   ///@{
@@ -198,6 +202,9 @@ protected:
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;
   void operator=(const vtkSpaceSkippingVolumeMapper&) = delete;
+
+  // Says a warning once per distinct message for the life of the mapper.
+  void WarnOnce(const std::string& message);
 
   // Reads the window depth of the viewport into the internal buffer (resolving MSAA if needed).
   bool ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);

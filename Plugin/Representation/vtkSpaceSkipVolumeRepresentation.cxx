@@ -101,6 +101,10 @@ double vtkSpaceSkipVolumeRepresentation::GetLastRenderSeconds()
 {
   return this->SpaceSkipMapper->GetLastRenderSeconds();
 }
+double vtkSpaceSkipVolumeRepresentation::GetSampleDistanceUsed()
+{
+  return this->SpaceSkipMapper->GetSampleDistanceUsed();
+}
 double vtkSpaceSkipVolumeRepresentation::GetNodeCount()
 {
   return static_cast<double>(this->SpaceSkipMapper->GetNodeCount());

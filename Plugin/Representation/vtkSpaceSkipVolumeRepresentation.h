@@ -54,6 +54,7 @@ public:
   double GetLastBuildSeconds();
   double GetLastClassifySeconds();
   double GetLastRenderSeconds();
+  double GetSampleDistanceUsed();
   double GetNodeCount();
   int GetTreeHeight();
   double GetLeafCount();

@@ -171,6 +171,14 @@ fine = shot("prop_sd025.png")
 p_fine = ssptest.psnr(ref, fine)
 ok.check(p_fine > p_coarse, "a finer distance (0.25) stays closer to auto (0.5) than 2.0 does "
          "(%.2f > %.2f dB)" % (p_fine, p_coarse))
+# A typo far below the voxel size (1e-4 ran for minutes and froze the GUI) is clamped to 1/16
+# of the smallest spacing (1 here: auto is 0.5), said once, and shown as Sample Distance Used.
+roundtrip("SampleDistance", 1e-6, 1e-6)
+tiny = shot("prop_sd_tiny.png")
+used = ssptest.stats(disp)["SampleDistanceUsed"]
+ok.check(used >= 1.0 / 16 * 0.999 and used <= 1.0 / 16 * 1.001,
+         "SampleDistance 1e-6 is clamped to 1/16 of the spacing (used %g)" % used)
+ok.check(ssptest.psnr(ref, tiny) > 30.0, "... and draws the volume")
 roundtrip("SampleDistance", 0.0, 0.0)
 again = shot("prop_sd_auto.png")
 ok.check(ssptest.psnr(ref, again) >= 60.0, "SampleDistance 0 (auto) renders the first image again")
