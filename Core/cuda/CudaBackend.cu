@@ -398,6 +398,7 @@ class CudaBackend final : public Backend {
       }
     }
     SS_CUDA_CHECK_LAUNCH(renderKernel);
+    SS_CUDA_CHECK(cuda::injectedRenderError());
     SS_CUDA_CHECK(cudaEventRecord(ev1_, stream_));
     out.width = f.width;
     out.height = f.height;
