@@ -17,6 +17,7 @@
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
 #include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
@@ -27,9 +28,11 @@
 #include "vtkVolumeProperty.h"
 #include "vtk_glew.h"
 
+#include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
 
 #include <algorithm>
+#include <array>
 #include <set>
 #include <cmath>
 #include <sstream>
@@ -154,7 +157,6 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   bool WarnedNearest = false;
   bool WarnedShade = false;
   bool WarnedBlend = false;
-  bool WarnedClip = false;
   bool WarnedDepthRead = false;
 
   void ResetVolume()
@@ -243,6 +245,10 @@ const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
 double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
 {
   return this->Internals->SampleDistanceUsed;
+}
+vtkIdType vtkSpaceSkippingVolumeMapper::GetDeviceBytesInUse()
+{
+  return static_cast<vtkIdType>(spaceskip::cudaDeviceBytesInUse());
 }
 void vtkSpaceSkippingVolumeMapper::WarnOnce(const std::string& message)
 {
@@ -573,9 +579,6 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       "shading is not supported yet; rendering unshaded (emission-absorption)");
     unsupported(this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND, d.WarnedBlend,
       "only the composite blend mode is supported; rendering with composite blending");
-    unsupported(this->Cropping != 0 ||
-        (this->ClippingPlanes && this->ClippingPlanes->GetNumberOfItems() > 0),
-      d.WarnedClip, "cropping and clipping planes are not supported; rendering the whole volume");
 
     spaceskip::BuildParams bp;
     bp.builder = static_cast<spaceskip::BuilderKind>(this->Builder);
@@ -588,6 +591,33 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     spaceskip::RenderParams rp = engine.renderParams();
     rp.sampleDistance = this->SampleDistance;
     rp.ertThreshold = this->EarlyRayTermination ? kErtThreshold : 2.0;
+    rp.jitter = this->UseJittering != 0;
+    // Cropping: the planes are in the data's coordinates, as the engine's.
+    rp.cropping = this->Cropping != 0;
+    std::copy(this->CroppingRegionPlanes, this->CroppingRegionPlanes + 6, rp.croppingPlanes);
+    rp.croppingFlags = this->CroppingRegionFlags;
+    // Clipping planes are in world coordinates; the engine works in the data's, so each plane
+    // n.X + d >= 0 becomes (A^T n).x + (n.t + d) >= 0 for X = A x + t, A the volume's matrix.
+    rp.clipPlanes.clear();
+    if (this->ClippingPlanes)
+    {
+      vtkMatrix4x4* A = vol->GetMatrix();
+      this->ClippingPlanes->InitTraversal();
+      while (vtkPlane* plane = this->ClippingPlanes->GetNextItem())
+      {
+        double n[3], p[3];
+        plane->GetNormal(n);
+        plane->GetOrigin(p);
+        std::array<double, 4> c{};
+        for (int k = 0; k < 3; ++k)
+        {
+          c[k] = n[0] * A->GetElement(0, k) + n[1] * A->GetElement(1, k) + n[2] * A->GetElement(2, k);
+        }
+        c[3] = n[0] * (A->GetElement(0, 3) - p[0]) + n[1] * (A->GetElement(1, 3) - p[1]) +
+          n[2] * (A->GetElement(2, 3) - p[2]);
+        rp.clipPlanes.push_back(c);
+      }
+    }
     engine.setRenderParams(rp);
 
     // Camera: the volume's matrix is folded into the view, so the engine marches in the
@@ -722,6 +752,7 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Backend: "
      << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";
   os << indent << "EarlyRayTermination: " << (this->EarlyRayTermination ? "On" : "Off") << "\n";
+  os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
   os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
   os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";

@@ -153,6 +153,19 @@ public:
 
   ///@{
   /**
+   * Jittering (vtkGPUVolumeRayCastMapper's UseJittering): each pixel's samples start at a
+   * random fraction of the sample distance, trading wood-grain artefacts at large sample
+   * distances for noise. Skipping stays lossless (the jittered lattice is the same for every
+   * builder). Off by default. Cropping (vtkVolumeMapper's regions) and clipping planes
+   * (vtkAbstractMapper) are honoured as well; they cut samples exactly.
+   */
+  vtkSetMacro(UseJittering, vtkTypeBool);
+  vtkGetMacro(UseJittering, vtkTypeBool);
+  vtkBooleanMacro(UseJittering, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -170,6 +183,8 @@ public:
   /// The sample distance of the last frame in world units, after the engine's bounds (at least
   /// 1/16 of the smallest spacing, at most 2^20 samples per ray); 0 before the first frame.
   double GetSampleDistanceUsed();
+  /// Bytes of device memory SpaceSkip holds now (all mappers of the process; 0 without CUDA).
+  vtkIdType GetDeviceBytesInUse();
   ///@}
 
   ///@{
@@ -198,6 +213,7 @@ protected:
   double SampleDistance = 0.0;
   int Backend = Auto;
   vtkTypeBool EarlyRayTermination = 1;
+  vtkTypeBool UseJittering = 0;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;

@@ -9,6 +9,7 @@
 #include "TransferFunction.h"
 #include "Volume.h"
 
+#include <array>
 #include <functional>
 #include <stdexcept>
 #include <memory>
@@ -62,7 +63,19 @@ struct RenderParams {
   unsigned jitterSeed = 0;
   FilterMode filter = FilterMode::Exact;
   bool countSamples = false;   ///< statistics: FrameStats::samples (costs a per-pixel buffer)
+  /// vtkVolumeMapper cropping: six planes (xmin, xmax, ymin, ymax, zmin, zmax) in the volume's
+  /// coordinates (origin + index * spacing) cut the box into 27 regions; region
+  /// i + 3j + 9k is drawn when bit i + 3j + 9k of `croppingFlags` is set (0x2000: the
+  /// sub-volume between the planes, VTK_CROP_SUBVOLUME).
+  bool cropping = false;
+  double croppingPlanes[6] = {0, 0, 0, 0, 0, 0};
+  int croppingFlags = 0x2000;
+  /// Clipping planes in the volume's world frame: a point x is kept where
+  /// n.x + d >= 0 for every plane (nx, ny, nz, d), as vtkPlane's normal points to the kept side.
+  std::vector<std::array<double, 4>> clipPlanes;
 };
+/// At most this many clipping planes (VTK's mappers take six).
+constexpr int kMaxClipPlanes = 6;
 
 /// Bounds on the work per ray (so a typo in Sample Distance cannot freeze ParaView's GUI).
 /// The step is at least the smallest voxel spacing / kMinStepsPerVoxel, and a ray through the

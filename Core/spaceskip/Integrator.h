@@ -25,7 +25,65 @@ struct FrameView {
   TreeView tree;           ///< Tree and Hybrid
   TransferFunctionView tf;
   unsigned* sampleCount;   ///< optional per-pixel count of samples taken (statistics)
+  int numClipPlanes;       ///< index-space half-spaces n.p + d >= 0 kept (convex: one interval)
+  float clip[6][4];
+  int cropping;            ///< 1: only regions of cropFlags between the planes are drawn
+  int cropFlags;           ///< bit i + 3j + 9k: region (i, j, k) of the 3x3x3 split is drawn
+  float crop[6];           ///< index-space planes x0, x1, y0, y1, z0, z1
 };
+
+/// Clips [tmin, tmax] to the convex intersection of the clipping half-spaces; false if empty.
+SS_FUNC bool clipToPlanes(const FrameView& f, const Ray& r, float& tmin, float& tmax) {
+  for (int i = 0; i < f.numClipPlanes; ++i) {
+    const float* c = f.clip[i];
+    const float num = c[0] * r.org.x + c[1] * r.org.y + c[2] * r.org.z + c[3];
+    const float den = c[0] * r.dir.x + c[1] * r.dir.y + c[2] * r.dir.z;
+    if (den == 0.f) {
+      if (num < 0.f) return false;  // parallel to the plane, on the removed side
+      continue;
+    }
+    const float t = -num / den;
+    if (den > 0.f) tmin = ss_max(tmin, t);  // entering the kept side
+    else tmax = ss_min(tmax, t);
+  }
+  return tmin < tmax;
+}
+
+/// Region index (0..2) of coordinate x between the planes lo and hi of one axis.
+SS_FUNC int cropSlab(float x, float lo, float hi) { return x < lo ? 0 : (x < hi ? 1 : 2); }
+
+/// Calls march(a, b) for each part of [tmin, tmax] that lies in a drawn cropping region, front
+/// to back: the six planes split the ray into at most seven pieces, each inside one region.
+template <class March>
+SS_FUNC void forEachCroppedInterval(const FrameView& f, const Ray& r, float tmin, float tmax, March&& march) {
+  float ts[8];
+  int n = 0;
+  ts[n++] = tmin;
+  for (int a = 0; a < 6; ++a) {
+    const float o = a < 2 ? r.org.x : (a < 4 ? r.org.y : r.org.z);
+    const float d = a < 2 ? r.dir.x : (a < 4 ? r.dir.y : r.dir.z);
+    if (d == 0.f) continue;
+    const float t = (f.crop[a] - o) / d;
+    if (t > tmin && t < tmax) ts[n++] = t;
+  }
+  ts[n++] = tmax;
+  for (int i = 1; i < n; ++i)  // insertion sort: at most 8 values
+    for (int j = i; j > 0 && ts[j] < ts[j - 1]; --j) {
+      const float x = ts[j];
+      ts[j] = ts[j - 1];
+      ts[j - 1] = x;
+    }
+  for (int i = 0; i + 1 < n; ++i) {
+    const float a = ts[i], b = ts[i + 1];
+    if (!(a < b)) continue;
+    const float tm = 0.5f * (a + b);
+    const vec3f p = r.org + r.dir * tm;
+    const int region = cropSlab(p.x, f.crop[0], f.crop[1]) + 3 * cropSlab(p.y, f.crop[2], f.crop[3]) +
+                       9 * cropSlab(p.z, f.crop[4], f.crop[5]);
+    if ((f.cropFlags >> region) & 1)
+      if (!march(a, b)) return;
+  }
+}
 
 /// A voxel as the integrator samples it. +-Inf becomes +-2^100: above every finite value (the
 /// engine rescales floating volumes into [2^-60, 2^60]), so it takes the end entry of the table,
@@ -175,21 +233,29 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
 
+  // The sample lattice stays anchored at the box entry: clipping and cropping only choose which
+  // samples of the unclipped ray are taken, so they never shift one.
   IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u};
   if (f.jitter) m.t0 += f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f);
-  switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
-    case TraversalKind::Naive: m(tEnter, tExit); break;
-    case TraversalKind::Grid: traverseGrid(f.grid, r, inv, tEnter, tExit, m); break;
-    case TraversalKind::Tree: {
-      TreeLeaf<Sampler> leaf{&m};
-      traverseTree(f.tree, r, inv, tEnter, tExit, leaf);
-      break;
+  auto march = [&](float a, float b) -> bool {
+    switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
+      case TraversalKind::Naive: return m(a, b);
+      case TraversalKind::Grid: return traverseGrid(f.grid, r, inv, a, b, m);
+      case TraversalKind::Tree: {
+        TreeLeaf<Sampler> leaf{&m};
+        return traverseTree(f.tree, r, inv, a, b, leaf);
+      }
+      case TraversalKind::Hybrid: {
+        HybridLeaf<Sampler> leaf{&m, inv};
+        return traverseTree(f.tree, r, inv, a, b, leaf);
+      }
     }
-    case TraversalKind::Hybrid: {
-      HybridLeaf<Sampler> leaf{&m, inv};
-      traverseTree(f.tree, r, inv, tEnter, tExit, leaf);
-      break;
-    }
+    return true;
+  };
+  float a = tEnter, b = tExit;
+  if (f.numClipPlanes == 0 || clipToPlanes(f, r, a, b)) {
+    if (f.cropping) forEachCroppedInterval(f, r, a, b, march);
+    else march(a, b);
   }
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
   return m.acc;

@@ -356,6 +356,32 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.boxHi = vec3f{float(cd.x), float(cd.y), float(cd.z)};
   f.dt = float(d.dt());
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
+  // Clipping planes and cropping planes into the index space of the integrator (in double).
+  const mat4 indexToWorldRel = atOrigin.indexToWorld();
+  const double* L = indexToWorldRel.m;  // column-major: index axis c is column c
+  f.numClipPlanes = 0;
+  if (int(d.render.clipPlanes.size()) > kMaxClipPlanes)
+    d.warn("more than " + std::to_string(kMaxClipPlanes) + " clipping planes: using the first " +
+           std::to_string(kMaxClipPlanes));
+  for (const auto& pl : d.render.clipPlanes) {
+    if (f.numClipPlanes == kMaxClipPlanes) break;
+    if (!(std::isfinite(pl[0]) && std::isfinite(pl[1]) && std::isfinite(pl[2]) && std::isfinite(pl[3]))) {
+      d.warn("a clipping plane with a non-finite normal or offset is ignored");
+      continue;
+    }
+    float* c = f.clip[f.numClipPlanes++];
+    for (int k = 0; k < 3; ++k) c[k] = float(pl[0] * L[k * 4] + pl[1] * L[k * 4 + 1] + pl[2] * L[k * 4 + 2]);
+    c[3] = float(pl[0] * d.volume.origin[0] + pl[1] * d.volume.origin[1] + pl[2] * d.volume.origin[2] + pl[3]);
+  }
+  f.cropping = d.render.cropping ? 1 : 0;
+  f.cropFlags = d.render.croppingFlags & 0x7ffffff;
+  for (int a = 0; a < 3; ++a) {
+    double lo = d.render.croppingPlanes[2 * a], hi = d.render.croppingPlanes[2 * a + 1];
+    if (lo > hi) std::swap(lo, hi);
+    const double o = d.volume.origin[a], sp = d.volume.spacing[a];
+    f.crop[2 * a] = float(std::clamp((lo - o) / sp, -1e30, 1e30));
+    f.crop[2 * a + 1] = float(std::clamp((hi - o) / sp, -1e30, 1e30));
+  }
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
   std::vector<unsigned> counts;

@@ -63,7 +63,7 @@ int TestSpaceSkippingVolumeSoak(int, char*[])
 
   vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
   mapper->SetInputData(image);
-  mapper->SetBackendToCPU();
+  mapper->SetBackendToAuto(); // CUDA where a device is usable (device memory checked too)
   vtkNew<vtkVolumeProperty> prop;
   sstest::SetupProperty(prop, lo, hi, 0.6);
   vtkNew<vtkVolume> volume;
@@ -108,6 +108,7 @@ int TestSpaceSkippingVolumeSoak(int, char*[])
   }
   sstest::CountNonBackground(sstest::Capture(win), bg);
   const double rss0 = ResidentBytes();
+  const vtkIdType device0 = mapper->GetDeviceBytesInUse();
   const int builds0 = mapper->GetBuildCount(), classify0 = mapper->GetClassifyCount();
   const int color0 = mapper->GetColorUpdateCount();
   int blank = 0;
@@ -125,18 +126,21 @@ int TestSpaceSkippingVolumeSoak(int, char*[])
     }
   }
   const double rss1 = ResidentBytes();
+  const vtkIdType device1 = mapper->GetDeviceBytesInUse();
   const int builds = mapper->GetBuildCount() - builds0;
   const int classified = mapper->GetClassifyCount() - classify0;
   const int colored = mapper->GetColorUpdateCount() - color0;
   std::cout << "1000 edits: RSS " << rss0 / 1048576.0 << " -> " << rss1 / 1048576.0
             << " MiB (growth " << (rss1 - rss0) / 1024.0 << " KiB); " << classified
             << " classifications, " << builds << " builds, " << colored
-            << " colour updates; blank frames " << blank << "/10\n";
+            << " colour updates; blank frames " << blank << "/10; backend "
+            << mapper->GetBackendUsed() << ", device bytes " << device0 << " -> " << device1 << "\n";
   bool ok = true;
   SS_CHECK(rss1 - rss0 <= 1048576.0);
   SS_CHECK(classified == 500 && colored == 500); // each edit did exactly what it needed
   SS_CHECK(builds > 0 && builds < 500);          // rebuilt only when the occupancy changed
   SS_CHECK(blank == 0);
+  SS_CHECK(device1 == device0);
 
   // 200 builder/backend switches with a sample distance far below the floor.
   mapper->SetSampleDistance(1e-6);
