@@ -233,11 +233,18 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
 
-  // The sample lattice stays anchored at the box entry: clipping and cropping only choose which
-  // samples of the unclipped ray are taken, so they never shift one.
+  // The sample lattice is anchored where the ray enters the drawn part of the volume (the box,
+  // cut by the clipping planes, and the first drawn cropping region), as VTK's mapper does by
+  // clipping its proxy geometry: no wood grain on cut faces. The anchor depends on the ray and
+  // the planes only, never on the skipping structure, so every builder takes the same samples.
   IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u};
-  if (f.jitter) m.t0 += f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f);
+  const float jitter = f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f;
+  bool anchored = false;
   auto march = [&](float a, float b) -> bool {
+    if (!anchored) {
+      m.t0 = a + jitter;
+      anchored = true;
+    }
     switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
       case TraversalKind::Naive: return m(a, b);
       case TraversalKind::Grid: return traverseGrid(f.grid, r, inv, a, b, m);

@@ -87,6 +87,14 @@ int vtkSpaceSkipVolumeRepresentation::GetEarlyRayTermination()
 {
   return this->SpaceSkipMapper->GetEarlyRayTermination() ? 1 : 0;
 }
+void vtkSpaceSkipVolumeRepresentation::SetUseJittering(int v)
+{
+  this->SpaceSkipMapper->SetUseJittering(v != 0);
+}
+int vtkSpaceSkipVolumeRepresentation::GetUseJittering()
+{
+  return this->SpaceSkipMapper->GetUseJittering() ? 1 : 0;
+}
 
 //------------------------------------------------------------------------------
 double vtkSpaceSkipVolumeRepresentation::GetLastBuildSeconds()

@@ -47,6 +47,8 @@ public:
   int GetBackend();
   void SetEarlyRayTermination(int on);
   int GetEarlyRayTermination();
+  void SetUseJittering(int on);
+  int GetUseJittering();
   ///@}
 
   ///@{
