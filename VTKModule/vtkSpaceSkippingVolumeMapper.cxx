@@ -33,8 +33,11 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <set>
 #include <cmath>
+#include <cstdlib>
+#include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -97,6 +100,32 @@ bool ConvertibleToFloat(int vtkType)
   }
 }
 
+// SPACESKIP_BACKEND=cpu|cuda|auto forces the backend of every mapper in the process, whatever
+// its Backend property says (tests and benchmarks on a GPU machine); -1 when unset or unknown.
+int BackendFromEnvironment()
+{
+  const char* e = std::getenv("SPACESKIP_BACKEND");
+  const std::string v = e ? e : "";
+  if (v == "cpu" || v == "CPU")
+  {
+    return vtkSpaceSkippingVolumeMapper::CPU;
+  }
+  if (v == "cuda" || v == "CUDA")
+  {
+    return vtkSpaceSkippingVolumeMapper::CUDA;
+  }
+  if (v == "auto" || v == "Auto")
+  {
+    return vtkSpaceSkippingVolumeMapper::Auto;
+  }
+  return -1;
+}
+
+double SecondsSince(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // Core's column-major mat4 from a row-major vtkMatrix4x4.
 spaceskip::mat4 ToCore(const vtkMatrix4x4* m)
 {
@@ -147,6 +176,17 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
 
   std::string BackendUsed = "none";
   std::string BuilderUsed = "none";
+  // SPACESKIP_REPORT set: one stdout line per mapper whenever backend or builder changes.
+  bool Report = std::getenv("SPACESKIP_REPORT") != nullptr;
+  std::string Reported;
+
+  // Where the last Render() spent its time (seconds; see the getters).
+  double RangeSeconds = 0;
+  double UpdateSeconds = 0;
+  double DepthSeconds = 0;
+  double EngineSeconds = 0;
+  double CompositeSeconds = 0;
+  double MapperSeconds = 0;
 
   spaceskip::Image Image;
   std::vector<float> Depth;
@@ -217,6 +257,39 @@ double vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds()
 double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
 {
   return this->Internals->Engine ? this->Internals->Engine->frameStats().seconds : 0.0;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
+{
+  if (!this->Internals->Engine)
+  {
+    return 0.0;
+  }
+  const spaceskip::FrameStats& f = this->Internals->Engine->frameStats();
+  return f.deviceSeconds >= 0 ? f.deviceSeconds : f.seconds;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastScalarRangeSeconds()
+{
+  return this->Internals->RangeSeconds;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastUpdateSeconds()
+{
+  return this->Internals->UpdateSeconds;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds()
+{
+  return this->Internals->DepthSeconds;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds()
+{
+  return this->Internals->EngineSeconds;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastCompositeSeconds()
+{
+  return this->Internals->CompositeSeconds;
+}
+double vtkSpaceSkippingVolumeMapper::GetLastMapperSeconds()
+{
+  return this->Internals->MapperSeconds;
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetNodeCount()
 {
@@ -430,8 +503,13 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
 
+  const auto tRender = std::chrono::steady_clock::now();
+  d.RangeSeconds = d.UpdateSeconds = d.DepthSeconds = d.EngineSeconds = d.CompositeSeconds = 0;
+  const int forced = BackendFromEnvironment();
+  const int backend = forced >= 0 ? forced : this->Backend;
+
   // Engine (re)created when the backend changes; counts are carried over.
-  if (!d.Engine || d.EngineBackend != this->Backend)
+  if (!d.Engine || d.EngineBackend != backend)
   {
     d.CountOffset = d.Counts();
     d.Engine.reset();
@@ -439,7 +517,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     {
       // Engine(CUDA) would report a missing device before setLogger() can route the message to
       // VTK; Auto makes the same choice silently and the mapper reports it below.
-      const spaceskip::BackendKind kind = this->Backend == CPU ? spaceskip::BackendKind::CPU
+      const spaceskip::BackendKind kind = backend == CPU ? spaceskip::BackendKind::CPU
                                                                : spaceskip::BackendKind::Auto;
       d.Engine.reset(new spaceskip::Engine(kind));
     }
@@ -449,8 +527,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       return;
     }
     d.Engine->setLogger([this](const std::string& m) { this->WarnOnce(m); });
-    d.EngineBackend = this->Backend;
-    if (this->Backend == CUDA && d.Engine->backendKind() != spaceskip::BackendKind::CUDA)
+    d.EngineBackend = backend;
+    if (backend == CUDA && d.Engine->backendKind() != spaceskip::BackendKind::CUDA)
     {
       this->WarnOnce("CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
                      "without CUDA); using the CPU backend");
@@ -500,12 +578,15 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         d.Borrowed = nullptr;
       }
       engine.setVolume(v);
-      scalars->GetFiniteRange(d.ScalarRange, 0);
-      if (!(d.ScalarRange[0] <= d.ScalarRange[1]))
+      // One parallel pass over the voxels the engine reads (vtkDataArray::GetFiniteRange was
+      // serial here: 267 s for the first frame of a 2048^3 uint8 volume).
+      const auto tRange = std::chrono::steady_clock::now();
+      if (!v.scalarRange(d.ScalarRange[0], d.ScalarRange[1]))
       {
         d.ScalarRange[0] = 0; // no finite value at all: an empty table range
         d.ScalarRange[1] = 1;
       }
+      d.RangeSeconds = SecondsSince(tRange);
       d.InputKey = input;
       d.InputMTime = input->GetMTime();
       d.ScalarsKey = scalars;
@@ -642,7 +723,13 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       return;
     }
 
+    // Ranges, upload, classification, build: whatever the changes above left to do.
+    auto t0 = std::chrono::steady_clock::now();
+    engine.update();
+    d.UpdateSeconds = SecondsSince(t0);
+
     // Depth of the opaque geometry already drawn, read from the framebuffer being rendered.
+    t0 = std::chrono::steady_clock::now();
     vtkOpenGLState* ostate = renWin->GetState();
     const float* depth = nullptr;
     d.Depth.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
@@ -656,8 +743,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       d.WarnedDepthRead = true;
     }
 
+    d.DepthSeconds = SecondsSince(t0);
+
     const int buildsBefore = engine.counters().builds;
+    t0 = std::chrono::steady_clock::now();
     engine.render(camera, width, height, d.Image, depth);
+    d.EngineSeconds = SecondsSince(t0);
     if (engine.counters().builds != buildsBefore)
     {
       const spaceskip::BuildStats& bs = engine.buildStats();
@@ -673,6 +764,19 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.BackendUsed = engine.frameStats().backend;
     d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
     d.SampleDistanceUsed = engine.sampleDistance();
+    if (d.Report && d.Reported != d.BackendUsed + d.BuilderUsed)
+    {
+      // What actually ran, for logs of test and benchmark runs on other machines.
+      const GLubyte* glRenderer = glGetString(GL_RENDERER);
+      const GLubyte* glVendor = glGetString(GL_VENDOR);
+      std::cout << "SpaceSkip: backend " << d.BackendUsed << ", builder " << d.BuilderUsed
+                << ", GL_RENDERER " << (glRenderer ? reinterpret_cast<const char*>(glRenderer) : "?")
+                << ", GL_VENDOR " << (glVendor ? reinterpret_cast<const char*>(glVendor) : "?")
+                << std::endl;
+      d.Reported = d.BackendUsed + d.BuilderUsed;
+    }
+
+    t0 = std::chrono::steady_clock::now();
 
     // Composite: premultiplied RGBA over what is drawn, (ONE, ONE_MINUS_SRC_ALPHA).
     if (!d.Texture)
@@ -718,6 +822,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.Quad->Program->SetUniformi("ssImage", d.Texture->GetTextureUnit());
     d.Quad->Render();
     d.Texture->Deactivate();
+    d.CompositeSeconds = SecondsSince(t0);
+    d.MapperSeconds = SecondsSince(tRender);
     d.LastProblem.clear();
   }
   catch (const std::exception& e)

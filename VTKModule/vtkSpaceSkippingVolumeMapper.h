@@ -133,7 +133,10 @@ public:
 
   ///@{
   /**
-   * Auto (default): CUDA when a usable device exists, else CPU.
+   * Auto (default): CUDA when a usable device exists, else CPU. The environment variable
+   * SPACESKIP_BACKEND (cpu, cuda or auto) overrides this property for every mapper of the
+   * process (to run tests and benchmarks on a given backend); SPACESKIP_REPORT (any value) prints
+   * one line per mapper with the backend, builder and GL_RENDERER whenever they change.
    */
   vtkSetClampMacro(Backend, int, Auto, CUDA);
   vtkGetMacro(Backend, int);
@@ -173,6 +176,32 @@ public:
   double GetLastRenderSeconds();
   vtkIdType GetNodeCount();
   int GetTreeHeight();
+  ///@}
+
+  ///@{
+  /**
+   * Where the last Render() spent its wall time, in seconds (host clocks; GL calls are
+   * asynchronous, so the composite time is the texture upload and the draw's submission):
+   * - ScalarRange: the pass over the voxels for the table's range (only when the data changed);
+   * - Update: the engine's upload and value ranges (data changed), classification (opacity
+   *   edit) and hierarchy build (see GetLastBuildSeconds/GetLastClassifySeconds);
+   * - DepthRead: reading the window's depth buffer (waits for the GL work before it);
+   * - EngineRender: the engine's frame: depth upload, kernel, image readback (CUDA), or the
+   *   CPU ray march; GetLastRenderSeconds() is the same frame as the engine timed it;
+   * - Kernel: the render kernel alone (CUDA events), or the CPU frame on the CPU backend;
+   * - Composite: image texture upload and the blending quad;
+   * - Mapper: the whole of Render().
+   */
+  double GetLastScalarRangeSeconds();
+  double GetLastUpdateSeconds();
+  double GetLastDepthReadSeconds();
+  double GetLastEngineRenderSeconds();
+  double GetLastKernelSeconds();
+  double GetLastCompositeSeconds();
+  double GetLastMapperSeconds();
+  ///@}
+
+  ///@{
   vtkIdType GetLeafCount();
   /// Fraction of occupied macro cells in the last classification.
   double GetOccupancy();

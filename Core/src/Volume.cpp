@@ -5,6 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 namespace spaceskip {
 
@@ -97,25 +102,59 @@ double Volume::value(int64_t i, int64_t j, int64_t k) const {
   return 0;
 }
 
-bool Volume::scalarRange(double& lo, double& hi) const {
-  lo = std::numeric_limits<double>::infinity();
-  hi = -lo;
-  const int64_t n = voxelCount();
-  for (int64_t i = 0; i < n; ++i) {
-    double v;
-    switch (type) {
-      case VoxelType::UInt8: v = at<uint8_t>(data, i); break;
-      case VoxelType::Int8: v = at<int8_t>(data, i); break;
-      case VoxelType::UInt16: v = at<uint16_t>(data, i); break;
-      case VoxelType::Int16: v = at<int16_t>(data, i); break;
-      case VoxelType::Float32: v = at<float>(data, i); break;
-      default: v = at<double>(data, i); break;
-    }
-    if (!std::isfinite(v)) continue;
-    lo = std::min(lo, v);
-    hi = std::max(hi, v);
-  }
+namespace {
+// Voxels per serial chunk of the range pass: large enough that a chunk's loop vectorises and
+// the task overhead vanishes, small enough to balance 8 GiB over all cores.
+constexpr int64_t kRangeGrain = int64_t(1) << 20;
+
+// Finite min/max of n voxels of type T, oneTBB parallel (a 2048^3 uint8 volume is 8 Gi voxels:
+// the serial per-voxel switch took tens of seconds there).
+template <class T>
+bool finiteRange(const void* data, int64_t n, double& lo, double& hi) {
+  const T* p = static_cast<const T*>(data);
+  using MinMax = std::pair<double, double>;
+  const MinMax empty{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  const MinMax r = tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, n, kRangeGrain), empty,
+      [p](const tbb::blocked_range<int64_t>& br, MinMax acc) {
+        if constexpr (std::is_integral_v<T>) {
+          T mn = std::numeric_limits<T>::max(), mx = std::numeric_limits<T>::lowest();
+          for (int64_t i = br.begin(); i < br.end(); ++i) {
+            mn = std::min(mn, p[i]);
+            mx = std::max(mx, p[i]);
+          }
+          acc.first = std::min(acc.first, double(mn));
+          acc.second = std::max(acc.second, double(mx));
+        } else {
+          for (int64_t i = br.begin(); i < br.end(); ++i) {
+            const double v = double(p[i]);
+            if (!std::isfinite(v)) continue;
+            acc.first = std::min(acc.first, v);
+            acc.second = std::max(acc.second, v);
+          }
+        }
+        return acc;
+      },
+      [](const MinMax& a, const MinMax& b) {
+        return MinMax{std::min(a.first, b.first), std::max(a.second, b.second)};
+      });
+  lo = r.first;
+  hi = r.second;
   return lo <= hi;
+}
+}  // namespace
+
+bool Volume::scalarRange(double& lo, double& hi) const {
+  const int64_t n = voxelCount();
+  switch (type) {
+    case VoxelType::UInt8: return finiteRange<uint8_t>(data, n, lo, hi);
+    case VoxelType::Int8: return finiteRange<int8_t>(data, n, lo, hi);
+    case VoxelType::UInt16: return finiteRange<uint16_t>(data, n, lo, hi);
+    case VoxelType::Int16: return finiteRange<int16_t>(data, n, lo, hi);
+    case VoxelType::Float32: return finiteRange<float>(data, n, lo, hi);
+    case VoxelType::Float64: return finiteRange<double>(data, n, lo, hi);
+  }
+  return finiteRange<double>(data, n, lo, hi);
 }
 
 void Volume::allocate(vec3l d, VoxelType t) {

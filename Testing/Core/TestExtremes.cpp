@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 using namespace spaceskip;
 
@@ -276,4 +277,31 @@ TEST(Extremes, InfinityTakesTheEndOfTheTableAndNeverMakesNaN) {
   EXPECT_FALSE(hasNonFinite(naive));
   EXPECT_GT(test::coverage(naive), 0.1);  // the Inf half is opaque red
   checkAllBuilders(v, tf, 0, 0, true);
+
+// The parallel range pass (many chunks) equals the serial definition: finite values only, the
+// extremes found wherever they lie, and no finite value at all reports an empty range.
+TEST(Extremes, ScalarRangeParallelSkipsNonFinite) {
+  const vec3l d{160, 160, 130};  // 3.3 M voxels: several chunks of the range pass
+  Volume f = filled(d, VoxelType::Float32, 5.0);
+  float* p = reinterpret_cast<float*>(f.mutableData());
+  const int64_t n = f.voxelCount();
+  p[0] = std::numeric_limits<float>::quiet_NaN();
+  p[n / 3] = std::numeric_limits<float>::infinity();
+  p[n / 2] = -std::numeric_limits<float>::infinity();
+  p[n - 7] = -2.5f;
+  p[(n * 3) / 4] = 11.0f;
+  double lo = 0, hi = 0;
+  ASSERT_TRUE(f.scalarRange(lo, hi));
+  EXPECT_EQ(lo, -2.5);
+  EXPECT_EQ(hi, 11.0);
+
+  Volume s = filled(d, VoxelType::Int16, -3);
+  reinterpret_cast<int16_t*>(s.mutableData())[n - 1] = 1234;
+  reinterpret_cast<int16_t*>(s.mutableData())[1] = -32768;
+  ASSERT_TRUE(s.scalarRange(lo, hi));
+  EXPECT_EQ(lo, -32768.0);
+  EXPECT_EQ(hi, 1234.0);
+
+  Volume nan = filled(vec3l{4, 4, 4}, VoxelType::Float64, std::nan(""));
+  EXPECT_FALSE(nan.scalarRange(lo, hi));
 }

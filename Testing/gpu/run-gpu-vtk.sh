@@ -1,0 +1,159 @@
+#!/usr/bin/env bash
+# On a GPU machine without VTK, X or GL loaders (DEVICE.md): unpacks the bundle made by
+# Testing/gpu/bundle-vtk.sh, starts its Xvfb, picks NVIDIA's GL for the clients
+# (__GLX_VENDOR_LIBRARY_NAME=nvidia; falls back to Mesa and says so), runs every VTK mapper test
+# with the CUDA backend forced (SPACESKIP_BACKEND=cuda) against the CPU baselines and thresholds
+# (then once more as written: Auto/CPU per test, as CI runs them),
+# compute-sanitizer memcheck on mapper tests, and the window benchmark beside the CLI's kernel
+# timings for the same cases. Writes everything into OUTDIR.
+#
+#   Testing/gpu/run-gpu-vtk.sh OUTDIR [PHASE...]
+#   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048
+#          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024)
+#   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), DEADLINE (epoch seconds: phases that would
+#          start after it are skipped), MEMCHECK_TESTS, BENCH_BUILDERS, VTK_GPU (1: also time
+#          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks)
+#
+# OUTDIR receives at most 8 files (the device tool's limit): env.txt, tests.log, memcheck.log,
+# bench.log, bench.csv, cli-bench.log, cli-bench.csv, logs.tgz (everything).
+set -uo pipefail
+out=${1:?usage: run-gpu-vtk.sh OUTDIR [PHASE...]}
+shift
+phases=${*:-tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024}
+src=$(cd "$(dirname "$0")/../.." && pwd)
+bundle=${BUNDLE:-$src/.vtkbundle}
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+work=$(mktemp -d)
+frames=${FRAMES:-16}
+status=0
+has() { case " $phases " in *" $1 "*) return 0 ;; *) return 1 ;; esac; }
+log() { echo "[$(date -u +%H:%M:%S)] $*" | tee -a "$work/run.log"; }
+late() { [ -n "${DEADLINE:-}" ] && [ "$(date +%s)" -ge "$DEADLINE" ]; }
+
+# --- unpack -----------------------------------------------------------------------------------
+B=$work/bundle
+mkdir -p "$B"
+for t in vtk x; do
+  xz -dc "$bundle/$t.tar.xz" | tar -C "$B" -xf - || { echo "cannot unpack $bundle/$t.tar.xz" >&2; exit 1; }
+done
+log "bundle unpacked ($(cat "$B/vtk/COMMIT" 2>/dev/null | head -1))"
+
+{
+  echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
+  echo "host: $(hostname)  phases: $phases  frames: $frames"
+  nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1
+  echo "bundle built from: $(cat "$B/vtk/COMMIT" 2>/dev/null)"
+  echo "tree: $(cd "$src" && git rev-parse HEAD 2>/dev/null || echo 'no git (copied tree)')"
+  echo "cores: $(nproc)  os: $(. /etc/os-release 2>/dev/null; echo "$PRETTY_NAME")"
+} > "$work/env.txt"
+
+# --- X server: the bundled Xvfb, its GLX on the bundled Mesa swrast driver ---------------------
+# Xvfb runs xkbcomp from its compiled-in directory (/usr/bin).
+[ -x /usr/bin/xkbcomp ] || cp "$B/x/bin/xkbcomp" /usr/bin/xkbcomp
+dpy=${XDISPLAY:-77}
+export DISPLAY=:$dpy
+LD_LIBRARY_PATH=$B/x/lib LIBGL_DRIVERS_PATH=$B/x/lib/dri \
+  "$B/x/bin/Xvfb" :$dpy -screen 0 1280x1024x24 -nolisten tcp -noreset -xkbdir "$B/x/share/xkb" \
+  > "$work/xvfb.log" 2>&1 &
+xpid=$!
+for _ in $(seq 50); do [ -S /tmp/.X11-unix/X$dpy ] && break; sleep 0.2; done
+log "Xvfb pid $xpid socket $(ls /tmp/.X11-unix/X$dpy 2>&1)"
+
+# --- GL for the clients: NVIDIA first, Mesa (llvmpipe, bundled) as the fallback ---------------
+export LD_LIBRARY_PATH=$B/vtk/lib
+export __GLX_VENDOR_LIBRARY_NAME=nvidia
+bench=$B/vtk/bin/spaceskip_window_bench
+tests=$B/vtk/bin/vtkSpaceSkipCxxTests
+cli=$B/vtk/bin/spaceskip
+probe() { timeout 60 "$bench" --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 > "$work/probe.log" 2>&1; }
+if probe && grep -q "GL_RENDERER.*NVIDIA" "$work/probe.log"; then
+  gl="NVIDIA GL (__GLX_VENDOR_LIBRARY_NAME=nvidia)"
+else
+  cp "$work/probe.log" "$work/probe-nvidia.log"
+  unset __GLX_VENDOR_LIBRARY_NAME
+  export LD_LIBRARY_PATH=$B/vtk/lib:$B/x/lib LIBGL_DRIVERS_PATH=$B/x/lib/dri
+  probe
+  gl="FALLBACK: Mesa (NVIDIA GL failed: see probe-nvidia.log)"
+fi
+log "client GL: $gl; $(grep GL_RENDERER "$work/probe.log")"
+{ echo "client GL: $gl"; grep GL_RENDERER "$work/probe.log"; } >> "$work/env.txt"
+cp "$work/env.txt" "$out/env.txt"
+
+# --- the VTK mapper tests, CUDA forced --------------------------------------------------------
+cxx=$src/VTKModule/Testing/Cxx/CMakeLists.txt
+testnames=$(sed -n '/vtk_add_test_cxx/,/)/p' "$cxx" | grep -oE 'Test[A-Za-z0-9]+\.cxx(,NO_VALID)?')
+run_tests() {  # BACKEND LOGNAME (BACKEND "asis": no override, each test's own Backend setting)
+  local be=$1 name=$2 pass=0 fail=0 skip=0 t exe valid rc env=()
+  mkdir -p "$work/tmp-$be" "$work/data"
+  for t in $testnames; do
+    exe=${t%%.cxx*}
+    valid=()
+    case $t in *NO_VALID) ;; *) valid=(-V "$src/VTKModule/Testing/Data/Baseline/$exe.png") ;; esac
+    echo "==== $exe (SPACESKIP_BACKEND=$be)" >> "$work/$name"
+    [ "$be" = asis ] && env=(-u SPACESKIP_BACKEND) || env=(SPACESKIP_BACKEND=$be)
+    env "${env[@]}" SPACESKIP_REPORT=1 timeout 300 "$tests" "$exe" -D "$work/data" \
+      -T "$work/tmp-$be" "${valid[@]}" >> "$work/$name" 2>&1
+    rc=$?
+    case $rc in 0) pass=$((pass + 1)) ;; 125) skip=$((skip + 1)) ;; *) fail=$((fail + 1)) ;; esac
+    echo "==== $exe rc=$rc" >> "$work/$name"
+    log "  $be $exe rc=$rc"
+  done
+  log "tests $be: $pass passed, $fail failed, $skip skipped"
+  echo "SUMMARY $be: $pass passed, $fail failed, $skip skipped of $((pass + fail + skip))" >> "$work/$name"
+  [ $fail -eq 0 ] || status=1
+}
+if has tests && ! late; then
+  log "VTK mapper tests, CUDA forced"
+  run_tests cuda tests-cuda.log
+  run_tests asis tests-asis.log
+  { grep -E "^SUMMARY|rc=|SpaceSkip: backend|Backend|PSNR|max diff|check failed|ERROR|Warning|error" \
+      "$work/tests-cuda.log" | head -400; grep -E "^SUMMARY" "$work/tests-asis.log"; } > "$out/tests.log"
+fi
+
+# --- compute-sanitizer memcheck on mapper tests (CUDA) ----------------------------------------
+if has memcheck && ! late; then
+  for exe in ${MEMCHECK_TESTS:-TestSpaceSkippingVolumeBackends TestSpaceSkippingVolumeTFEdit}; do
+    log "memcheck $exe"
+    SPACESKIP_BACKEND=cuda SPACESKIP_REPORT=1 timeout 240 compute-sanitizer --tool memcheck \
+      --error-exitcode 99 "$tests" "$exe" -D "$work/data" -T "$work/tmp-cuda" \
+      > "$work/memcheck-$exe.log" 2>&1
+    rc=$?
+    log "memcheck $exe rc=$rc"
+    [ $rc -eq 0 ] || status=1
+    { echo "==== $exe rc=$rc"; grep -E "ERROR SUMMARY|Invalid|SpaceSkip: backend" "$work/memcheck-$exe.log" | head -20; tail -3 "$work/memcheck-$exe.log"; } >> "$out/memcheck.log"
+  done
+fi
+
+# --- window benchmark + the CLI's kernel timings, same volume, builders, camera and TF ---------
+wb=${BENCH_BUILDERS:-Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4}
+cb=naive,grid,lbvh,lbvh-cpu,kdtree-cpu:mls32,kdtree-gpu-fast:mls32,hybrid,distance-grid,distance-grid:brick4
+window_bench() {  # SHAPE N [--vtk-gpu]
+  local shape=$1 n=$2
+  shift 2
+  late && { log "skip bench $shape$n (deadline)"; return; }
+  log "window bench $shape $n^3 $*"
+  SPACESKIP_BACKEND=cuda timeout 420 "$bench" --shape "$shape" --dims "$n" --frames "$frames" \
+    --size 1024 --builders "$wb" --csv "$out/bench.csv" "$@" >> "$work/bench.log" 2>&1
+  log "window bench rc=$?"
+  cp "$work/bench.log" "$out/bench.log"
+  log "CLI bench gen:$shape:$n"
+  timeout 300 "$cli" bench "gen:$shape:$n" --backend cuda --builders "$cb" --size 1024x1024 \
+    --frames "$frames" --csv "$work/cli-$shape$n.csv" >> "$work/cli-bench.log" 2>&1
+  log "CLI bench rc=$?"
+  cp "$work/cli-bench.log" "$out/cli-bench.log"
+  if [ -f "$work/cli-$shape$n.csv" ]; then
+    [ -f "$out/cli-bench.csv" ] || head -1 "$work/cli-$shape$n.csv" > "$out/cli-bench.csv"
+    tail -n +2 "$work/cli-$shape$n.csv" >> "$out/cli-bench.csv"
+  fi
+}
+vg=()
+[ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
+has bench-nbody1024 && window_bench nbody 1024 "${vg[@]}"
+has bench-nbody2048 && window_bench nbody 2048
+has bench-menger1024 && window_bench menger 1024 "${vg[@]}"
+
+kill $xpid 2>/dev/null
+tar -C "$work" --exclude=bundle -czf "$out/logs.tgz" . 2>/dev/null
+log "done, status=$status"
+exit $status
