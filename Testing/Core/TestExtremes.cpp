@@ -277,6 +277,7 @@ TEST(Extremes, InfinityTakesTheEndOfTheTableAndNeverMakesNaN) {
   EXPECT_FALSE(hasNonFinite(naive));
   EXPECT_GT(test::coverage(naive), 0.1);  // the Inf half is opaque red
   checkAllBuilders(v, tf, 0, 0, true);
+}
 
 // The parallel range pass (many chunks) equals the serial definition: finite values only, the
 // extremes found wherever they lie, and no finite value at all reports an empty range.
