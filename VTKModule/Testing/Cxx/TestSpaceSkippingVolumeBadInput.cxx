@@ -189,9 +189,6 @@ int TestSpaceSkippingVolumeBadInput(int, char*[])
           m->SetBlendModeToMaximumIntensity();
         },
         "only the composite blend mode" },
-      { "cropping",
-        [](vtkSpaceSkippingVolumeMapper* m, vtkVolumeProperty*) { m->CroppingOn(); },
-        "cropping and clipping planes are not supported" },
     };
     for (const Option& o : options)
     {
