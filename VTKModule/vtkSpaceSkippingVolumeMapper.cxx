@@ -21,6 +21,8 @@
 #include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
+#include "vtkSMPTools.h"
+#include "vtkScalarsToColors.h"
 #include "vtkShaderProgram.h"
 #include "vtkSmartPointer.h"
 #include "vtkTextureObject.h"
@@ -173,6 +175,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   // across the engines that backend switches create.
   std::set<std::string> Said;
   double SampleDistanceUsed = 0;
+  int Selection = 0; // the component the volume was made from; -1: the magnitude
 
   std::string BackendUsed = "none";
   std::string BuilderUsed = "none";
@@ -477,14 +480,17 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       "nothing drawn");
     return;
   }
-  if (scalars->GetNumberOfComponents() != 1)
+  // Several components: the one selected by VectorMode/VectorComponent (ParaView's colour
+  // array component, or Magnitude) is rendered, as vtkSmartVolumeMapper does.
+  const int ncomp = scalars->GetNumberOfComponents();
+  const bool magnitude = ncomp > 1 && this->VectorMode == vtkScalarsToColors::MAGNITUDE;
+  const int component = ncomp > 1 && !magnitude ? std::min(std::max(this->VectorComponent, 0), ncomp - 1) : 0;
+  if (ncomp > 1 && vol->GetProperty() && !vol->GetProperty()->GetIndependentComponents())
   {
-    std::ostringstream s;
-    s << "scalars '" << (scalars->GetName() ? scalars->GetName() : "") << "' have "
-      << scalars->GetNumberOfComponents()
-      << " components; only single-component scalars are supported: nothing drawn";
-    fail(s.str());
-    return;
+    this->WarnOnce("dependent components (direct RGBA, or value + opacity: Multi Components "
+                   "Mapping) are not supported; rendering " +
+      std::string(magnitude ? "the magnitude" : "component " + std::to_string(component)) +
+      " through the transfer functions");
   }
   const vtkIdType npts = input->GetNumberOfPoints();
   if (scalars->GetNumberOfTuples() != npts)
@@ -541,9 +547,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   try
   {
     // Volume: only when the data changed (the engine then recomputes its value ranges).
+    const int selection = magnitude ? -1 : component;
     if (!d.HaveVolume || d.InputKey != input || d.InputMTime != input->GetMTime() ||
-      d.ScalarsKey != scalars || d.ScalarsMTime != scalars->GetMTime())
+      d.ScalarsKey != scalars || d.ScalarsMTime != scalars->GetMTime() ||
+      d.Selection != selection)
     {
+      d.Selection = selection;
       spaceskip::Volume v;
       int dims[3];
       input->GetDimensions(dims);
@@ -553,7 +562,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       input->TransformIndexToPhysicalPoint(ext[0], ext[2], ext[4], v.origin);
       const double* dir = input->GetDirectionMatrix()->GetData();
       std::copy(dir, dir + 9, v.direction);
-      if (native && scalars->HasStandardMemoryLayout())
+      if (native && ncomp == 1 && scalars->HasStandardMemoryLayout())
       {
         v.type = vtype;
         v.data = scalars->GetVoidPointer(0);
@@ -565,14 +574,31 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       {
         if (!native)
         {
-          vtkWarningMacro(<< "scalar type " << scalars->GetDataTypeAsString()
-                          << " converted to float (values beyond 2^24 lose precision)");
+          this->WarnOnce(std::string("scalar type ") + scalars->GetDataTypeAsString() +
+            " converted to float (values beyond 2^24 lose precision)");
         }
         d.Converted.resize(static_cast<size_t>(npts));
-        for (vtkIdType i = 0; i < npts; ++i)
-        {
-          d.Converted[static_cast<size_t>(i)] = static_cast<float>(scalars->GetComponent(i, 0));
-        }
+        float* out = d.Converted.data();
+        vtkSMPTools::For(0, npts, [&](vtkIdType begin, vtkIdType end) {
+          std::vector<double> tuple(static_cast<size_t>(ncomp));
+          for (vtkIdType i = begin; i < end; ++i)
+          {
+            if (magnitude)
+            {
+              scalars->GetTuple(i, tuple.data());
+              double m = 0;
+              for (double c : tuple)
+              {
+                m += c * c;
+              }
+              out[i] = static_cast<float>(std::sqrt(m));
+            }
+            else
+            {
+              out[i] = static_cast<float>(scalars->GetComponent(i, component));
+            }
+          }
+        });
         v.type = spaceskip::VoxelType::Float32;
         v.data = d.Converted.data();
         d.Borrowed = nullptr;
@@ -859,6 +885,8 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
      << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";
   os << indent << "EarlyRayTermination: " << (this->EarlyRayTermination ? "On" : "Off") << "\n";
   os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
+  os << indent << "VectorMode: " << this->VectorMode << "\n";
+  os << indent << "VectorComponent: " << this->VectorComponent << "\n";
   os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
   os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";

@@ -169,6 +169,19 @@ public:
 
   ///@{
   /**
+   * Multi-component scalars (vtkSmartVolumeMapper's API, set by ParaView's representation from
+   * the colour map's Magnitude/Component choice): vtkScalarsToColors::MAGNITUDE renders the
+   * Euclidean norm of each tuple, COMPONENT (default) the component VectorComponent. Dependent
+   * components (direct RGBA, value + opacity) are not supported: one warning, then the same.
+   */
+  vtkSetMacro(VectorMode, int);
+  vtkGetMacro(VectorMode, int);
+  vtkSetMacro(VectorComponent, int);
+  vtkGetMacro(VectorComponent, int);
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -243,6 +256,8 @@ protected:
   int Backend = Auto;
   vtkTypeBool EarlyRayTermination = 1;
   vtkTypeBool UseJittering = 0;
+  int VectorMode = 1; // vtkScalarsToColors::COMPONENT
+  int VectorComponent = 0;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;

@@ -1,9 +1,12 @@
 // ParaView's image-data volume representation with vtkSpaceSkippingVolumeMapper installed.
 #include "vtkSpaceSkipVolumeRepresentation.h"
 
+#include "vtkColorTransferFunction.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
+#include "vtkScalarsToColors.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
+#include "vtkVolumeProperty.h"
 
 vtkStandardNewMacro(vtkSpaceSkipVolumeRepresentation);
 
@@ -20,6 +23,23 @@ vtkSpaceSkipVolumeRepresentation::vtkSpaceSkipVolumeRepresentation()
 
 //------------------------------------------------------------------------------
 vtkSpaceSkipVolumeRepresentation::~vtkSpaceSkipVolumeRepresentation() = default;
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
+{
+  this->Superclass::UpdateMapperParameters();
+  // Same rule as the base class for vtkSmartVolumeMapper: with independent components the
+  // colour map's vector mode and component, else component 0.
+  vtkVolumeProperty* prop = this->Property;
+  vtkColorTransferFunction* ctf = prop ? prop->GetRGBTransferFunction(0) : nullptr;
+  if (!ctf)
+  {
+    return;
+  }
+  const bool indep = prop->GetIndependentComponents() != 0;
+  this->SpaceSkipMapper->SetVectorMode(indep ? ctf->GetVectorMode() : vtkScalarsToColors::COMPONENT);
+  this->SpaceSkipMapper->SetVectorComponent(indep ? ctf->GetVectorComponent() : 0);
+}
 
 //------------------------------------------------------------------------------
 // Setters: the mapper's own Modified() makes the next render rebuild what the change needs.

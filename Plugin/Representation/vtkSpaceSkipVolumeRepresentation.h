@@ -76,6 +76,10 @@ protected:
   vtkSpaceSkipVolumeRepresentation();
   ~vtkSpaceSkipVolumeRepresentation() override;
 
+  /// The base class hands the colour map's Magnitude/Component choice only to VTK's own
+  /// mappers; this passes it to ours as well.
+  void UpdateMapperParameters() override;
+
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
   std::string BackendUsedName;

@@ -80,16 +80,6 @@ int TestSpaceSkippingVolumeBadInput(int, char*[])
   }
   {
     auto img = Blank(16);
-    vtkNew<vtkUnsignedCharArray> a;
-    a->SetName("rgb");
-    a->SetNumberOfComponents(3);
-    a->SetNumberOfTuples(16 * 16 * 16);
-    a->FillValue(200);
-    img->GetPointData()->SetScalars(a);
-    cases.push_back({ "3 components", img, "have 3 components", false, false, "" });
-  }
-  {
-    auto img = Blank(16);
     vtkNew<vtkBitArray> a;
     a->SetName("bits");
     a->SetNumberOfTuples(16 * 16 * 16);
