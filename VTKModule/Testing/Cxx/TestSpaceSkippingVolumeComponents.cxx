@@ -26,13 +26,6 @@ namespace
 {
 constexpr double kMinPSNR = 40.0;
 
-vtkSmartPointer<vtkImageData> RenderWith(
-  vtkRenderWindow* win, vtkVolume* volume, vtkAbstractVolumeMapper* mapper)
-{
-  volume->SetMapper(mapper);
-  win->Render();
-  return sstest::Capture(win);
-}
 }
 
 int TestSpaceSkippingVolumeComponents(int argc, char* argv[])
@@ -123,8 +116,8 @@ int TestSpaceSkippingVolumeComponents(int argc, char* argv[])
     ours->SetVectorMode(k.mode);
     ours->SetVectorComponent(k.component);
     ours->SetBuilderToNaive();
-    auto a = RenderWith(win, volume, smart);
-    auto naive = RenderWith(win, volume, ours);
+    auto a = sstest::RenderWith(win, volume, smart);
+    auto naive = sstest::RenderWith(win, volume, ours);
     const double psnr = sstest::PSNR(a, naive);
     std::cout << k.name << ": PSNR(vtkSmartVolumeMapper, ours) = " << psnr << " dB, max |diff| "
               << sstest::MaxDiff(a, naive) << "/255, pixels " << sstest::CountNonBackground(naive, bg)
@@ -149,7 +142,7 @@ int TestSpaceSkippingVolumeComponents(int argc, char* argv[])
            vtkSpaceSkippingVolumeMapper::DistanceGrid })
     {
       ours->SetBuilder(b);
-      SS_CHECK(sstest::MaxDiff(naive, RenderWith(win, volume, ours)) <= 1);
+      SS_CHECK(sstest::MaxDiff(naive, sstest::RenderWith(win, volume, ours)) <= 1);
     }
   }
 

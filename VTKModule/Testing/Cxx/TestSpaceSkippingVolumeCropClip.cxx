@@ -22,13 +22,6 @@ namespace
 {
 constexpr double kMinPSNR = 40.0;
 
-vtkSmartPointer<vtkImageData> RenderWith(
-  vtkRenderWindow* win, vtkVolume* volume, vtkAbstractVolumeMapper* mapper)
-{
-  volume->SetMapper(mapper);
-  win->Render();
-  return sstest::Capture(win);
-}
 
 // The same cropping and clipping on both mappers.
 void Configure(vtkVolumeMapper* m, bool crop, int flags, const double planes[6],
@@ -49,12 +42,7 @@ int TestSpaceSkippingVolumeCropClip(int argc, char* argv[])
   image->GetBounds(bounds);
   const double sampleDistance = 0.5;
 
-  vtkNew<vtkGPUVolumeRayCastMapper> gpu;
-  gpu->SetInputData(image);
-  gpu->AutoAdjustSampleDistancesOff();
-  gpu->LockSampleDistanceToInputSpacingOff();
-  gpu->SetSampleDistance(sampleDistance);
-  gpu->UseJitteringOff();
+  auto gpu = sstest::ReferenceGPUMapper(image, sampleDistance);
 
   vtkNew<vtkSpaceSkippingVolumeMapper> ours;
   ours->SetInputData(image);
@@ -141,15 +129,15 @@ int TestSpaceSkippingVolumeCropClip(int argc, char* argv[])
     vtkSpaceSkippingVolumeMapper::DistanceGrid };
   const double bg[3] = { 0, 0, 0 };
   ours->SetBuilderToNaive();
-  auto uncut = RenderWith(win, volume, ours);
+  auto uncut = sstest::RenderWith(win, volume, ours);
   double worst = std::numeric_limits<double>::infinity();
   for (const Case& k : cases)
   {
     Configure(gpu, k.crop, k.flags, planes, k.clip);
     Configure(ours, k.crop, k.flags, planes, k.clip);
     ours->SetBuilderToNaive();
-    auto a = RenderWith(win, volume, gpu);
-    auto naive = RenderWith(win, volume, ours);
+    auto a = sstest::RenderWith(win, volume, gpu);
+    auto naive = sstest::RenderWith(win, volume, ours);
     const double psnr = sstest::PSNR(a, naive);
     std::cout << "case " << k.name << ": PSNR(vtkGPUVolumeRayCastMapper, ours) = " << psnr
               << " dB, max |diff| = " << sstest::MaxDiff(a, naive) << "/255, drawn pixels gpu "
@@ -171,7 +159,7 @@ int TestSpaceSkippingVolumeCropClip(int argc, char* argv[])
     for (int b : builders)
     {
       ours->SetBuilder(b);
-      auto img = RenderWith(win, volume, ours);
+      auto img = sstest::RenderWith(win, volume, ours);
       const int diff = sstest::MaxDiff(naive, img);
       if (diff > 1)
       {
@@ -188,9 +176,9 @@ int TestSpaceSkippingVolumeCropClip(int argc, char* argv[])
   Configure(ours, false, VTK_CROP_SUBVOLUME, planes, none);
   ours->SetSampleDistance(2.0);
   ours->SetBuilderToNaive();
-  auto plain = RenderWith(win, volume, ours);
+  auto plain = sstest::RenderWith(win, volume, ours);
   ours->UseJitteringOn();
-  auto jittered = RenderWith(win, volume, ours);
+  auto jittered = sstest::RenderWith(win, volume, ours);
   std::cout << "jittering at sample distance 2: PSNR(plain, jittered) = "
             << sstest::PSNR(plain, jittered) << " dB\n";
   SS_CHECK(sstest::MaxDiff(plain, jittered) > 1);
@@ -198,7 +186,7 @@ int TestSpaceSkippingVolumeCropClip(int argc, char* argv[])
   for (int b : builders)
   {
     ours->SetBuilder(b);
-    SS_CHECK(sstest::MaxDiff(jittered, RenderWith(win, volume, ours)) <= 1);
+    SS_CHECK(sstest::MaxDiff(jittered, sstest::RenderWith(win, volume, ours)) <= 1);
   }
   return EXIT_SUCCESS;
 }
