@@ -175,6 +175,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   // across the engines that backend switches create.
   std::set<std::string> Said;
   double SampleDistanceUsed = 0;
+  std::string BuilderChoice;
   int Selection = 0; // the component the volume was made from; -1: the magnitude
 
   std::string BackendUsed = "none";
@@ -317,6 +318,10 @@ const char* vtkSpaceSkippingVolumeMapper::GetBackendUsed()
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
 {
   return this->Internals->BuilderUsed.c_str();
+}
+const char* vtkSpaceSkippingVolumeMapper::GetBuilderChoice()
+{
+  return this->Internals->BuilderChoice.c_str();
 }
 double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
 {
@@ -790,6 +795,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.BackendUsed = engine.frameStats().backend;
     d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
     d.SampleDistanceUsed = engine.sampleDistance();
+    d.BuilderChoice = engine.buildStats().choice;
     if (d.Report && d.Reported != d.BackendUsed + d.BuilderUsed)
     {
       // What actually ran, for logs of test and benchmark runs on other machines.

@@ -48,7 +48,8 @@ public:
     KdTreeGPU,
     KdTreeGPUFast,
     Hybrid,
-    DistanceGrid
+    DistanceGrid,
+    AutoBuilder ///< measures Naive and a few structures one frame each and keeps the fastest
   };
   enum LeafCriterionTypes
   {
@@ -69,7 +70,7 @@ public:
    * DDA leaping through empty space with a capped Chebyshev distance field over the macro cells
    * (CPU and CUDA); it is fastest on very sparse data with MacroCellSize 4.
    */
-  vtkSetClampMacro(Builder, int, Naive, DistanceGrid);
+  vtkSetClampMacro(Builder, int, Naive, AutoBuilder);
   vtkGetMacro(Builder, int);
   void SetBuilderToNaive() { this->SetBuilder(Naive); }
   void SetBuilderToGrid() { this->SetBuilder(Grid); }
@@ -80,6 +81,7 @@ public:
   void SetBuilderToKdTreeGPUFast() { this->SetBuilder(KdTreeGPUFast); }
   void SetBuilderToHybrid() { this->SetBuilder(Hybrid); }
   void SetBuilderToDistanceGrid() { this->SetBuilder(DistanceGrid); }
+  void SetBuilderToAuto() { this->SetBuilder(AutoBuilder); }
   const char* GetBuilderAsString();
   ///@}
 
@@ -225,6 +227,8 @@ public:
   /// The sample distance of the last frame in world units, after the engine's bounds (at least
   /// 1/16 of the smallest spacing, at most 2^20 samples per ray); 0 before the first frame.
   double GetSampleDistanceUsed();
+  /// Builder Auto: what it chose and why, one line (empty for the other builders).
+  const char* GetBuilderChoice();
   /// Bytes of device memory SpaceSkip holds now (all mappers of the process; 0 without CUDA).
   vtkIdType GetDeviceBytesInUse();
   ///@}
@@ -247,7 +251,7 @@ protected:
   vtkSpaceSkippingVolumeMapper();
   ~vtkSpaceSkippingVolumeMapper() override;
 
-  int Builder = Grid;
+  int Builder = AutoBuilder;
   int LeafCriterion = Deep;
   int MaxLeafSize = 0;
   int BinCount = 4;

@@ -57,8 +57,9 @@ const char* kUsage = R"(usage:
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
-  --builder B        naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu kdtree-gpu-fast hybrid
-                     distance-grid
+  --builder B        auto (default: one frame with each of naive, grid, distance-grid and a
+                     k-d tree, then the fastest) naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu
+                     kdtree-gpu-fast hybrid distance-grid
   --leaf shallow|deep  --mls N  --bins N  --brick N
       --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;
       0 sweeps every brick boundary, the kdtree-cpu tree (kdtree-cpu always sweeps)
@@ -138,7 +139,7 @@ int cmdRender(const Options& o) {
   Engine engine(backendKind(o));
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
-  engine.setBuildParams(buildParams(o, o.get("--builder", "grid")));
+  engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
   engine.setRenderParams(renderParams(o));
   auto t1 = Clock::now();
   engine.update();
@@ -146,8 +147,10 @@ int cmdRender(const Options& o) {
   Image img;
   Camera cam = makeCamera(o, v, w, h);
   engine.render(cam, w, h, img);  // first frame (warm-up)
+  for (int i = 0; i < 16 && engine.exploring(); ++i) engine.render(cam, w, h, img);  // Auto measures
   engine.render(cam, w, h, img);
   const BuildStats& s = engine.buildStats();
+  if (!s.choice.empty()) std::printf("%s\n", s.choice.c_str());
   std::printf("volume %s: %lldx%lldx%lld %s, load %.3f s\n", o.positional[0].c_str(), (long long)v.dims.x,
               (long long)v.dims.y, (long long)v.dims.z, voxelTypeName(v.type), load);
   std::printf("backend %s, builder %s: ranges+classify+build %.3f s (classify %.4f s, build %.4f s), "
@@ -229,6 +232,13 @@ int cmdBench(const Options& o) {
       v.worldBounds(b6);
       Image img;
       engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
+      // Auto: its measuring frames (one per candidate) are not timed; then what it chose is.
+      for (int i = 0; i < 16 && engine.exploring(); ++i)
+        engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);
+      if (bp.builder == BuilderKind::Auto) {
+        s = engine.buildStats();
+        std::printf("%s\n", s.choice.c_str());
+      }
       double total = 0, totalDevice = 0, cpuTotal = 0;
       for (int f = 0; f < frames; ++f) {
         const double c0 = processCpuSeconds();
@@ -309,7 +319,7 @@ int cmdAccuracy(const Options& o) {
   engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
-  engine.setBuildParams(buildParams(o, o.get("--builder", "grid")));
+  engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
   Camera cam = makeCamera(o, v, w, h);
   RenderParams ref;
   ref.sampleDistance = minSpacing / 8;

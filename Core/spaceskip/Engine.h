@@ -27,7 +27,8 @@ enum class BuilderKind : int {
   KdTreeGPU,      ///< paper 3.2.2, CUDA, host-driven recursion
   KdTreeGPUFast,  ///< ours: level-parallel CUDA k-d tree
   Hybrid,         ///< paper 3.3: shallow k-d tree + 16^3 grid
-  DistanceGrid    ///< ours: the Grid DDA leaping through empty space with a distance field
+  DistanceGrid,   ///< ours: the Grid DDA leaping through empty space with a distance field
+  Auto            ///< measures a few structures (Naive among them) one frame each, keeps the fastest
 };
 enum class LeafCriterion : int { Shallow, Deep };
 enum class BackendKind : int { Auto, CPU, CUDA };
@@ -98,6 +99,9 @@ struct BuildStats {
   int height = 0;
   int64_t leaves = 0;
   double occupancy = 0;      ///< fraction of occupied macro cells
+  /// Builder Auto: what it chose and why, one line ("" for the other builders, "exploring ..."
+  /// while it measures).
+  std::string choice;
 };
 
 struct FrameStats {
@@ -159,6 +163,8 @@ class Engine {
   void render(const Camera& cam, int width, int height, Image& out, const float* depth = nullptr);
 
   const BuildStats& buildStats() const;
+  /// Builder Auto: true while it still measures its candidates (one frame each).
+  bool exploring() const;
   const FrameStats& frameStats() const;
   const Counters& counters() const;
   /// Host copies for tests and statistics (downloaded from the device if needed).

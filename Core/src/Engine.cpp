@@ -36,6 +36,7 @@ constexpr BuilderName kBuilders[] = {
     {BuilderKind::KdTreeGPUFast, "KdTreeGPUFast", "kdtree-gpu-fast"},
     {BuilderKind::Hybrid, "Hybrid", "hybrid"},
     {BuilderKind::DistanceGrid, "DistanceGrid", "distance-grid"},
+    {BuilderKind::Auto, "Auto", "auto"},
 };
 
 std::string lower(std::string s) {
@@ -147,6 +148,77 @@ struct Engine::Impl {
   FrameStats frame;
   Counters counters;
 
+  // Builder Auto ("never slower than naive"): skipping is lossless, so every candidate draws the
+  // same image and only its speed differs. Each candidate renders one frame, the fastest is kept;
+  // the candidates are measured again when the occupancy moves by more than kAutoReexplore or
+  // the image size changes, otherwise an occupancy change rebuilds the chosen one only.
+  struct AutoState {
+    std::vector<BuildParams> candidates;
+    std::vector<double> seconds;  ///< measured frame time per candidate, < 0: not yet
+    int current = -1;             ///< the candidate built now
+    bool exploring = false;
+    double occupancy = -1;        ///< when the choice was made
+    int width = 0, height = 0;
+    std::string choice;
+  } autoState;
+  static constexpr double kAutoReexplore = 0.1;
+
+  std::vector<BuildParams> autoCandidates() const {
+    auto with = [&](BuilderKind k, int mls) {
+      BuildParams p = build;
+      p.builder = k;
+      p.leaf = LeafCriterion::Deep;
+      p.maxLeafSize = mls;
+      return p;
+    };
+    if (backend->kind() == BackendKind::CUDA)
+      return {with(BuilderKind::Naive, 0), with(BuilderKind::Grid, 0), with(BuilderKind::DistanceGrid, 0),
+              with(BuilderKind::KdTreeGPUFast, 128), with(BuilderKind::LBVH, 0)};
+    return {with(BuilderKind::Naive, 0), with(BuilderKind::Grid, 0), with(BuilderKind::DistanceGrid, 0),
+            with(BuilderKind::KdTreeCPU, 32)};
+  }
+
+  void startAutoExploration() {
+    autoState.candidates = autoCandidates();
+    autoState.seconds.assign(autoState.candidates.size(), -1.0);
+    autoState.current = 0;
+    autoState.exploring = true;
+    autoState.choice = "Auto: measuring " + std::to_string(autoState.candidates.size()) + " structures";
+    buildDirty = true;
+  }
+
+  /// After a frame of `seconds` at width x height: records it and picks the next build.
+  void autoFrameDone(double seconds, int width, int height) {
+    AutoState& a = autoState;
+    if (!a.exploring) {
+      if (width != a.width || height != a.height) startAutoExploration();
+      return;
+    }
+    a.seconds[size_t(a.current)] = seconds;
+    a.width = width;
+    a.height = height;
+    if (size_t(a.current) + 1 < a.candidates.size()) {
+      ++a.current;
+      buildDirty = true;
+      return;
+    }
+    int best = 0;
+    for (size_t i = 1; i < a.seconds.size(); ++i)
+      if (a.seconds[i] < a.seconds[size_t(best)]) best = int(i);
+    a.exploring = false;
+    a.occupancy = backend->occupancy().occupancy();
+    char line[512];
+    int n = std::snprintf(line, sizeof line, "Auto: %s (%.3g ms/frame) at occupancy %.3f; measured", builderName(a.candidates[size_t(best)].builder),
+                          1e3 * a.seconds[size_t(best)], a.occupancy);
+    for (size_t i = 0; i < a.seconds.size() && n > 0 && size_t(n) < sizeof line; ++i)
+      n += std::snprintf(line + n, sizeof line - size_t(n), "%s %s %.3g", i ? "," : "", builderName(a.candidates[i].builder),
+                         1e3 * a.seconds[i]);
+    a.choice = line;
+    if (best != a.current) buildDirty = true;
+    a.current = best;
+    stats.choice = a.choice;
+  }
+
   void chooseBackend() {
     if (requested == BackendKind::CPU) {
       backend = makeCpuBackend();
@@ -171,6 +243,7 @@ struct Engine::Impl {
     warn("CUDA backend failed (" + why + "); falling back to the CPU backend");
     backend = makeCpuBackend();
     rangesDirty = opacityDirty = buildDirty = tableDirty = true;
+    autoState = AutoState{};
   }
 
   TransferFunction scaledTF() const {
@@ -204,7 +277,11 @@ struct Engine::Impl {
       opacityDirty = false;
       tableDirty = true;
       if (changed) buildDirty = true;
+      if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
+          std::fabs(backend->occupancy().occupancy() - autoState.occupancy) > kAutoReexplore)
+        startAutoExploration();
     }
+    if (build.builder == BuilderKind::Auto && autoState.candidates.empty()) startAutoExploration();
     if (tableDirty || colorDirty) {
       if (!tableDirty) ++counters.colorUpdates;
       std::string note;
@@ -216,7 +293,8 @@ struct Engine::Impl {
       tableDirty = colorDirty = false;
     }
     if (buildDirty) {
-      BuildParams p = build;
+      const bool isAuto = build.builder == BuilderKind::Auto;
+      BuildParams p = isAuto ? autoState.candidates[size_t(autoState.current)] : build;
       bool gpuOnly = p.builder == BuilderKind::KdTreeGPU || p.builder == BuilderKind::KdTreeGPUFast;
       if (gpuOnly && backend->kind() != BackendKind::CUDA) {
         warn(std::string("builder ") + builderName(p.builder) + " needs the CUDA backend; building KdTreeCPU with the same parameters");
@@ -234,6 +312,7 @@ struct Engine::Impl {
       s.builder = p.builder;
       s.classifySeconds = stats.classifySeconds;
       s.occupancy = backend->occupancy().occupancy();
+      s.choice = isAuto ? autoState.choice : std::string();
       stats = s;
       ++counters.builds;
       buildDirty = false;
@@ -260,6 +339,7 @@ void Engine::setVolume(const Volume& v) {
   validate(v);
   impl_->volume = v;
   impl_->valueExponent = 0;
+  impl_->autoState = Impl::AutoState{};
   // The integrator samples in float: magnitudes near the ends of double's (or float's) range
   // would overflow trilinear interpolation or the table mapping (+-1e308 gave a blank image),
   // and denormal-scale data would collapse to one table entry. Such volumes are sampled from a
@@ -304,7 +384,10 @@ void Engine::setBuildParams(const BuildParams& p) {
     throw std::invalid_argument("bins must be 0 (sweep every brick boundary) or >= 2, got " + std::to_string(p.bins));
   Impl& d = *impl_;
   if (p.brick != d.build.brick) d.rangesDirty = true;
-  if (p != d.build) d.buildDirty = true;
+  if (p != d.build) {
+    d.buildDirty = true;
+    d.autoState = Impl::AutoState{};  // Auto measures again with the new parameters
+  }
   d.build = p;
   d.build.brick = std::max(1, p.brick);
 }
@@ -407,9 +490,14 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   }
   d.frame.backend = d.backend->name();
   ++d.counters.frames;
+  if (d.build.builder == BuilderKind::Auto)
+    d.autoFrameDone(d.frame.deviceSeconds > 0 ? d.frame.deviceSeconds : d.frame.seconds, width, height);
 }
 
 const BuildStats& Engine::buildStats() const { return impl_->stats; }
+bool Engine::exploring() const {
+  return impl_->build.builder == BuilderKind::Auto && (impl_->autoState.exploring || impl_->autoState.candidates.empty());
+}
 const FrameStats& Engine::frameStats() const { return impl_->frame; }
 const Counters& Engine::counters() const { return impl_->counters; }
 const OccupancyGrid& Engine::occupancy() {

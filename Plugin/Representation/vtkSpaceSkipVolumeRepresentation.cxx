@@ -150,6 +150,12 @@ double vtkSpaceSkipVolumeRepresentation::GetOccupancy()
   return this->SpaceSkipMapper->GetOccupancy();
 }
 // The string getters copy: the wrapped caller reads the value after the mapper may change it.
+const char* vtkSpaceSkipVolumeRepresentation::GetBuilderChoice()
+{
+  const char* text = this->SpaceSkipMapper->GetBuilderChoice();
+  this->BuilderChoiceText = text ? text : "";
+  return this->BuilderChoiceText.c_str();
+}
 const char* vtkSpaceSkipVolumeRepresentation::GetBuilderUsed()
 {
   const char* name = this->SpaceSkipMapper->GetBuilderUsed();

@@ -63,6 +63,7 @@ public:
   double GetOccupancy();
   const char* GetBackendUsed();
   const char* GetBuilderUsed();
+  const char* GetBuilderChoice();
   int GetBuildCount();
   int GetClassifyCount();
   int GetColorUpdateCount();
@@ -84,6 +85,7 @@ protected:
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
   std::string BackendUsedName;
   std::string BuilderUsedName;
+  std::string BuilderChoiceText;
 
 private:
   vtkSpaceSkipVolumeRepresentation(const vtkSpaceSkipVolumeRepresentation&) = delete;

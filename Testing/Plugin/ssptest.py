@@ -114,7 +114,7 @@ def stats(disp):
     names = ["BuilderUsed", "BackendUsed", "LastBuildSeconds", "LastClassifySeconds",
              "LastRenderSeconds", "NodeCount", "LeafCount", "TreeHeight", "Occupancy",
              "BuildCount", "ClassifyCount", "ColorUpdateCount", "FrameCount",
-             "SampleDistanceUsed"]
+             "SampleDistanceUsed", "BuilderChoice"]
     return {n: disp.GetPropertyValue(n) for n in names}
 
 
