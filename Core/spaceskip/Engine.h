@@ -9,6 +9,7 @@
 #include "TransferFunction.h"
 #include "Volume.h"
 
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <memory>
@@ -62,6 +63,23 @@ struct RenderParams {
   unsigned jitterSeed = 0;
   FilterMode filter = FilterMode::Exact;
   bool countSamples = false;   ///< statistics: FrameStats::samples (costs a per-pixel buffer)
+
+  // Blend modes (vtkVolumeMapper::SetBlendMode semantics, as vtkGPUVolumeRayCastMapper does them).
+  BlendMode blend = BlendMode::Composite;
+  std::vector<double> isoValues;  ///< Isosurface: up to kMaxIsoValues (16); any order
+  /// Additive and average: scalars are normalised to [0, 1] over this range (VTK uses the scalar
+  /// array's range); lo >= hi: the transfer function's range.
+  double scalarRange[2] = {0, 0};
+  /// Average: only samples with value in this range count (vtkVolumeMapper's AverageIPScalarRange).
+  double averageRange[2] = {-HUGE_VAL, HUGE_VAL};
+
+  // Gradient shading (vtkVolumeProperty's Shade, Ambient, Diffuse, Specular, SpecularPower;
+  // VTK's defaults), composite and isosurface modes only, as in VTK.
+  bool shade = false;
+  double ambient = 0.0, diffuse = 0.7, specular = 0.2, specularPower = 10.0;
+  /// World direction from the volume towards a directional white light; (0,0,0): a headlight
+  /// (VTK's default light: at the camera, so every ray is lit along itself).
+  double lightDirection[3] = {0, 0, 0};
 };
 
 struct BuildStats {

@@ -119,7 +119,7 @@ struct Engine::Impl {
       if (!tableDirty) ++counters.colorUpdates;
       const float lo = float(tf.rangeMin);
       const float scale = float(double(tf.table.size() - 1) / std::max(tf.rangeMax - tf.rangeMin, 1e-30));
-      backend->setTransferTable(correctedTable(tf, float(dt())), lo, scale);
+      backend->setTransferTable(tableForBlend(tf, float(dt()), render.blend), lo, scale);
       tableDirty = colorDirty = false;
     }
     if (buildDirty) {
@@ -193,7 +193,7 @@ void Engine::setBuildParams(const BuildParams& p) {
 }
 
 void Engine::setRenderParams(const RenderParams& p) {
-  if (p.sampleDistance != impl_->render.sampleDistance) impl_->tableDirty = true;
+  if (p.sampleDistance != impl_->render.sampleDistance || p.blend != impl_->render.blend) impl_->tableDirty = true;
   impl_->render = p;
 }
 
@@ -210,6 +210,39 @@ void Engine::update() {
     d.update();
   }
 }
+
+namespace {
+/// The blend-mode and shading part of the frame from the render parameters.
+template <class Impl>
+void fillBlend(Impl& d, FrameView& f) {
+  const RenderParams& r = d.render;
+  f.blend = r.blend;
+  double lo = r.scalarRange[0], hi = r.scalarRange[1];
+  if (!(lo < hi)) {
+    lo = d.tf.rangeMin;
+    hi = d.tf.rangeMax;
+  }
+  f.normLo = float(lo);
+  f.normScale = hi > lo ? float(1.0 / (hi - lo)) : 0.f;
+  f.avgLo = float(std::max(r.averageRange[0], -double(HUGE_VALF)));
+  f.avgHi = float(std::min(r.averageRange[1], double(HUGE_VALF)));
+  std::vector<double> iso = r.isoValues;
+  std::sort(iso.begin(), iso.end());
+  if (iso.size() > size_t(kMaxIsoValues)) {
+    d.log("isosurface: " + std::to_string(iso.size()) + " iso values, using the lowest " +
+          std::to_string(kMaxIsoValues));
+    iso.resize(size_t(kMaxIsoValues));
+  }
+  f.numIso = int(iso.size());
+  for (int i = 0; i < f.numIso; ++i) f.iso[i] = float(iso[size_t(i)]);
+  f.shade = r.shade && (r.blend == BlendMode::Composite || r.blend == BlendMode::Isosurface) ? 1 : 0;
+  f.ambient = float(r.ambient);
+  f.diffuse = float(r.diffuse);
+  f.specular = float(r.specular);
+  f.specularPower = float(r.specularPower);
+  f.lightDir = vec3f{float(r.lightDirection[0]), float(r.lightDirection[1]), float(r.lightDirection[2])};
+}
+}  // namespace
 
 void Engine::render(const Camera& cam, int width, int height, Image& out, const float* depth) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("render size must be positive");
@@ -231,6 +264,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
+  fillBlend(d, f);
   std::vector<unsigned> counts;
   if (d.render.countSamples) {
     counts.assign(size_t(width) * size_t(height), 0u);
