@@ -63,6 +63,10 @@ struct RenderParams {
   unsigned jitterSeed = 0;
   FilterMode filter = FilterMode::Exact;
   bool countSamples = false;   ///< statistics: FrameStats::samples (costs a per-pixel buffer)
+  /// The first sample lies this many sample distances past the ray's entry into the box (>= 0).
+  /// vtkGPUVolumeRayCastMapper starts one step in (1) and takes that first sample even where the
+  /// ray leaves the box before it (clamped to the box); > 0 does the same. 0: at the entry.
+  double firstSampleOffset = 0;
 
   // Blend modes (vtkVolumeMapper::SetBlendMode semantics, as vtkGPUVolumeRayCastMapper does them).
   BlendMode blend = BlendMode::Composite;

@@ -30,6 +30,7 @@ struct FrameView {
   float dt;                ///< sample distance in world units
   float ertThreshold;      ///< early ray termination when alpha >= this; > 1 disables
   int jitter;              ///< 1: per-pixel random start offset in [0, dt)
+  float firstSample;       ///< first sample at the box entry + firstSample * dt (see RenderParams)
   uint32_t jitterSeed;
   const float* depth;      ///< optional window depth in [0,1] per pixel (opaque geometry)
   TraversalKind traversal;
@@ -46,6 +47,7 @@ struct FrameView {
   int shade;                ///< 1: gradient shading (composite and isosurface, as VTK)
   float ambient, diffuse, specular, specularPower;
   vec3f lightDir;           ///< world direction towards the light; (0,0,0): headlight
+  vec3f eyeW;               ///< camera position in world space (the headlight; parallel views too)
 };
 
 /// Exact trilinear sampling in float from a linear voxel array (clamped at the border).
@@ -110,7 +112,7 @@ struct IntervalMarcher {
   int nextK;
   vec4f acc;         ///< composite, isosurface: premultiplied colour so far
   unsigned samples;
-  vec3f lightW, halfW;  ///< shading: towards the light and the half vector, world space
+  vec3f lightW, viewW;  ///< shading: towards the light and towards the eye, world space
   float extreme;     ///< MIP/MinIP: running max/min; average/additive: running sum
   unsigned count;    ///< MIP/MinIP: samples seen; average: samples counted
   int isoIndex;      ///< isosurface: the iso interval of the last sample, -1 before the first
@@ -129,9 +131,10 @@ struct IntervalMarcher {
   /// Iso interval bounds: -inf, iso[0], ..., iso[n-1], +inf.
   SS_FUNC float isoBound(int i) const { return i <= 0 ? -INFINITY : i > f->numIso ? INFINITY : f->iso[i - 1]; }
 
-  /// Blinn-Phong with VTK's volume-mapper conventions: gradient by central differences one voxel
-  /// apart (to world space through the inverse transpose of index->world), two-sided lighting,
-  /// white light, specular not tinted by the sample colour.
+  /// Phong shading as vtkGPUVolumeRayCastMapper does it for its headlight (VTK 9.2): gradient by
+  /// central differences one voxel apart (to world space through the inverse transpose of
+  /// index->world), two-sided diffuse, specular from the reflected light vector, white light,
+  /// specular not tinted, the result clamped to [0, 1].
   SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p) const {
     const float gx = s->sample(p + vec3f{1, 0, 0}) - s->sample(p - vec3f{1, 0, 0});
     const float gy = s->sample(p + vec3f{0, 1, 0}) - s->sample(p - vec3f{0, 1, 0});
@@ -140,10 +143,13 @@ struct IntervalMarcher {
     vec3f n{M[0] * gx + M[4] * gy + M[8] * gz, M[1] * gx + M[5] * gy + M[9] * gz, M[2] * gx + M[6] * gy + M[10] * gz};
     const float len = length(n);
     n = len > 0.f ? n * (1.f / len) : vec3f{0, 0, 0};
-    const float nl = fabsf(dot(n, lightW)), nh = fabsf(dot(n, halfW));
-    const float spec = nh > 0.f ? f->specular * powf(nh, f->specularPower) : 0.f;
-    const float d = f->diffuse * nl;
-    return vec3f{(f->ambient + d) * rgb.x + spec, (f->ambient + d) * rgb.y + spec, (f->ambient + d) * rgb.z + spec};
+    const float nl = -dot(n, lightW);  // VTK: the gradient points inwards, hence -l
+    const vec3f r = normalize(n * (2.f * nl) + lightW);
+    const float vr = ss_max(-dot(r, viewW), 0.f);
+    const float spec = vr > 0.f ? f->specular * powf(vr, f->specularPower) : 0.f;
+    const float k = f->ambient + f->diffuse * fabsf(nl);
+    return vec3f{ss_clamp(k * rgb.x + spec, 0.f, 1.f), ss_clamp(k * rgb.y + spec, 0.f, 1.f),
+                 ss_clamp(k * rgb.z + spec, 0.f, 1.f)};
   }
 
   /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
@@ -308,14 +314,19 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
 
   IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
                              0.f, 0u, -1};
-  if (f.shade) {  // VTK's headlight: light at the eye, so light, view and half vector coincide
-    const vec3f toEye = vec3f{0, 0, 0} - dirW;
+  if (f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
+    const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
     const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
     m.lightW = head ? toEye : normalize(f.lightDir);
-    m.halfW = head ? toEye : normalize(m.lightW + toEye);
+    m.viewW = toEye;
   }
+  m.t0 += f.firstSample * f.dt;
   if (f.jitter) m.t0 += f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f);
-  switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
+  // Starting one or more steps in, the ray may leave the box before its first sample: that sample
+  // is still taken (clamped to the box), as vtkGPUVolumeRayCastMapper does; every traversal alike.
+  if (f.firstSample > 0.f && !(m.t0 < tExit)) {
+    m(m.t0, m.t0 + f.dt);
+  } else switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
     case TraversalKind::Naive: m(tEnter, tExit); break;
     case TraversalKind::Grid: traverseGrid(f.grid, r, inv, tEnter, tExit, m); break;
     case TraversalKind::Tree: {

@@ -264,6 +264,10 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
+  f.firstSample = float(std::max(0.0, d.render.firstSampleOffset));
+  mat4 iv;
+  if (!invert(cam.view, iv)) throw std::invalid_argument("camera view matrix is singular");
+  f.eyeW = vec3f{float(iv.m[12]), float(iv.m[13]), float(iv.m[14])};
   fillBlend(d, f);
   std::vector<unsigned> counts;
   if (d.render.countSamples) {

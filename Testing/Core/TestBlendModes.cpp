@@ -107,7 +107,13 @@ TEST(BlendModes, EveryBuilderEqualsNaiveInEveryMode) {
     Volume v = generateVolume(c.shape, vec3l{c.n, c.n + 2, c.n - 3});
     double lo, hi;
     ASSERT_TRUE(v.scalarRange(lo, hi));
-    for (const Mode& m : allModes(lo, hi)) {
+    std::vector<Mode> modes = allModes(lo, hi);
+    for (size_t i : {size_t(0), size_t(2), size_t(6)}) {  // VTK's first sample, one step in
+      Mode m = modes[i];
+      m.rp.firstSampleOffset = 1;
+      modes.push_back(m);
+    }
+    for (const Mode& m : modes) {
       const bool low = c.lowTF || m.rp.blend == BlendMode::MinimumIntensity;
       TransferFunction tf = low ? lowTF(lo, hi) : TransferFunction::preset("ramp", lo, hi, 256);
       for (const Cam& cam : cams) {
@@ -117,7 +123,8 @@ TEST(BlendModes, EveryBuilderEqualsNaiveInEveryMode) {
         for (const BuildParams& bp : skippingBuilders()) {
           Image img = test::renderWith(v, tf, bp, cam.az, cam.el, cam.persp, 48, BackendKind::CPU, m.rp);
           ImageDiff d = compareImages(ref, img);
-          EXPECT_LE(d.maxAbs, 1.f / 255.f) << c.shape << " " << m.name << " " << builderName(bp.builder) << " brick "
+          EXPECT_LE(d.maxAbs, 1.f / 255.f) << c.shape << " " << m.name << " offset " << m.rp.firstSampleOffset << " "
+                                           << builderName(bp.builder) << " brick "
                                            << bp.brick << " az " << cam.az;
           EXPECT_FALSE(hasNonFinite(img)) << c.shape << " " << m.name;
         }
@@ -221,9 +228,9 @@ TEST(BlendModes, IsosurfaceCompositesEachCrossingWithTheIsoValuesColour) {
   EXPECT_EQ(test::coverage(none), 0.0);
 }
 
-TEST(Shading, HeadlightFollowsTheGradient) {
-  // Values grow with x. Looking along x the gradient faces the headlight (|n.l| = 1): diffuse 1,
-  // ambient 0, specular 0 gives the unshaded image. Looking along z it is perpendicular: black.
+TEST(Shading, LightFollowsTheGradient) {
+  // Values grow with x. A light along x faces the gradient (|n.l| = 1): diffuse 1, ambient 0,
+  // specular 0 gives the unshaded image. A light along z is perpendicular to it: black.
   Volume v = makeVolume(24, 24, 24, [](int i, int, int) { return float(i) * 10.f; });
   TransferFunction tf = TransferFunction::fromPoints({{0, 0.8f, 0.5f, 0.2f, 0.3f}, {230, 0.2f, 0.5f, 0.9f, 0.3f}}, 0, 230, 256);
   RenderParams plain, lit;
@@ -231,14 +238,26 @@ TEST(Shading, HeadlightFollowsTheGradient) {
   lit.ambient = 0;
   lit.diffuse = 1;
   lit.specular = 0;
+  lit.lightDirection[0] = 1;
   Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 32, BackendKind::CPU, plain);
   Image along = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 32, BackendKind::CPU, lit);
   EXPECT_LE(compareImages(ref, along).maxAbs, 2e-3f);
   ASSERT_GT(test::coverage(ref), 0.1);
+  lit.lightDirection[0] = 0;
+  lit.lightDirection[2] = -1;
   Image across = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 0, 0, false, 32, BackendKind::CPU, lit);
-  const vec4f c = centre(across);
+  EXPECT_GT(test::coverage(across), 0.1);
+  for (const vec4f& p : across.rgba) EXPECT_LT(p.x + p.y + p.z, 1e-4f);
+  // The headlight (VTK's: at the camera, seen from each ray's entry point) is within a degree of
+  // the view axis at the centre pixel of this orthographic view.
+  lit.lightDirection[2] = 0;
+  const vec4f h = centre(test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 32, BackendKind::CPU, lit));
+  const vec4f r = centre(ref);
+  EXPECT_NEAR(h.x, r.x, 2e-3f);
+  EXPECT_NEAR(h.z, r.z, 2e-3f);
+  const vec4f c = centre(test::renderWith(v, tf, test::builder(BuilderKind::Grid), 0, 0, false, 32, BackendKind::CPU, lit));
   EXPECT_GT(c.w, 0.1f);
-  EXPECT_LT(c.x + c.y + c.z, 1e-3f);
+  EXPECT_LT(c.x + c.y + c.z, 0.05f);
   // Specular adds white regardless of colour; ambient scales the colour.
   lit.specular = 0.5;
   lit.diffuse = 0;
