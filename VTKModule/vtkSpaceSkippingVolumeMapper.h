@@ -5,7 +5,10 @@
  * A drop-in for vtkSmartVolumeMapper: point scalars of one component (unsigned/signed char,
  * unsigned/signed short, float, double; int/unsigned int/long are converted to float with a
  * warning), the volume property's colour and scalar-opacity functions and its
- * ScalarOpacityUnitDistance. The hierarchy over the occupied macro cells is built by `Builder`
+ * ScalarOpacityUnitDistance, its Shade/Ambient/Diffuse/Specular/SpecularPower (VTK's headlight or
+ * one directional light) and IsoSurfaceValues, and every blend mode of vtkVolumeMapper but slice
+ * (composite, maximum/minimum/average intensity with AverageIPScalarRange, additive,
+ * isosurface), with vtkGPUVolumeRayCastMapper's semantics. The hierarchy over the occupied macro cells is built by `Builder`
  * (the builders of Morrical/Zellmann et al.); a colour-only transfer-function edit only updates
  * the lookup table, an opacity edit re-classifies and rebuilds only when the occupied cells changed.
  * The image is marched by the CUDA backend when a device is usable (Backend Auto), else by the
