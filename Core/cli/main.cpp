@@ -64,6 +64,8 @@ options:
   --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective
   --sample-distance D  (world units; default half the smallest spacing)
   --ert T  --jitter  --filter exact|hardware
+  --blend composite|mip|minip|average|additive|iso   --iso V1,V2,...  (iso values)
+  --shade on|AMBIENT,DIFFUSE,SPECULAR,POWER  gradient shading with a headlight (on: 0,0.7,0.2,10)
   --compare REF.png  print max difference and PSNR against a reference image
   --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
 )";
@@ -186,6 +188,33 @@ RenderParams renderParams(const Options& o) {
   if (f == "exact") r.filter = FilterMode::Exact;
   else if (f == "hardware") r.filter = FilterMode::Hardware;
   else throw std::invalid_argument("--filter must be exact or hardware");
+  const std::string b = o.get("--blend", "composite");
+  const std::pair<const char*, BlendMode> modes[] = {
+      {"composite", BlendMode::Composite}, {"mip", BlendMode::MaximumIntensity},
+      {"minip", BlendMode::MinimumIntensity}, {"average", BlendMode::AverageIntensity},
+      {"additive", BlendMode::Additive}, {"iso", BlendMode::Isosurface}};
+  bool known = false;
+  for (const auto& m : modes)
+    if (b == m.first) {
+      r.blend = m.second;
+      known = true;
+    }
+  if (!known) throw std::invalid_argument("--blend must be composite, mip, minip, average, additive or iso");
+  if (o.has("--iso"))
+    for (const std::string& v : split(o.get("--iso", ""), ',')) r.isoValues.push_back(std::stod(v));
+  if (r.blend == BlendMode::Isosurface && r.isoValues.empty()) throw std::invalid_argument("--blend iso needs --iso V1,V2,...");
+  if (o.has("--shade")) {  // "on" (VTK's coefficients) or AMBIENT,DIFFUSE,SPECULAR,POWER
+    r.shade = true;
+    const std::string sh = o.get("--shade", "on");
+    if (sh != "on") {
+      std::vector<std::string> c = split(sh, ',');
+      if (c.size() != 4) throw std::invalid_argument("--shade takes on or AMBIENT,DIFFUSE,SPECULAR,POWER");
+      r.ambient = std::stod(c[0]);
+      r.diffuse = std::stod(c[1]);
+      r.specular = std::stod(c[2]);
+      r.specularPower = std::stod(c[3]);
+    }
+  }
   return r;
 }
 
