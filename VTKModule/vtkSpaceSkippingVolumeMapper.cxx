@@ -57,10 +57,9 @@ static_assert(static_cast<int>(spaceskip::BlendMode::Isosurface) == vtkVolumeMap
 // Blend mode, iso values and shading from the mapper, the volume property and the renderer's
 // lights, as vtkGPUVolumeRayCastMapper reads them. Lights: a headlight (VTK's default) or one
 // directional light; anything else is lit by a headlight, said once through `warnedLight`.
-void SetBlendAndShading(vtkVolumeMapper* mapper, spaceskip::RenderParams& rp, vtkRenderer* ren,
-  vtkVolume* vol, const double scalarRange[2], bool& warnedLight)
+void SetBlendAndShading(vtkVolumeMapper* mapper, int mode, spaceskip::RenderParams& rp,
+  vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2], bool& warnedLight)
 {
-  const int mode = mapper->GetBlendMode();
   rp.blend = mode >= vtkVolumeMapper::COMPOSITE_BLEND && mode <= vtkVolumeMapper::ISOSURFACE_BLEND
     ? static_cast<spaceskip::BlendMode>(mode)
     : spaceskip::BlendMode::Composite; // slice: warned by the caller
@@ -637,9 +636,9 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     };
     unsupported(prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION, d.WarnedNearest,
       "nearest interpolation is not supported; rendering with trilinear interpolation");
-    unsupported(this->BlendMode == vtkVolumeMapper::SLICE_BLEND ||
-        this->BlendMode < vtkVolumeMapper::COMPOSITE_BLEND ||
-        this->BlendMode > vtkVolumeMapper::SLICE_BLEND,
+    const int blend = this->EffectiveBlendMode();
+    unsupported(blend == vtkVolumeMapper::SLICE_BLEND || blend < vtkVolumeMapper::COMPOSITE_BLEND ||
+        blend > vtkVolumeMapper::SLICE_BLEND,
       d.WarnedBlend, "the slice blend mode is not supported; rendering with composite blending");
     unsupported(this->Cropping != 0 ||
         (this->ClippingPlanes && this->ClippingPlanes->GetNumberOfItems() > 0),
@@ -657,7 +656,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     rp.sampleDistance = this->SampleDistance;
     rp.ertThreshold = this->EarlyRayTermination ? kErtThreshold : 2.0;
     rp.firstSampleOffset = 1.0; // where vtkGPUVolumeRayCastMapper samples first (without jitter)
-    SetBlendAndShading(this, rp, ren, vol, d.ScalarRange, d.WarnedLight);
+    SetBlendAndShading(this, this->EffectiveBlendMode(), rp, ren, vol, d.ScalarRange, d.WarnedLight);
     engine.setRenderParams(rp);
 
     // Camera: the volume's matrix is folded into the view, so the engine marches in the
@@ -791,6 +790,7 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Backend: "
      << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";
   os << indent << "EarlyRayTermination: " << (this->EarlyRayTermination ? "On" : "Off") << "\n";
+  os << indent << "BlendModeOverride: " << this->BlendModeOverride << "\n";
   os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
   os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";

@@ -155,6 +155,16 @@ public:
 
   ///@{
   /**
+   * When >= 0, the blend mode used instead of vtkVolumeMapper::BlendMode (same values). -1
+   * (default): BlendMode. For front ends whose BlendMode menu lacks modes this mapper has
+   * (ParaView 5.11 offers composite, isosurface and slice only).
+   */
+  vtkSetClampMacro(BlendModeOverride, int, -1, vtkVolumeMapper::ISOSURFACE_BLEND);
+  vtkGetMacro(BlendModeOverride, int);
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -197,6 +207,7 @@ protected:
   double SampleDistance = 0.0;
   int Backend = Auto;
   vtkTypeBool EarlyRayTermination = 1;
+  int BlendModeOverride = -1;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;
@@ -204,6 +215,11 @@ private:
 
   // Reads the window depth of the viewport into the internal buffer (resolving MSAA if needed).
   bool ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);
+  /// BlendModeOverride when set, else BlendMode.
+  int EffectiveBlendMode() const
+  {
+    return this->BlendModeOverride >= 0 ? this->BlendModeOverride : this->BlendMode;
+  }
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

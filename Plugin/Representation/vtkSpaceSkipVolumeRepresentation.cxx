@@ -88,6 +88,16 @@ int vtkSpaceSkipVolumeRepresentation::GetEarlyRayTermination()
   return this->SpaceSkipMapper->GetEarlyRayTermination() ? 1 : 0;
 }
 
+void vtkSpaceSkipVolumeRepresentation::SetExtraBlendMode(int mode)
+{
+  this->SpaceSkipMapper->SetBlendModeOverride(mode);
+}
+
+int vtkSpaceSkipVolumeRepresentation::GetExtraBlendMode()
+{
+  return this->SpaceSkipMapper->GetBlendModeOverride();
+}
+
 //------------------------------------------------------------------------------
 double vtkSpaceSkipVolumeRepresentation::GetLastBuildSeconds()
 {

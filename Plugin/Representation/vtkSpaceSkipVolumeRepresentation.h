@@ -47,6 +47,10 @@ public:
   int GetBackend();
   void SetEarlyRayTermination(int on);
   int GetEarlyRayTermination();
+  /// The blend modes ParaView 5.11's Blend Mode menu lacks (vtkSpaceSkippingVolumeMapper's
+  /// BlendModeOverride): -1 follows Blend Mode.
+  void SetExtraBlendMode(int mode);
+  int GetExtraBlendMode();
   ///@}
 
   ///@{
