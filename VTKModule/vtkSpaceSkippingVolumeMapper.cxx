@@ -2,8 +2,11 @@
 #include "vtkSpaceSkippingVolumeMapper.h"
 
 #include "vtkColorTransferFunction.h"
+#include "vtkContourValues.h"
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
+#include "vtkLight.h"
+#include "vtkLightCollection.h"
 #include "vtkLogger.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
@@ -55,6 +58,86 @@ static_assert(static_cast<int>(spaceskip::BuilderKind::Hybrid) == vtkSpaceSkippi
   "vtkSpaceSkippingVolumeMapper::BuilderTypes out of step with spaceskip::BuilderKind");
 // Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
 constexpr double kErtThreshold = 0.99;
+
+static_assert(static_cast<int>(spaceskip::BlendMode::Isosurface) == vtkVolumeMapper::ISOSURFACE_BLEND &&
+    static_cast<int>(spaceskip::BlendMode::MaximumIntensity) == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND,
+  "spaceskip::BlendMode out of step with vtkVolumeMapper's blend modes");
+
+// Blend mode, iso values and shading from the mapper, the volume property and the renderer's
+// lights, as vtkGPUVolumeRayCastMapper reads them. Lights: a headlight (VTK's default) or one
+// directional light; anything else is lit by a headlight, said once through `warnedLight`.
+void SetBlendAndShading(vtkVolumeMapper* mapper, int mode, spaceskip::RenderParams& rp,
+  vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2], bool& warnedLight)
+{
+  rp.blend = mode >= vtkVolumeMapper::COMPOSITE_BLEND && mode <= vtkVolumeMapper::ISOSURFACE_BLEND
+    ? static_cast<spaceskip::BlendMode>(mode)
+    : spaceskip::BlendMode::Composite; // slice: warned by the caller
+  rp.isoValues.clear();
+  vtkVolumeProperty* prop = vol->GetProperty();
+  if (rp.blend == spaceskip::BlendMode::Isosurface)
+  {
+    vtkContourValues* iso = prop->GetIsoSurfaceValues();
+    for (int i = 0; i < iso->GetNumberOfContours(); ++i)
+    {
+      rp.isoValues.push_back(iso->GetValue(i));
+    }
+  }
+  rp.scalarRange[0] = scalarRange[0];
+  rp.scalarRange[1] = scalarRange[1];
+  const double* avg = mapper->GetAverageIPScalarRange();
+  rp.averageRange[0] = avg[0];
+  rp.averageRange[1] = avg[1];
+
+  rp.shade = prop->GetShade(0) != 0;
+  rp.ambient = prop->GetAmbient(0);
+  rp.diffuse = prop->GetDiffuse(0);
+  rp.specular = prop->GetSpecular(0);
+  rp.specularPower = prop->GetSpecularPower(0);
+  rp.lightDirection[0] = rp.lightDirection[1] = rp.lightDirection[2] = 0; // headlight
+  if (!rp.shade)
+  {
+    return;
+  }
+  vtkLight* only = nullptr;
+  int on = 0;
+  vtkLightCollection* lights = ren->GetLights();
+  vtkCollectionSimpleIterator it;
+  lights->InitTraversal(it);
+  while (vtkLight* l = lights->GetNextLight(it))
+  {
+    if (l->GetSwitch())
+    {
+      ++on;
+      only = l;
+    }
+  }
+  if (on == 1 && !only->LightTypeIsHeadlight() && !only->GetPositional())
+  {
+    // A directional light, from world into the volume's physical space (its matrix's inverse).
+    double p[3], f[3];
+    only->GetTransformedPosition(p);
+    only->GetTransformedFocalPoint(f);
+    vtkNew<vtkMatrix4x4> inv;
+    vtkMatrix4x4::Invert(vol->GetMatrix(), inv);
+    const double w[4] = { p[0] - f[0], p[1] - f[1], p[2] - f[2], 0.0 };
+    double o[4];
+    inv->MultiplyPoint(w, o);
+    std::copy(o, o + 3, rp.lightDirection);
+  }
+  else if (on != 1 && !warnedLight)
+  {
+    vtkWarningWithObjectMacro(mapper,
+      << "shading with " << on << " lights: only a headlight or a single directional light is "
+      << "supported; shading with a headlight");
+    warnedLight = true;
+  }
+  else if (on == 1 && only->GetPositional() && !warnedLight)
+  {
+    vtkWarningWithObjectMacro(
+      mapper, << "positional lights are not supported; shading with a headlight");
+    warnedLight = true;
+  }
+}
 
 // Core voxel types by VTK type; int/unsigned int/long become float (see ConvertScalars).
 bool CoreTypeOf(int vtkType, spaceskip::VoxelType& out)
@@ -199,7 +282,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
   bool ResolveStencil = false;
   bool WarnedNearest = false;
-  bool WarnedShade = false;
+  bool WarnedLight = false;
   bool WarnedBlend = false;
   bool WarnedDepthRead = false;
 
@@ -687,10 +770,10 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     };
     unsupported(prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION, d.WarnedNearest,
       "nearest interpolation is not supported; rendering with trilinear interpolation");
-    unsupported(prop->GetShade(0) != 0, d.WarnedShade,
-      "shading is not supported yet; rendering unshaded (emission-absorption)");
-    unsupported(this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND, d.WarnedBlend,
-      "only the composite blend mode is supported; rendering with composite blending");
+    const int blend = this->EffectiveBlendMode();
+    unsupported(blend == vtkVolumeMapper::SLICE_BLEND || blend < vtkVolumeMapper::COMPOSITE_BLEND ||
+        blend > vtkVolumeMapper::SLICE_BLEND,
+      d.WarnedBlend, "the slice blend mode is not supported; rendering with composite blending");
 
     spaceskip::BuildParams bp;
     bp.builder = static_cast<spaceskip::BuilderKind>(this->Builder);
@@ -730,6 +813,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         rp.clipPlanes.push_back(c);
       }
     }
+    rp.firstSampleOffset = 1.0; // where vtkGPUVolumeRayCastMapper samples first (without jitter)
+    SetBlendAndShading(this, this->EffectiveBlendMode(), rp, ren, vol, d.ScalarRange, d.WarnedLight);
     engine.setRenderParams(rp);
 
     // Camera: the volume's matrix is folded into the view, so the engine marches in the
@@ -893,6 +978,7 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
   os << indent << "VectorMode: " << this->VectorMode << "\n";
   os << indent << "VectorComponent: " << this->VectorComponent << "\n";
+  os << indent << "BlendModeOverride: " << this->BlendModeOverride << "\n";
   os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
   os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";

@@ -5,7 +5,10 @@
  * A drop-in for vtkSmartVolumeMapper: point scalars of one component (unsigned/signed char,
  * unsigned/signed short, float, double; int/unsigned int/long are converted to float with a
  * warning), the volume property's colour and scalar-opacity functions and its
- * ScalarOpacityUnitDistance. The hierarchy over the occupied macro cells is built by `Builder`
+ * ScalarOpacityUnitDistance, its Shade/Ambient/Diffuse/Specular/SpecularPower (VTK's headlight or
+ * one directional light) and IsoSurfaceValues, and every blend mode of vtkVolumeMapper but slice
+ * (composite, maximum/minimum/average intensity with AverageIPScalarRange, additive,
+ * isosurface), with vtkGPUVolumeRayCastMapper's semantics. The hierarchy over the occupied macro cells is built by `Builder`
  * (the builders of Morrical/Zellmann et al.); a colour-only transfer-function edit only updates
  * the lookup table, an opacity edit re-classifies and rebuilds only when the occupied cells changed.
  * The image is marched by the CUDA backend when a device is usable (Backend Auto), else by the
@@ -184,6 +187,16 @@ public:
 
   ///@{
   /**
+   * When >= 0, the blend mode used instead of vtkVolumeMapper::BlendMode (same values). -1
+   * (default): BlendMode. For front ends whose BlendMode menu lacks modes this mapper has
+   * (ParaView 5.11 offers composite, isosurface and slice only).
+   */
+  vtkSetClampMacro(BlendModeOverride, int, -1, vtkVolumeMapper::ISOSURFACE_BLEND);
+  vtkGetMacro(BlendModeOverride, int);
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -262,6 +275,7 @@ protected:
   vtkTypeBool UseJittering = 0;
   int VectorMode = 1; // vtkScalarsToColors::COMPONENT
   int VectorComponent = 0;
+  int BlendModeOverride = -1;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;
@@ -272,6 +286,11 @@ private:
 
   // Reads the window depth of the viewport into the internal buffer (resolving MSAA if needed).
   bool ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);
+  /// BlendModeOverride when set, else BlendMode.
+  int EffectiveBlendMode() const
+  {
+    return this->BlendModeOverride >= 0 ? this->BlendModeOverride : this->BlendMode;
+  }
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

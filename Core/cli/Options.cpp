@@ -2,6 +2,7 @@
 // range-checked, so a typo gives a message naming the option instead of a crash or garbage.
 #include "Options.h"
 
+#include "spaceskip/Integrator.h"
 #include "spaceskip/Parse.h"
 #include "spaceskip/VolumeIO.h"
 
@@ -23,7 +24,8 @@ const std::set<std::string>& valueOptions() {
   static const std::set<std::string> s = {
       "-o", "--dims", "--seed", "--builder", "--builders", "--leaf", "--mls", "--bins", "--brick", "--backend",
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
-      "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes"};
+      "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
+      "--shade"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
@@ -203,6 +205,37 @@ RenderParams renderParams(const Options& o) {
   if (f == "exact") r.filter = FilterMode::Exact;
   else if (f == "hardware") r.filter = FilterMode::Hardware;
   else throw bad("--filter", f, "is not exact or hardware");
+  const std::string blend = o.get("--blend", "composite");
+  const std::pair<const char*, BlendMode> modes[] = {
+      {"composite", BlendMode::Composite}, {"mip", BlendMode::MaximumIntensity},
+      {"minip", BlendMode::MinimumIntensity}, {"average", BlendMode::AverageIntensity},
+      {"additive", BlendMode::Additive}, {"iso", BlendMode::Isosurface}};
+  bool known = false;
+  for (const auto& m : modes)
+    if (blend == m.first) {
+      r.blend = m.second;
+      known = true;
+    }
+  if (!known) throw bad("--blend", blend, "is not composite, mip, minip, average, additive or iso");
+  if (o.has("--iso"))
+    for (const std::string& v : split(o.get("--iso", ""), ','))
+      r.isoValues.push_back(parseDoubleArg(v, "--iso", -1e300, 1e300));
+  if (r.blend == BlendMode::Isosurface && r.isoValues.empty())
+    throw bad("--blend", blend, "needs --iso V1,V2,...");
+  if (r.isoValues.size() > size_t(kMaxIsoValues))
+    throw bad("--iso", o.get("--iso", ""), "has more than " + std::to_string(kMaxIsoValues) + " values");
+  if (o.has("--shade")) {  // "on" (VTK's coefficients) or AMBIENT,DIFFUSE,SPECULAR,POWER
+    r.shade = true;
+    const std::string sh = o.get("--shade", "on");
+    if (sh != "on") {
+      std::vector<std::string> c = split(sh, ',');
+      if (c.size() != 4) throw bad("--shade", sh, "is not on or AMBIENT,DIFFUSE,SPECULAR,POWER");
+      r.ambient = parseDoubleArg(c[0], "--shade (ambient)", 0, 1);
+      r.diffuse = parseDoubleArg(c[1], "--shade (diffuse)", 0, 1);
+      r.specular = parseDoubleArg(c[2], "--shade (specular)", 0, 1);
+      r.specularPower = parseDoubleArg(c[3], "--shade (specular power)", 0, 128);
+    }
+  }
   return r;
 }
 

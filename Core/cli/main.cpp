@@ -69,6 +69,8 @@ options:
   --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective
   --sample-distance D  (world units; default half the smallest spacing)
   --ert T  --jitter  --filter exact|hardware
+  --blend composite|mip|minip|average|additive|iso   --iso V1,V2,...  (iso values)
+  --shade on|AMBIENT,DIFFUSE,SPECULAR,POWER  gradient shading with a headlight (on: 0,0.7,0.2,10)
   --compare REF.png  print max difference and PSNR against a reference image
   --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
   --max-volume-bytes N[K|M|G|T]  largest volume read or generated (default: the environment's

@@ -10,6 +10,7 @@
 #include "Volume.h"
 
 #include <array>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <memory>
@@ -74,6 +75,27 @@ struct RenderParams {
   /// Clipping planes in the volume's world frame: a point x is kept where
   /// n.x + d >= 0 for every plane (nx, ny, nz, d), as vtkPlane's normal points to the kept side.
   std::vector<std::array<double, 4>> clipPlanes;
+  /// The first sample lies this many sample distances past the ray's entry into the box (>= 0).
+  /// vtkGPUVolumeRayCastMapper starts one step in (1) and takes that first sample even where the
+  /// ray leaves the box before it (clamped to the box); > 0 does the same. 0: at the entry.
+  double firstSampleOffset = 0;
+
+  // Blend modes (vtkVolumeMapper::SetBlendMode semantics, as vtkGPUVolumeRayCastMapper does them).
+  BlendMode blend = BlendMode::Composite;
+  std::vector<double> isoValues;  ///< Isosurface: up to kMaxIsoValues (16); any order
+  /// Additive and average: scalars are normalised to [0, 1] over this range (VTK uses the scalar
+  /// array's range); lo >= hi: the transfer function's range.
+  double scalarRange[2] = {0, 0};
+  /// Average: only samples with value in this range count (vtkVolumeMapper's AverageIPScalarRange).
+  double averageRange[2] = {-HUGE_VAL, HUGE_VAL};
+
+  // Gradient shading (vtkVolumeProperty's Shade, Ambient, Diffuse, Specular, SpecularPower;
+  // VTK's defaults), composite and isosurface modes only, as in VTK.
+  bool shade = false;
+  double ambient = 0.0, diffuse = 0.7, specular = 0.2, specularPower = 10.0;
+  /// World direction from the volume towards a directional white light; (0,0,0): a headlight
+  /// (VTK's default light: at the camera, so every ray is lit along itself).
+  double lightDirection[3] = {0, 0, 0};
 };
 /// At most this many clipping planes (VTK's mappers take six).
 constexpr int kMaxClipPlanes = 6;

@@ -9,6 +9,18 @@ namespace spaceskip {
 
 enum class TraversalKind : int { Naive = 0, Grid = 1, Tree = 2, Hybrid = 3 };
 
+/// Most iso values the isosurface blend mode takes (they travel in the FrameView).
+constexpr int kMaxIsoValues = 16;
+
+/// Blend modes whose result a brick can change although the TF gives it no opacity (MIP, MinIP:
+/// the extreme sample is mapped after the march; average: transparent samples count), or whose
+/// skipping test depends on the ray (isosurface). They march the range grid with the ray-dependent
+/// test IntervalMarcher::active instead of the opacity occupancy.
+SS_FUNC bool usesValueRanges(BlendMode m) {
+  return m == BlendMode::MaximumIntensity || m == BlendMode::MinimumIntensity ||
+         m == BlendMode::AverageIntensity || m == BlendMode::Isosurface;
+}
+
 /// Everything a pixel needs, plain data (device pointers on the GPU).
 struct FrameView {
   float invViewProj[16];   ///< NDC -> world, column-major
@@ -18,6 +30,7 @@ struct FrameView {
   float dt;                ///< sample distance in world units
   float ertThreshold;      ///< early ray termination when alpha >= this; > 1 disables
   int jitter;              ///< 1: per-pixel random start offset in [0, dt)
+  float firstSample;       ///< first sample at the box entry + firstSample * dt (see RenderParams)
   uint32_t jitterSeed;
   const float* depth;      ///< optional window depth in [0,1] per pixel (opaque geometry)
   TraversalKind traversal;
@@ -30,6 +43,16 @@ struct FrameView {
   int cropping;            ///< 1: only regions of cropFlags between the planes are drawn
   int cropFlags;           ///< bit i + 3j + 9k: region (i, j, k) of the 3x3x3 split is drawn
   float crop[6];           ///< index-space planes x0, x1, y0, y1, z0, z1
+  // Blend mode and shading (vtkVolumeMapper / vtkVolumeProperty semantics).
+  BlendMode blend;
+  float normLo, normScale;  ///< additive/average: normalised scalar = (v - normLo) * normScale
+  float avgLo, avgHi;       ///< average: only samples with value in [avgLo, avgHi] count
+  int numIso;               ///< isosurface: iso values, ascending
+  float iso[kMaxIsoValues];
+  int shade;                ///< 1: gradient shading (composite and isosurface, as VTK)
+  float ambient, diffuse, specular, specularPower;
+  vec3f lightDir;           ///< world direction towards the light; (0,0,0): headlight
+  vec3f eyeW;               ///< camera position in world space (the headlight; parallel views too)
 };
 
 /// Clips [tmin, tmax] to the convex intersection of the clipping half-spaces; false if empty.
@@ -149,7 +172,9 @@ SS_FUNC vec3f unproject(const float* m, float x, float y, float z) {
 /// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
 /// never before `nextK`, so adjacent intervals never take a sample twice. Sample indices are
 /// 64-bit: the engine bounds a ray to kMaxSamplesPerRay samples, but an index computed from a
-/// far interval end must never wrap (a tiny step once overflowed int and drew nothing).
+/// far interval end must never wrap (a tiny step once overflowed int and drew nothing). It also
+/// keeps each blend mode's running state, from which `active` decides which bricks can still
+/// matter.
 template <class Sampler>
 struct IntervalMarcher {
   const FrameView* f;
@@ -157,33 +182,159 @@ struct IntervalMarcher {
   Ray ray;
   float t0;
   int64_t nextK;
-  vec4f acc;
+  vec4f acc;         ///< composite, isosurface: premultiplied colour so far
   unsigned samples;
+  vec3f lightW, viewW;  ///< shading: towards the light and towards the eye, world space
+  float extreme;     ///< MIP/MinIP: running max/min; average/additive: running sum
+  unsigned count;    ///< MIP/MinIP: samples seen; average: samples counted
+  int isoIndex;      ///< isosurface: the iso interval of the last sample, -1 before the first
+
+  /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
+  SS_FUNC bool active(float lo, float hi) const {
+    switch (f->blend) {
+      case BlendMode::MaximumIntensity: return count == 0 || hi > extreme;
+      case BlendMode::MinimumIntensity: return count == 0 || lo < extreme;
+      case BlendMode::AverageIntensity: return lo <= f->avgHi && hi >= f->avgLo;
+      case BlendMode::Isosurface:  // no crossing possible when [lo, hi] is inside the interval
+        return isoIndex < 0 || !(isoBound(isoIndex) <= lo && hi <= isoBound(isoIndex + 1));
+      default: return true;
+    }
+  }
+  /// Iso interval bounds: -inf, iso[0], ..., iso[n-1], +inf.
+  SS_FUNC float isoBound(int i) const { return i <= 0 ? -INFINITY : i > f->numIso ? INFINITY : f->iso[i - 1]; }
+
+  /// Phong shading as vtkGPUVolumeRayCastMapper does it for its headlight (VTK 9.2): gradient by
+  /// central differences one voxel apart (to world space through the inverse transpose of
+  /// index->world), two-sided diffuse, specular from the reflected light vector, white light,
+  /// specular not tinted, the result clamped to [0, 1].
+  SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p) const {
+    const float gx = s->sample(p + vec3f{1, 0, 0}) - s->sample(p - vec3f{1, 0, 0});
+    const float gy = s->sample(p + vec3f{0, 1, 0}) - s->sample(p - vec3f{0, 1, 0});
+    const float gz = s->sample(p + vec3f{0, 0, 1}) - s->sample(p - vec3f{0, 0, 1});
+    const float* M = f->worldToIndex;
+    vec3f n{M[0] * gx + M[4] * gy + M[8] * gz, M[1] * gx + M[5] * gy + M[9] * gz, M[2] * gx + M[6] * gy + M[10] * gz};
+    const float len = length(n);
+    n = len > 0.f ? n * (1.f / len) : vec3f{0, 0, 0};
+    const float nl = -dot(n, lightW);  // VTK: the gradient points inwards, hence -l
+    const vec3f r = normalize(n * (2.f * nl) + lightW);
+    const float vr = ss_max(-dot(r, viewW), 0.f);
+    const float spec = vr > 0.f ? f->specular * powf(vr, f->specularPower) : 0.f;
+    const float k = f->ambient + f->diffuse * fabsf(nl);
+    return vec3f{ss_clamp(k * rgb.x + spec, 0.f, 1.f), ss_clamp(k * rgb.y + spec, 0.f, 1.f),
+                 ss_clamp(k * rgb.z + spec, 0.f, 1.f)};
+  }
+
+  /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
+  SS_FUNC bool composite(vec4f c, vec3f p) {
+    if (f->shade) {
+      vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p);
+      c.x = rgb.x;
+      c.y = rgb.y;
+      c.z = rgb.z;
+    }
+    float w = (1.f - acc.w) * c.w;
+    acc.x += w * c.x;
+    acc.y += w * c.y;
+    acc.z += w * c.z;
+    acc.w += w;
+    return acc.w < f->ertThreshold;
+  }
+
+  /// Every mode but composite, one sample of value v at p; false: terminate.
+  SS_FUNC bool blendSample(float v, vec3f p) {
+    if (!(v == v)) return true;  // NaN: no contribution, as in classification
+    switch (f->blend) {
+      case BlendMode::MaximumIntensity:
+        if (count == 0 || v > extreme) extreme = v;
+        ++count;
+        return true;
+      case BlendMode::MinimumIntensity:
+        if (count == 0 || v < extreme) extreme = v;
+        ++count;
+        return true;
+      case BlendMode::AverageIntensity:
+        if (v >= f->avgLo && v <= f->avgHi) {
+          extreme += lookup(f->tf, v).w * (v - f->normLo) * f->normScale;
+          ++count;
+        }
+        return true;
+      case BlendMode::Additive:
+        extreme += lookup(f->tf, v).w * (v - f->normLo) * f->normScale;
+        return true;
+      case BlendMode::Isosurface: {
+        // vtkVolumeShaderComposer: the first sample picks its interval; later, leaving the
+        // interval crosses the iso value on that side (one per sample), composited with that
+        // value's colour and opacity and shaded at the sample.
+        if (isoIndex < 0) {
+          int i = 0;
+          while (i < f->numIso && v > f->iso[i]) ++i;
+          isoIndex = i;
+          return true;
+        }
+        float iv;
+        if (v < isoBound(isoIndex)) {
+          iv = isoBound(isoIndex);
+          --isoIndex;
+        } else if (v > isoBound(isoIndex + 1)) {
+          iv = isoBound(isoIndex + 1);
+          ++isoIndex;
+        } else {
+          return true;
+        }
+        vec4f c = lookup(f->tf, iv);
+        return c.w > 0.f ? composite(c, p) : true;
+      }
+      default: return true;
+    }
+  }
 
   SS_FUNC bool operator()(float a, float b) {
     const float dt = f->dt;
     int64_t kBegin = int64_t(ceilf((a - t0) / dt));
     int64_t kEnd = int64_t(ceilf((b - t0) / dt));
     if (kBegin < nextK) kBegin = nextK;
+    const bool comp = f->blend == BlendMode::Composite;
     for (int64_t k = kBegin; k < kEnd; ++k) {
       float t = t0 + float(k) * dt;
-      vec4f c = lookup(f->tf, s->sample(ray.org + ray.dir * t));
-      if (c.w > 0.f) {
-        float w = (1.f - acc.w) * c.w;
-        acc.x += w * c.x;
-        acc.y += w * c.y;
-        acc.z += w * c.z;
-        acc.w += w;
-        if (acc.w >= f->ertThreshold) {
-          samples += unsigned(k + 1 - kBegin);
-          nextK = k + 1;
-          return false;
-        }
+      const vec3f p = ray.org + ray.dir * t;
+      bool go;
+      if (comp) {
+        vec4f c = lookup(f->tf, s->sample(p));
+        go = c.w > 0.f ? composite(c, p) : true;
+      } else {
+        go = blendSample(s->sample(p), p);
+      }
+      if (!go) {
+        samples += unsigned(k + 1 - kBegin);
+        nextK = k + 1;
+        return false;
       }
     }
     if (kEnd > kBegin) samples += unsigned(kEnd - kBegin);
     if (kEnd > nextK) nextK = kEnd;
     return true;
+  }
+
+  /// The pixel's premultiplied RGBA once the march is over.
+  SS_FUNC vec4f result() const {
+    switch (f->blend) {
+      case BlendMode::MaximumIntensity:
+      case BlendMode::MinimumIntensity: {
+        if (count == 0) return vec4f{0, 0, 0, 0};
+        vec4f c = lookup(f->tf, extreme);
+        return vec4f{c.x * c.w, c.y * c.w, c.z * c.w, c.w};
+      }
+      case BlendMode::AverageIntensity: {
+        if (count == 0) return vec4f{0, 0, 0, 0};
+        const float g = ss_clamp(extreme / float(count), 0.f, 1.f);
+        return vec4f{g, g, g, 1.f};
+      }
+      case BlendMode::Additive: {
+        const float g = ss_clamp(extreme, 0.f, 1.f);
+        return vec4f{g, g, g, 1.f};
+      }
+      default: return acc;
+    }
   }
 };
 
@@ -233,16 +384,25 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
 
+  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
+                             0.f, 0u, -1};
+  if (f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
+    const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
+    const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
+    m.lightW = head ? toEye : normalize(f.lightDir);
+    m.viewW = toEye;
+  }
   // The sample lattice is anchored where the ray enters the drawn part of the volume (the box,
   // cut by the clipping planes, and the first drawn cropping region), as VTK's mapper does by
-  // clipping its proxy geometry: no wood grain on cut faces. The anchor depends on the ray and
-  // the planes only, never on the skipping structure, so every builder takes the same samples.
-  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u};
-  const float jitter = f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f;
+  // clipping its proxy geometry: no wood grain on cut faces; firstSample steps in and the
+  // jitter follow. The anchor depends on the ray and the planes only, never on the skipping
+  // structure, so every builder takes the same samples.
+  float lead = f.firstSample * f.dt +
+                     (f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f);
   bool anchored = false;
   auto march = [&](float a, float b) -> bool {
     if (!anchored) {
-      m.t0 = a + jitter;
+      m.t0 = a + lead;
       anchored = true;
     }
     switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
@@ -261,11 +421,24 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   };
   float a = tEnter, b = tExit;
   if (f.numClipPlanes == 0 || clipToPlanes(f, r, a, b)) {
-    if (f.cropping) forEachCroppedInterval(f, r, a, b, march);
-    else march(a, b);
+    if (f.cropping) {
+      // VTK starts cropped rays on the face of the first drawn region itself, not one step in
+      // (measured against vtkGPUVolumeRayCastMapper: sub-volume 43.5 dB this way, 38.9 dB one
+      // step in, 40.7 dB on the box's lattice).
+      lead -= f.firstSample * f.dt;
+      forEachCroppedInterval(f, r, a, b, march);
+    } else if (f.firstSample > 0.f && !(a + lead < b)) {
+      // Starting one or more steps in, the ray may leave the box before its first sample: that
+      // sample is still taken (clamped to the box), as vtkGPUVolumeRayCastMapper does; every
+      // traversal alike.
+      m.t0 = a + lead;
+      m(m.t0, m.t0 + f.dt);
+    } else {
+      march(a, b);
+    }
   }
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
-  return m.acc;
+  return m.result();
 }
 
 }  // namespace spaceskip

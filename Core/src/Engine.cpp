@@ -289,7 +289,7 @@ struct Engine::Impl {
       if (!note.empty()) warn(note);
       float lo, scale;
       tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
-      backend->setTransferTable(correctedTable(tf, float(step)), lo, scale);
+      backend->setTransferTable(tableForBlend(tf, float(step), render.blend), lo, scale);
       tableDirty = colorDirty = false;
     }
     if (buildDirty) {
@@ -393,7 +393,7 @@ void Engine::setBuildParams(const BuildParams& p) {
 }
 
 void Engine::setRenderParams(const RenderParams& p) {
-  if (p.sampleDistance != impl_->render.sampleDistance) impl_->tableDirty = true;
+  if (p.sampleDistance != impl_->render.sampleDistance || p.blend != impl_->render.blend) impl_->tableDirty = true;
   impl_->render = p;
 }
 
@@ -410,6 +410,43 @@ void Engine::update() {
     d.update();
   }
 }
+
+namespace {
+/// The blend-mode and shading part of the frame from the render parameters.
+template <class Impl>
+void fillBlend(Impl& d, FrameView& f) {
+  const RenderParams& r = d.render;
+  f.blend = r.blend;
+  // Scalar values in the frame are in the sampled units: times 2^valueExponent (setVolume).
+  auto scaled = [&](double v) { return std::ldexp(v, d.valueExponent); };
+  double lo = r.scalarRange[0], hi = r.scalarRange[1];
+  if (!(lo < hi)) {
+    lo = d.tf.rangeMin;
+    hi = d.tf.rangeMax;
+  }
+  lo = scaled(lo);
+  hi = scaled(hi);
+  f.normLo = float(lo);
+  f.normScale = hi > lo ? float(1.0 / (hi - lo)) : 0.f;
+  f.avgLo = float(std::max(scaled(r.averageRange[0]), -double(HUGE_VALF)));
+  f.avgHi = float(std::min(scaled(r.averageRange[1]), double(HUGE_VALF)));
+  std::vector<double> iso = r.isoValues;
+  std::sort(iso.begin(), iso.end());
+  if (iso.size() > size_t(kMaxIsoValues)) {
+    d.warn("isosurface: " + std::to_string(iso.size()) + " iso values, using the lowest " +
+           std::to_string(kMaxIsoValues));
+    iso.resize(size_t(kMaxIsoValues));
+  }
+  f.numIso = int(iso.size());
+  for (int i = 0; i < f.numIso; ++i) f.iso[i] = float(scaled(iso[size_t(i)]));
+  f.shade = r.shade && (r.blend == BlendMode::Composite || r.blend == BlendMode::Isosurface) ? 1 : 0;
+  f.ambient = float(r.ambient);
+  f.diffuse = float(r.diffuse);
+  f.specular = float(r.specular);
+  f.specularPower = float(r.specularPower);
+  f.lightDir = vec3f{float(r.lightDirection[0]), float(r.lightDirection[1]), float(r.lightDirection[2])};
+}
+}  // namespace
 
 void Engine::render(const Camera& cam, int width, int height, Image& out, const float* depth) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("render size must be positive");
@@ -467,6 +504,13 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   }
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
+  f.firstSample = float(std::max(0.0, d.render.firstSampleOffset));
+  mat4 iv;
+  if (!invert(cam.view, iv)) throw std::invalid_argument("camera view matrix is singular");
+  // The eye in the same origin-relative frame as the rays (subtracted in double).
+  f.eyeW = vec3f{float(iv.m[12] - d.volume.origin[0]), float(iv.m[13] - d.volume.origin[1]),
+                 float(iv.m[14] - d.volume.origin[2])};
+  fillBlend(d, f);
   std::vector<unsigned> counts;
   if (d.render.countSamples) {
     counts.assign(size_t(width) * size_t(height), 0u);

@@ -96,6 +96,16 @@ std::vector<vec4f> correctedTable(const TransferFunction& tf, float dt) {
   return out;
 }
 
+std::vector<vec4f> tableForBlend(const TransferFunction& tf, float dt, BlendMode mode) {
+  if (mode == BlendMode::Composite) return correctedTable(tf, dt);
+  std::vector<vec4f> out(tf.table);
+  if (mode == BlendMode::Additive) {
+    const float factor = dt / float(tf.unitDistance);
+    for (auto& e : out) e.w *= factor;
+  }
+  return out;
+}
+
 OpacityRangeMax::OpacityRangeMax(const TransferFunction& tf)
     : lo_(tf.rangeMin), size_(int(tf.table.size())) {
   scale_ = tf.rangeMax > tf.rangeMin ? double(size_ - 1) / (tf.rangeMax - tf.rangeMin) : 0.0;

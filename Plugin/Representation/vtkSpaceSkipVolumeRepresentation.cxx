@@ -116,6 +116,16 @@ int vtkSpaceSkipVolumeRepresentation::GetUseJittering()
   return this->SpaceSkipMapper->GetUseJittering() ? 1 : 0;
 }
 
+void vtkSpaceSkipVolumeRepresentation::SetExtraBlendMode(int mode)
+{
+  this->SpaceSkipMapper->SetBlendModeOverride(mode);
+}
+
+int vtkSpaceSkipVolumeRepresentation::GetExtraBlendMode()
+{
+  return this->SpaceSkipMapper->GetBlendModeOverride();
+}
+
 //------------------------------------------------------------------------------
 double vtkSpaceSkipVolumeRepresentation::GetLastBuildSeconds()
 {

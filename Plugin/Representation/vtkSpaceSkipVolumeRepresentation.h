@@ -49,6 +49,10 @@ public:
   int GetEarlyRayTermination();
   void SetUseJittering(int on);
   int GetUseJittering();
+  /// The blend modes ParaView 5.11's Blend Mode menu lacks (vtkSpaceSkippingVolumeMapper's
+  /// BlendModeOverride): -1 follows Blend Mode.
+  void SetExtraBlendMode(int mode);
+  int GetExtraBlendMode();
   ///@}
 
   ///@{
