@@ -1,6 +1,8 @@
 // Transfer-function tables, presets and the sparse-table range-max query.
 #include "spaceskip/TransferFunction.h"
 
+#include "spaceskip/TransferFunctionIO.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -68,42 +70,7 @@ TransferFunction TransferFunction::preset(const std::string& name, double lo, do
 }
 
 TransferFunction TransferFunction::load(const std::string& path, double lo, double hi) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open transfer-function file");
-  std::vector<TFPoint> pts;
-  int size = 1024;
-  double unit = 1.0;
-  std::string line;
-  int lineNo = 0;
-  while (std::getline(in, line)) {
-    ++lineNo;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ls(line);
-    std::string first;
-    ls >> first;
-    if (first.empty()) continue;
-    if (first == "range") {
-      if (!(ls >> lo >> hi)) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad range");
-    } else if (first == "size") {
-      if (!(ls >> size) || size < 2) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad size");
-    } else if (first == "unit") {
-      if (!(ls >> unit) || !(unit > 0)) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad unit");
-    } else {
-      TFPoint p{};
-      try {
-        p.value = std::stod(first);
-      } catch (...) {
-        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected 'value r g b a'");
-      }
-      if (!(ls >> p.r >> p.g >> p.b >> p.a))
-        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected 'value r g b a'");
-      pts.push_back(p);
-    }
-  }
-  if (pts.empty()) throw std::runtime_error(path + ": no control points");
-  TransferFunction tf = fromPoints(pts, lo, hi, size);
-  tf.unitDistance = unit;
-  return tf;
+  return loadTransferFunction(path, lo, hi);  // bounded, strict parser: TransferFunctionIO.cpp
 }
 
 bool TransferFunction::sameOpacity(const TransferFunction& o) const {
