@@ -101,8 +101,7 @@ bool readBoundedLine(std::istream& in, std::string& line, size_t maxLine, uint64
       return true;
     }
     if (line.size() >= maxLine)
-      throw ioError(path, "NRRD header line " + std::string(line.compare(0, 4, "NRRD") == 0 ? "(magic) " : "") +
-                              "longer than " + std::to_string(maxLine) + " bytes: not a NRRD header");
+      throw ioError(path, "NRRD header line longer than " + std::to_string(maxLine) + " bytes: not a NRRD header");
     line.push_back(char(c));
   }
   if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -336,6 +335,12 @@ NrrdHeader readNrrdHeader(std::istream& in, const std::string& path, const ReadL
       h.spacing[a] = len;
       for (int r = 0; r < 3; ++r) h.direction[r * 3 + a] = d[r] / len;
     }
+    // Axes beyond `dimension` keep their identity columns; all three must span space.
+    const double* m = h.direction;
+    const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+                       m[2] * (m[3] * m[7] - m[4] * m[6]);
+    if (!(std::fabs(det) > 1e-9))
+      throw fieldError(path, "space directions", "the axes are parallel (no volume)");
   }
   if (has("space origin") && !parseVector(fields["space origin"], 3, h.origin))
     throw fieldError(path, "space origin", "'" + fields["space origin"].substr(0, 80) + "' is not a point (x,y,z)");

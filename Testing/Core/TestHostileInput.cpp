@@ -248,6 +248,10 @@ TEST(HostileInput, NrrdFieldErrorsNameTheField) {
       {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nspace directions: (1,0,0) (0,0,0) (0,0,1)\n",
        "field 'space directions': axis 1"},
       {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nspace origin: (1,2)\n", "field 'space origin'"},
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nspace directions: (1,0,0) (2,0,0) (0,0,1)\n",
+       "field 'space directions': the axes are parallel"},
+      {"type: uint8\ndimension: 2\nsizes: 2 4\nencoding: raw\nspace directions: (0,0,1) (0,1,0)\n",
+       "field 'space directions': the axes are parallel"},
       {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: slice%03d.raw 0 9 1\n", "field 'data file'"},
       {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nsizes:2 2 2\n", "malformed NRRD field"},
   };
