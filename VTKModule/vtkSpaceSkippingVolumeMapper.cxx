@@ -813,7 +813,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
         rp.clipPlanes.push_back(c);
       }
     }
-    rp.firstSampleOffset = 1.0; // where vtkGPUVolumeRayCastMapper samples first (without jitter)
+    // Where vtkGPUVolumeRayCastMapper samples first: one step in, or the jitter alone.
+    rp.firstSampleOffset = this->UseJittering ? 0.0 : 1.0;
     SetBlendAndShading(this, this->EffectiveBlendMode(), rp, ren, vol, d.ScalarRange, d.WarnedLight);
     engine.setRenderParams(rp);
 
