@@ -2,8 +2,11 @@
 #include "vtkSpaceSkippingVolumeMapper.h"
 
 #include "vtkColorTransferFunction.h"
+#include "vtkContourValues.h"
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
+#include "vtkLight.h"
+#include "vtkLightCollection.h"
 #include "vtkLogger.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
@@ -17,9 +20,12 @@
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
 #include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
 #include "vtkPlaneCollection.h"
 #include "vtkPointData.h"
 #include "vtkRenderer.h"
+#include "vtkSMPTools.h"
+#include "vtkScalarsToColors.h"
 #include "vtkShaderProgram.h"
 #include "vtkSmartPointer.h"
 #include "vtkTextureObject.h"
@@ -27,6 +33,7 @@
 #include "vtkVolumeProperty.h"
 #include "vtk_glew.h"
 
+#include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
 
 #include <tbb/blocked_range.h>
@@ -39,7 +46,9 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <set>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -59,6 +68,86 @@ static_assert(static_cast<int>(spaceskip::BuilderKind::Hybrid) == vtkSpaceSkippi
   "vtkSpaceSkippingVolumeMapper::BuilderTypes out of step with spaceskip::BuilderKind");
 // Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
 constexpr double kErtThreshold = 0.99;
+
+static_assert(static_cast<int>(spaceskip::BlendMode::Isosurface) == vtkVolumeMapper::ISOSURFACE_BLEND &&
+    static_cast<int>(spaceskip::BlendMode::MaximumIntensity) == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND,
+  "spaceskip::BlendMode out of step with vtkVolumeMapper's blend modes");
+
+// Blend mode, iso values and shading from the mapper, the volume property and the renderer's
+// lights, as vtkGPUVolumeRayCastMapper reads them. Lights: a headlight (VTK's default) or one
+// directional light; anything else is lit by a headlight, said once through `warnedLight`.
+void SetBlendAndShading(vtkVolumeMapper* mapper, int mode, spaceskip::RenderParams& rp,
+  vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2], bool& warnedLight)
+{
+  rp.blend = mode >= vtkVolumeMapper::COMPOSITE_BLEND && mode <= vtkVolumeMapper::ISOSURFACE_BLEND
+    ? static_cast<spaceskip::BlendMode>(mode)
+    : spaceskip::BlendMode::Composite; // slice: warned by the caller
+  rp.isoValues.clear();
+  vtkVolumeProperty* prop = vol->GetProperty();
+  if (rp.blend == spaceskip::BlendMode::Isosurface)
+  {
+    vtkContourValues* iso = prop->GetIsoSurfaceValues();
+    for (int i = 0; i < iso->GetNumberOfContours(); ++i)
+    {
+      rp.isoValues.push_back(iso->GetValue(i));
+    }
+  }
+  rp.scalarRange[0] = scalarRange[0];
+  rp.scalarRange[1] = scalarRange[1];
+  const double* avg = mapper->GetAverageIPScalarRange();
+  rp.averageRange[0] = avg[0];
+  rp.averageRange[1] = avg[1];
+
+  rp.shade = prop->GetShade(0) != 0;
+  rp.ambient = prop->GetAmbient(0);
+  rp.diffuse = prop->GetDiffuse(0);
+  rp.specular = prop->GetSpecular(0);
+  rp.specularPower = prop->GetSpecularPower(0);
+  rp.lightDirection[0] = rp.lightDirection[1] = rp.lightDirection[2] = 0; // headlight
+  if (!rp.shade)
+  {
+    return;
+  }
+  vtkLight* only = nullptr;
+  int on = 0;
+  vtkLightCollection* lights = ren->GetLights();
+  vtkCollectionSimpleIterator it;
+  lights->InitTraversal(it);
+  while (vtkLight* l = lights->GetNextLight(it))
+  {
+    if (l->GetSwitch())
+    {
+      ++on;
+      only = l;
+    }
+  }
+  if (on == 1 && !only->LightTypeIsHeadlight() && !only->GetPositional())
+  {
+    // A directional light, from world into the volume's physical space (its matrix's inverse).
+    double p[3], f[3];
+    only->GetTransformedPosition(p);
+    only->GetTransformedFocalPoint(f);
+    vtkNew<vtkMatrix4x4> inv;
+    vtkMatrix4x4::Invert(vol->GetMatrix(), inv);
+    const double w[4] = { p[0] - f[0], p[1] - f[1], p[2] - f[2], 0.0 };
+    double o[4];
+    inv->MultiplyPoint(w, o);
+    std::copy(o, o + 3, rp.lightDirection);
+  }
+  else if (on != 1 && !warnedLight)
+  {
+    vtkWarningWithObjectMacro(mapper,
+      << "shading with " << on << " lights: only a headlight or a single directional light is "
+      << "supported; shading with a headlight");
+    warnedLight = true;
+  }
+  else if (on == 1 && only->GetPositional() && !warnedLight)
+  {
+    vtkWarningWithObjectMacro(
+      mapper, << "positional lights are not supported; shading with a headlight");
+    warnedLight = true;
+  }
+}
 
 // Core voxel types by VTK type; int/unsigned int/long become float (see ConvertScalars).
 bool CoreTypeOf(int vtkType, spaceskip::VoxelType& out)
@@ -175,6 +264,12 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
 
   // One message per distinct problem, not one per frame.
   std::string LastProblem;
+  // Warnings (engine fallbacks, clamps) already said by this mapper: each cause once, also
+  // across the engines that backend switches create.
+  std::set<std::string> Said;
+  double SampleDistanceUsed = 0;
+  std::string BuilderChoice;
+  int Selection = 0; // the component the volume was made from; -1: the magnitude
 
   std::string BackendUsed = "none";
   std::string BuilderUsed = "none";
@@ -205,9 +300,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
   bool ResolveStencil = false;
   bool WarnedNearest = false;
-  bool WarnedShade = false;
+  bool WarnedLight = false;
   bool WarnedBlend = false;
-  bool WarnedClip = false;
   bool WarnedDepthRead = false;
 
   void ReleaseInterop()
@@ -427,6 +521,25 @@ const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
 {
   return this->Internals->CompositePath.c_str();
 }
+const char* vtkSpaceSkippingVolumeMapper::GetBuilderChoice()
+{
+  return this->Internals->BuilderChoice.c_str();
+}
+double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
+{
+  return this->Internals->SampleDistanceUsed;
+}
+vtkIdType vtkSpaceSkippingVolumeMapper::GetDeviceBytesInUse()
+{
+  return static_cast<vtkIdType>(spaceskip::cudaDeviceBytesInUse());
+}
+void vtkSpaceSkippingVolumeMapper::WarnOnce(const std::string& message)
+{
+  if (this->Internals->Said.insert(message).second)
+  {
+    vtkWarningMacro(<< message);
+  }
+}
 int vtkSpaceSkippingVolumeMapper::GetBuildCount()
 {
   return this->Internals->Counts().builds;
@@ -580,14 +693,17 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       "nothing drawn");
     return;
   }
-  if (scalars->GetNumberOfComponents() != 1)
+  // Several components: the one selected by VectorMode/VectorComponent (ParaView's colour
+  // array component, or Magnitude) is rendered, as vtkSmartVolumeMapper does.
+  const int ncomp = scalars->GetNumberOfComponents();
+  const bool magnitude = ncomp > 1 && this->VectorMode == vtkScalarsToColors::MAGNITUDE;
+  const int component = ncomp > 1 && !magnitude ? std::min(std::max(this->VectorComponent, 0), ncomp - 1) : 0;
+  if (ncomp > 1 && vol->GetProperty() && !vol->GetProperty()->GetIndependentComponents())
   {
-    std::ostringstream s;
-    s << "scalars '" << (scalars->GetName() ? scalars->GetName() : "") << "' have "
-      << scalars->GetNumberOfComponents()
-      << " components; only single-component scalars are supported: nothing drawn";
-    fail(s.str());
-    return;
+    this->WarnOnce("dependent components (direct RGBA, or value + opacity: Multi Components "
+                   "Mapping) are not supported; rendering " +
+      std::string(magnitude ? "the magnitude" : "component " + std::to_string(component)) +
+      " through the transfer functions");
   }
   const vtkIdType npts = input->GetNumberOfPoints();
   if (scalars->GetNumberOfTuples() != npts)
@@ -629,12 +745,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       fail(std::string("cannot create the SpaceSkip engine: ") + e.what());
       return;
     }
-    d.Engine->setLogger([this](const std::string& m) { vtkWarningWithObjectMacro(this, << m); });
+    d.Engine->setLogger([this](const std::string& m) { this->WarnOnce(m); });
     d.EngineBackend = backend;
     if (backend == CUDA && d.Engine->backendKind() != spaceskip::BackendKind::CUDA)
     {
-      vtkWarningMacro(<< "CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
-                         "without CUDA); using the CPU backend");
+      this->WarnOnce("CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
+                     "without CUDA); using the CPU backend");
     }
     d.ResetVolume();
     d.ResetTF();
@@ -644,9 +760,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   try
   {
     // Volume: only when the data changed (the engine then recomputes its value ranges).
+    const int selection = magnitude ? -1 : component;
     if (!d.HaveVolume || d.InputKey != input || d.InputMTime != input->GetMTime() ||
-      d.ScalarsKey != scalars || d.ScalarsMTime != scalars->GetMTime())
+      d.ScalarsKey != scalars || d.ScalarsMTime != scalars->GetMTime() ||
+      d.Selection != selection)
     {
+      d.Selection = selection;
       spaceskip::Volume v;
       int dims[3];
       input->GetDimensions(dims);
@@ -656,7 +775,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       input->TransformIndexToPhysicalPoint(ext[0], ext[2], ext[4], v.origin);
       const double* dir = input->GetDirectionMatrix()->GetData();
       std::copy(dir, dir + 9, v.direction);
-      if (native && scalars->HasStandardMemoryLayout())
+      if (native && ncomp == 1 && scalars->HasStandardMemoryLayout())
       {
         v.type = vtype;
         v.data = scalars->GetVoidPointer(0);
@@ -668,14 +787,31 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       {
         if (!native)
         {
-          vtkWarningMacro(<< "scalar type " << scalars->GetDataTypeAsString()
-                          << " converted to float (values beyond 2^24 lose precision)");
+          this->WarnOnce(std::string("scalar type ") + scalars->GetDataTypeAsString() +
+            " converted to float (values beyond 2^24 lose precision)");
         }
         d.Converted.resize(static_cast<size_t>(npts));
-        for (vtkIdType i = 0; i < npts; ++i)
-        {
-          d.Converted[static_cast<size_t>(i)] = static_cast<float>(scalars->GetComponent(i, 0));
-        }
+        float* out = d.Converted.data();
+        vtkSMPTools::For(0, npts, [&](vtkIdType begin, vtkIdType end) {
+          std::vector<double> tuple(static_cast<size_t>(ncomp));
+          for (vtkIdType i = begin; i < end; ++i)
+          {
+            if (magnitude)
+            {
+              scalars->GetTuple(i, tuple.data());
+              double m = 0;
+              for (double c : tuple)
+              {
+                m += c * c;
+              }
+              out[i] = static_cast<float>(std::sqrt(m));
+            }
+            else
+            {
+              out[i] = static_cast<float>(scalars->GetComponent(i, component));
+            }
+          }
+        });
         v.type = spaceskip::VoxelType::Float32;
         v.data = d.Converted.data();
         d.Borrowed = nullptr;
@@ -759,13 +895,10 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     };
     unsupported(prop->GetInterpolationType() == VTK_NEAREST_INTERPOLATION, d.WarnedNearest,
       "nearest interpolation is not supported; rendering with trilinear interpolation");
-    unsupported(prop->GetShade(0) != 0, d.WarnedShade,
-      "shading is not supported yet; rendering unshaded (emission-absorption)");
-    unsupported(this->BlendMode != vtkVolumeMapper::COMPOSITE_BLEND, d.WarnedBlend,
-      "only the composite blend mode is supported; rendering with composite blending");
-    unsupported(this->Cropping != 0 ||
-        (this->ClippingPlanes && this->ClippingPlanes->GetNumberOfItems() > 0),
-      d.WarnedClip, "cropping and clipping planes are not supported; rendering the whole volume");
+    const int blend = this->EffectiveBlendMode();
+    unsupported(blend == vtkVolumeMapper::SLICE_BLEND || blend < vtkVolumeMapper::COMPOSITE_BLEND ||
+        blend > vtkVolumeMapper::SLICE_BLEND,
+      d.WarnedBlend, "the slice blend mode is not supported; rendering with composite blending");
 
     spaceskip::BuildParams bp;
     bp.builder = static_cast<spaceskip::BuilderKind>(this->Builder);
@@ -778,6 +911,36 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     spaceskip::RenderParams rp = engine.renderParams();
     rp.sampleDistance = this->SampleDistance;
     rp.ertThreshold = this->EarlyRayTermination ? kErtThreshold : 2.0;
+    rp.jitter = this->UseJittering != 0;
+    // Cropping: the planes are in the data's coordinates, as the engine's.
+    rp.cropping = this->Cropping != 0;
+    std::copy(this->CroppingRegionPlanes, this->CroppingRegionPlanes + 6, rp.croppingPlanes);
+    rp.croppingFlags = this->CroppingRegionFlags;
+    // Clipping planes are in world coordinates; the engine works in the data's, so each plane
+    // n.X + d >= 0 becomes (A^T n).x + (n.t + d) >= 0 for X = A x + t, A the volume's matrix.
+    rp.clipPlanes.clear();
+    if (this->ClippingPlanes)
+    {
+      vtkMatrix4x4* A = vol->GetMatrix();
+      this->ClippingPlanes->InitTraversal();
+      while (vtkPlane* plane = this->ClippingPlanes->GetNextItem())
+      {
+        double n[3], p[3];
+        plane->GetNormal(n);
+        plane->GetOrigin(p);
+        std::array<double, 4> c{};
+        for (int k = 0; k < 3; ++k)
+        {
+          c[k] = n[0] * A->GetElement(0, k) + n[1] * A->GetElement(1, k) + n[2] * A->GetElement(2, k);
+        }
+        c[3] = n[0] * (A->GetElement(0, 3) - p[0]) + n[1] * (A->GetElement(1, 3) - p[1]) +
+          n[2] * (A->GetElement(2, 3) - p[2]);
+        rp.clipPlanes.push_back(c);
+      }
+    }
+    // Where vtkGPUVolumeRayCastMapper samples first: one step in, or the jitter alone.
+    rp.firstSampleOffset = this->UseJittering ? 0.0 : 1.0;
+    SetBlendAndShading(this, this->EffectiveBlendMode(), rp, ren, vol, d.ScalarRange, d.WarnedLight);
     engine.setRenderParams(rp);
 
     // Camera: the volume's matrix is folded into the view, so the engine marches in the
@@ -846,6 +1009,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       width, height, engine.frameStats().seconds, engine.frameStats().backend.c_str());
     d.BackendUsed = engine.frameStats().backend;
     d.BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
+    d.SampleDistanceUsed = engine.sampleDistance();
+    d.BuilderChoice = engine.buildStats().choice;
     t0 = std::chrono::steady_clock::now();
     vtkTextureObject* image = nullptr;
     if (const void* deviceImage = engine.deviceImage())
@@ -996,6 +1161,10 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EightBitComposite: " << (this->EightBitComposite ? "On" : "Off") << "\n";
   os << indent << "GPUComposite: " << (this->GPUComposite ? "On" : "Off") << "\n";
   os << indent << "CompositePathUsed: " << this->Internals->CompositePath << "\n";
+  os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
+  os << indent << "VectorMode: " << this->VectorMode << "\n";
+  os << indent << "VectorComponent: " << this->VectorComponent << "\n";
+  os << indent << "BlendModeOverride: " << this->BlendModeOverride << "\n";
   os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
   os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";

@@ -5,7 +5,10 @@
  * A drop-in for vtkSmartVolumeMapper: point scalars of one component (unsigned/signed char,
  * unsigned/signed short, float, double; int/unsigned int/long are converted to float with a
  * warning), the volume property's colour and scalar-opacity functions and its
- * ScalarOpacityUnitDistance. The hierarchy over the occupied macro cells is built by `Builder`
+ * ScalarOpacityUnitDistance, its Shade/Ambient/Diffuse/Specular/SpecularPower (VTK's headlight or
+ * one directional light) and IsoSurfaceValues, and every blend mode of vtkVolumeMapper but slice
+ * (composite, maximum/minimum/average intensity with AverageIPScalarRange, additive,
+ * isosurface), with vtkGPUVolumeRayCastMapper's semantics. The hierarchy over the occupied macro cells is built by `Builder`
  * (the builders of Morrical/Zellmann et al.); a colour-only transfer-function edit only updates
  * the lookup table, an opacity edit re-classifies and rebuilds only when the occupied cells changed.
  * The image is marched by the CUDA backend when a device is usable (Backend Auto), else by the
@@ -23,6 +26,7 @@
 #include "vtkVolumeMapper.h"
 
 #include <memory> // For std::unique_ptr
+#include <string> // For WarnOnce
 
 class vtkOpenGLRenderWindow;
 class vtkRenderer;
@@ -47,7 +51,8 @@ public:
     KdTreeGPU,
     KdTreeGPUFast,
     Hybrid,
-    DistanceGrid
+    DistanceGrid,
+    AutoBuilder ///< measures Naive and a few structures one frame each and keeps the fastest
   };
   enum LeafCriterionTypes
   {
@@ -68,7 +73,7 @@ public:
    * DDA leaping through empty space with a capped Chebyshev distance field over the macro cells
    * (CPU and CUDA); it is fastest on very sparse data with MacroCellSize 4.
    */
-  vtkSetClampMacro(Builder, int, Naive, DistanceGrid);
+  vtkSetClampMacro(Builder, int, Naive, AutoBuilder);
   vtkGetMacro(Builder, int);
   void SetBuilderToNaive() { this->SetBuilder(Naive); }
   void SetBuilderToGrid() { this->SetBuilder(Grid); }
@@ -79,6 +84,7 @@ public:
   void SetBuilderToKdTreeGPUFast() { this->SetBuilder(KdTreeGPUFast); }
   void SetBuilderToHybrid() { this->SetBuilder(Hybrid); }
   void SetBuilderToDistanceGrid() { this->SetBuilder(DistanceGrid); }
+  void SetBuilderToAuto() { this->SetBuilder(AutoBuilder); }
   const char* GetBuilderAsString();
   ///@}
 
@@ -166,6 +172,19 @@ public:
 
   ///@{
   /**
+   * Jittering (vtkGPUVolumeRayCastMapper's UseJittering): each pixel's samples start at a
+   * random fraction of the sample distance, trading wood-grain artefacts at large sample
+   * distances for noise. Skipping stays lossless (the jittered lattice is the same for every
+   * builder). Off by default. Cropping (vtkVolumeMapper's regions) and clipping planes
+   * (vtkAbstractMapper) are honoured as well; they cut samples exactly.
+   */
+  vtkSetMacro(UseJittering, vtkTypeBool);
+  vtkGetMacro(UseJittering, vtkTypeBool);
+  vtkBooleanMacro(UseJittering, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Keep the image on the GPU (default on): with the CUDA backend and the window's OpenGL on the
    * same NVIDIA device, the frame is copied from CUDA memory into a GL texture (CUDA-GL interop)
    * instead of going down to host memory and up again. When interop is not possible (another GL
@@ -176,6 +195,29 @@ public:
   vtkGetMacro(GPUComposite, vtkTypeBool);
   vtkBooleanMacro(GPUComposite, vtkTypeBool);
   const char* GetCompositePathUsed();
+  ///@}
+
+  ///@{
+  /**
+   * Multi-component scalars (vtkSmartVolumeMapper's API, set by ParaView's representation from
+   * the colour map's Magnitude/Component choice): vtkScalarsToColors::MAGNITUDE renders the
+   * Euclidean norm of each tuple, COMPONENT (default) the component VectorComponent. Dependent
+   * components (direct RGBA, value + opacity) are not supported: one warning, then the same.
+   */
+  vtkSetMacro(VectorMode, int);
+  vtkGetMacro(VectorMode, int);
+  vtkSetMacro(VectorComponent, int);
+  vtkGetMacro(VectorComponent, int);
+  ///@}
+
+  ///@{
+  /**
+   * When >= 0, the blend mode used instead of vtkVolumeMapper::BlendMode (same values). -1
+   * (default): BlendMode. For front ends whose BlendMode menu lacks modes this mapper has
+   * (ParaView 5.11 offers composite, isosurface and slice only).
+   */
+  vtkSetClampMacro(BlendModeOverride, int, -1, vtkVolumeMapper::ISOSURFACE_BLEND);
+  vtkGetMacro(BlendModeOverride, int);
   ///@}
 
   ///@{
@@ -220,6 +262,13 @@ public:
   const char* GetBackendUsed();
   /// The builder that actually ran (after fallbacks), as a name; "none" before the first build.
   const char* GetBuilderUsed();
+  /// The sample distance of the last frame in world units, after the engine's bounds (at least
+  /// 1/16 of the smallest spacing, at most 2^20 samples per ray); 0 before the first frame.
+  double GetSampleDistanceUsed();
+  /// Builder Auto: what it chose and why, one line (empty for the other builders).
+  const char* GetBuilderChoice();
+  /// Bytes of device memory SpaceSkip holds now (all mappers of the process; 0 without CUDA).
+  vtkIdType GetDeviceBytesInUse();
   ///@}
 
   ///@{
@@ -240,7 +289,7 @@ protected:
   vtkSpaceSkippingVolumeMapper();
   ~vtkSpaceSkippingVolumeMapper() override;
 
-  int Builder = Grid;
+  int Builder = AutoBuilder;
   int LeafCriterion = Deep;
   int MaxLeafSize = 0;
   int BinCount = 4;
@@ -250,13 +299,25 @@ protected:
   vtkTypeBool EarlyRayTermination = 1;
   vtkTypeBool EightBitComposite = 1;
   vtkTypeBool GPUComposite = 1;
+  vtkTypeBool UseJittering = 0;
+  int VectorMode = 1; // vtkScalarsToColors::COMPONENT
+  int VectorComponent = 0;
+  int BlendModeOverride = -1;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;
   void operator=(const vtkSpaceSkippingVolumeMapper&) = delete;
 
+  // Says a warning once per distinct message for the life of the mapper.
+  void WarnOnce(const std::string& message);
+
   // Reads the window depth of the viewport into the internal buffer (resolving MSAA if needed).
   bool ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);
+  /// BlendModeOverride when set, else BlendMode.
+  int EffectiveBlendMode() const
+  {
+    return this->BlendModeOverride >= 0 ? this->BlendModeOverride : this->BlendMode;
+  }
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

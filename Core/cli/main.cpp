@@ -1,7 +1,9 @@
 // spaceskip: command-line renderer, generator and benchmark over Core (no VTK).
+#include "Options.h"
 #include "spaceskip/Engine.h"
 #include "spaceskip/Generators.h"
 #include "spaceskip/ImageIO.h"
+#include "spaceskip/TransferFunctionIO.h"
 #include "spaceskip/VolumeIO.h"
 
 #include <tbb/global_control.h>
@@ -13,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -23,6 +26,7 @@
 #include <vector>
 
 using namespace spaceskip;
+using namespace spaceskip::cli;
 
 namespace {
 
@@ -53,8 +57,9 @@ const char* kUsage = R"(usage:
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
-  --builder B        naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu kdtree-gpu-fast hybrid
-                     distance-grid
+  --builder B        auto (default: one frame with each of naive, grid, distance-grid and a
+                     k-d tree, then the fastest) naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu
+                     kdtree-gpu-fast hybrid distance-grid
   --leaf shallow|deep  --mls N  --bins N  --brick N
       --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;
       0 sweeps every brick boundary, the kdtree-cpu tree (kdtree-cpu always sweeps)
@@ -64,153 +69,38 @@ options:
   --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective
   --sample-distance D  (world units; default half the smallest spacing)
   --ert T  --jitter  --filter exact|hardware
+  --blend composite|mip|minip|average|additive|iso   --iso V1,V2,...  (iso values)
+  --shade on|AMBIENT,DIFFUSE,SPECULAR,POWER  gradient shading with a headlight (on: 0,0.7,0.2,10)
   --compare REF.png  print max difference and PSNR against a reference image
   --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
+  --max-volume-bytes N[K|M|G|T]  largest volume read or generated (default: the environment's
+                     SPACESKIP_MAX_VOLUME_BYTES, else min(64 GiB, physical memory))
 )";
 
-struct Options {
-  std::vector<std::string> positional;
-  std::map<std::string, std::string> kv;
-  bool has(const std::string& k) const { return kv.count(k) != 0; }
-  std::string get(const std::string& k, const std::string& def) const {
-    auto it = kv.find(k);
-    return it == kv.end() ? def : it->second;
-  }
-};
-
-Options parseArgs(int argc, char** argv, int first) {
-  static const char* flags[] = {"--perspective", "--jitter"};
-  Options o;
-  for (int i = first; i < argc; ++i) {
-    std::string a = argv[i];
-    if (a.rfind("--", 0) == 0 || a == "-o") {
-      bool isFlag = false;
-      for (const char* f : flags) isFlag |= a == f;
-      if (isFlag) { o.kv[a] = "1"; continue; }
-      if (a == "--dims") {
-        if (i + 3 >= argc) throw std::invalid_argument("--dims needs X Y Z");
-        o.kv[a] = std::string(argv[i + 1]) + "x" + argv[i + 2] + "x" + argv[i + 3];
-        i += 3;
-        continue;
-      }
-      if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-      o.kv[a] = argv[++i];
-    } else {
-      o.positional.push_back(a);
-    }
-  }
-  return o;
-}
-
-vec3l parseDims(const std::string& s) {
-  long long x, y, z;
-  char c1, c2;
-  std::istringstream is(s);
-  if (is >> x >> c1 >> y >> c2 >> z && c1 == 'x' && c2 == 'x') return vec3l{x, y, z};
-  std::istringstream is2(s);
-  if (is2 >> x && is2.eof()) return vec3l{x, x, x};
-  throw std::invalid_argument("bad dims '" + s + "' (N or XxYxZ)");
-}
-
-Volume openVolume(const std::string& spec) {
-  if (spec.rfind("gen:", 0) == 0) {
-    std::string rest = spec.substr(4);
-    size_t c = rest.find(':');
-    if (c == std::string::npos) throw std::invalid_argument("expected gen:SHAPE:N, got " + spec);
-    return generateVolume(rest.substr(0, c), parseDims(rest.substr(c + 1)));
-  }
-  return loadVolume(spec);
+Volume openVolume(const std::string& spec, const Options& o) {
+  const uint64_t cap = maxVolumeBytes(o);
+  std::string shape;
+  vec3l dims;
+  if (parseGeneratorSpec(spec, cap, shape, dims)) return generateVolume(shape, dims);
+  ReadLimits limits;
+  limits.maxBytes = cap;
+  return loadVolume(spec, limits);
 }
 
 TransferFunction makeTF(const Options& o, const Volume& v) {
   double lo, hi;
   if (!v.scalarRange(lo, hi)) lo = 0, hi = 1;
   std::string t = o.get("--tf", "ramp");
-  std::ifstream probe(t);
-  if (probe.good()) return TransferFunction::load(t, lo, hi);
+  // A preset name unless a file of that name exists (loadTransferFunction refuses devices).
+  std::error_code ec;
+  if (std::filesystem::exists(t, ec)) return loadTransferFunction(t, lo, hi);
   return TransferFunction::preset(t, lo, hi);
-}
-
-std::vector<std::string> split(const std::string& s, char c) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, c))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-int suffixNumber(const std::string& item, const std::string& key, const std::string& spec) {
-  const std::string num = item.substr(key.size());
-  if (num.empty() || num.find_first_not_of("0123456789") != std::string::npos)
-    throw std::invalid_argument("bad builder suffix '" + item + "' in '" + spec + "'");
-  return std::stoi(num);
-}
-
-/// `builder` is NAME[:SUFFIX]... (bench variants); suffixes override --leaf/--mls/--bins/--brick:
-/// shallow, deep, mlsN, binsN, brickN.
-BuildParams buildParams(const Options& o, const std::string& spec) {
-  BuildParams p;
-  std::vector<std::string> parts = split(spec, ':');
-  const std::string builder = parts.empty() ? spec : parts[0];
-  if (!parseBuilder(builder, p.builder)) throw std::invalid_argument("unknown builder '" + builder + "'");
-  std::string leaf = o.get("--leaf", "deep");
-  if (leaf == "shallow") p.leaf = LeafCriterion::Shallow;
-  else if (leaf == "deep") p.leaf = LeafCriterion::Deep;
-  else throw std::invalid_argument("--leaf must be shallow or deep");
-  p.maxLeafSize = std::stoi(o.get("--mls", "0"));
-  p.bins = std::stoi(o.get("--bins", "4"));
-  p.brick = std::stoi(o.get("--brick", "8"));
-  for (size_t i = 1; i < parts.size(); ++i) {
-    const std::string& it = parts[i];
-    if (it == "shallow") p.leaf = LeafCriterion::Shallow;
-    else if (it == "deep") p.leaf = LeafCriterion::Deep;
-    else if (it.rfind("mls", 0) == 0) p.maxLeafSize = suffixNumber(it, "mls", spec);
-    else if (it.rfind("bins", 0) == 0) p.bins = suffixNumber(it, "bins", spec);
-    else if (it.rfind("brick", 0) == 0) p.brick = suffixNumber(it, "brick", spec);
-    else throw std::invalid_argument("unknown builder suffix '" + it + "' in '" + spec + "' (shallow deep mlsN binsN brickN)");
-  }
-  if (p.bins < 0 || p.bins == 1)
-    throw std::invalid_argument("bad bins " + std::to_string(p.bins) + " in '" + spec +
-                                "': 0 (sweep every brick boundary) or >= 2");
-  if (p.maxLeafSize < 0 || p.brick < 1) throw std::invalid_argument("bad --mls/--brick");
-  return p;
-}
-
-RenderParams renderParams(const Options& o) {
-  RenderParams r;
-  r.sampleDistance = std::stod(o.get("--sample-distance", "0"));
-  r.ertThreshold = std::stod(o.get("--ert", "2"));
-  r.jitter = o.has("--jitter");
-  std::string f = o.get("--filter", "exact");
-  if (f == "exact") r.filter = FilterMode::Exact;
-  else if (f == "hardware") r.filter = FilterMode::Hardware;
-  else throw std::invalid_argument("--filter must be exact or hardware");
-  return r;
-}
-
-BackendKind backendKind(const Options& o) {
-  std::string b = o.get("--backend", "auto");
-  if (b == "auto") return BackendKind::Auto;
-  if (b == "cpu") return BackendKind::CPU;
-  if (b == "cuda") return BackendKind::CUDA;
-  throw std::invalid_argument("--backend must be auto, cpu or cuda");
-}
-
-void parseSize(const std::string& s, int& w, int& h) {
-  char x;
-  std::istringstream is(s);
-  if (!(is >> w >> x >> h) || x != 'x' || w <= 0 || h <= 0) throw std::invalid_argument("bad --size '" + s + "'");
 }
 
 Camera makeCamera(const Options& o, const Volume& v, int w, int h, double azDefault = 30, double elDefault = 20) {
   double az = azDefault, el = elDefault, zoom = 1;
   if (o.has("--camera")) {
-    std::string c = o.get("--camera", "");
-    for (char& ch : c) if (ch == ',') ch = ' ';
-    std::istringstream is(c);
-    if (!(is >> az >> el)) throw std::invalid_argument("--camera needs AZ,EL[,ZOOM]");
-    is >> zoom;
+    parseCamera(o.get("--camera", ""), az, el, zoom);
   }
   double b[6];
   v.worldBounds(b);
@@ -220,9 +110,11 @@ Camera makeCamera(const Options& o, const Volume& v, int w, int h, double azDefa
 int cmdGenerate(const Options& o) {
   if (o.positional.size() != 1 || !o.has("--dims") || !o.has("-o"))
     throw std::invalid_argument("generate needs SHAPE --dims X Y Z -o FILE");
-  vec3l d = parseDims(o.get("--dims", ""));
+  vec3l d = parseDims(o.get("--dims", ""), "--dims");
+  checkGeneratorSize(o.positional[0], d, maxVolumeBytes(o));
+  const unsigned seed = unsigned(o.getInt("--seed", 1, 0, 4294967295LL));
   auto t0 = Clock::now();
-  Volume v = generateVolume(o.positional[0], d, unsigned(std::stoul(o.get("--seed", "1"))));
+  Volume v = generateVolume(o.positional[0], d, seed);
   double gen = since(t0);
   std::string out = o.get("-o", "");
   if (out.size() > 5 && out.substr(out.size() - 5) == ".nrrd") saveNrrd(v, out);
@@ -242,14 +134,14 @@ int cmdGenerate(const Options& o) {
 int cmdRender(const Options& o) {
   if (o.positional.size() != 1 || !o.has("-o")) throw std::invalid_argument("render needs VOLUME -o out.png");
   auto t0 = Clock::now();
-  Volume v = openVolume(o.positional[0]);
+  Volume v = openVolume(o.positional[0], o);
   double load = since(t0);
   int w = 512, h = 512;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   Engine engine(backendKind(o));
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
-  engine.setBuildParams(buildParams(o, o.get("--builder", "grid")));
+  engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
   engine.setRenderParams(renderParams(o));
   auto t1 = Clock::now();
   engine.update();
@@ -257,8 +149,10 @@ int cmdRender(const Options& o) {
   Image img;
   Camera cam = makeCamera(o, v, w, h);
   engine.render(cam, w, h, img);  // first frame (warm-up)
+  for (int i = 0; i < 16 && engine.exploring(); ++i) engine.render(cam, w, h, img);  // Auto measures
   engine.render(cam, w, h, img);
   const BuildStats& s = engine.buildStats();
+  if (!s.choice.empty()) std::printf("%s\n", s.choice.c_str());
   std::printf("volume %s: %lldx%lldx%lld %s, load %.3f s\n", o.positional[0].c_str(), (long long)v.dims.x,
               (long long)v.dims.y, (long long)v.dims.z, voxelTypeName(v.type), load);
   std::printf("backend %s, builder %s: ranges+classify+build %.3f s (classify %.4f s, build %.4f s), "
@@ -273,7 +167,7 @@ int cmdRender(const Options& o) {
     ImageDiff d = compareImages(img, loadPng(o.get("--compare", "")));
     std::printf("compare: max diff %.5f (%.2f/255), PSNR %.2f dB, %lld pixels > 1/255\n", d.maxAbs, d.maxAbs * 255,
                 d.psnr, (long long)d.differing);
-    if (o.has("--max-diff") && d.maxAbs * 255.0 > std::stod(o.get("--max-diff", "1"))) {
+    if (o.has("--max-diff") && d.maxAbs * 255.0 > o.getDouble("--max-diff", 1, 0, 255)) {
       std::fprintf(stderr, "spaceskip: max difference %.2f/255 exceeds --max-diff %s\n", d.maxAbs * 255.0,
                    o.get("--max-diff", "").c_str());
       return 3;
@@ -282,35 +176,11 @@ int cmdRender(const Options& o) {
   return 0;
 }
 
-/// Bench-only suffixes of a --builders item, stripped before buildParams sees it:
-/// `hw`/`exact` pick the filter for this item, `cold` times the first build only (no rebuilds:
-/// for very slow builders such as the paper's KdTreeGPU at 2048^3).
-struct BenchItem {
-  std::string spec;  ///< the item without bench-only suffixes
-  int filter = -1;   ///< -1: --filter, else a FilterMode
-  bool cold = false;
-  std::string resident;  ///< `resN`: SPACESKIP_CUDA_RESIDENT=N for this item (CUDA launch shape)
-};
-
-BenchItem benchItem(const std::string& item) {
-  BenchItem it;
-  for (const std::string& part : split(item, ':')) {
-    if (part == "hw") it.filter = int(FilterMode::Hardware);
-    else if (part == "exact") it.filter = int(FilterMode::Exact);
-    else if (part == "cold") it.cold = true;
-    else if (part.size() > 3 && part.rfind("res", 0) == 0 && part.find_first_not_of("0123456789", 3) == std::string::npos)
-      it.resident = part.substr(3);
-    else it.spec += (it.spec.empty() ? "" : ":") + part;
-  }
-  return it;
-}
-
 int cmdBench(const Options& o) {
   if (o.positional.empty()) throw std::invalid_argument("bench needs at least one VOLUME");
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
-  int frames = std::stoi(o.get("--frames", "8"));
-  const int buildReps = std::stoi(o.get("--build-reps", "1"));
-  if (frames < 1 || buildReps < 1) throw std::invalid_argument("--frames and --build-reps must be >= 1");
+  const int frames = int(o.getInt("--frames", 8, 1, 1000000));
+  const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
   int w = 1024, h = 1024;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   std::ostringstream json;
@@ -326,7 +196,7 @@ int cmdBench(const Options& o) {
               "classify_ms", "fps", "kern_fps", "cpu_ms/f", "nodes", "height", "leaves", "vs_naive", "Gsmp/s");
   for (const std::string& spec : o.positional) {
     auto tg = Clock::now();
-    Volume v = openVolume(spec);
+    Volume v = openVolume(spec, o);
     std::fprintf(stderr, "  note: %s ready in %.2f s\n", spec.c_str(), since(tg));
     TransferFunction tf = makeTF(o, v);
     double naiveFps = 0;
@@ -364,6 +234,14 @@ int cmdBench(const Options& o) {
       v.worldBounds(b6);
       Image img;
       engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
+      // Auto: its measuring frames (one per candidate) are not timed; then what it chose is.
+      for (int i = 0; i < 16 && engine.exploring(); ++i)
+        engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);
+      if (bp.builder == BuilderKind::Auto) {
+        engine.update();  // builds the kept structure when it was not the last one measured
+        s = engine.buildStats();
+        std::printf("%s\n", s.choice.c_str());
+      }
       double total = 0, totalDevice = 0, cpuTotal = 0;
       for (int f = 0; f < frames; ++f) {
         const double c0 = processCpuSeconds();
@@ -436,7 +314,7 @@ int cmdBench(const Options& o) {
 // (hardware filtering exists on the CUDA backend only) and early ray termination.
 int cmdAccuracy(const Options& o) {
   if (o.positional.size() != 1) throw std::invalid_argument("accuracy needs one VOLUME");
-  Volume v = openVolume(o.positional[0]);
+  Volume v = openVolume(o.positional[0], o);
   int w = 512, h = 512;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   const double minSpacing = std::min({v.spacing[0], v.spacing[1], v.spacing[2]});
@@ -444,7 +322,7 @@ int cmdAccuracy(const Options& o) {
   engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
-  engine.setBuildParams(buildParams(o, o.get("--builder", "grid")));
+  engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
   Camera cam = makeCamera(o, v, w, h);
   RenderParams ref;
   ref.sampleDistance = minSpacing / 8;
@@ -497,10 +375,12 @@ int main(int argc, char** argv) {
   try {
     std::string cmd = argv[1];
     Options o = parseArgs(argc, argv, 2);
+    // Checked before any work: a bad value is reported even when no volume is loaded.
+    (void)maxVolumeBytes(o);
     std::unique_ptr<tbb::global_control> threads;
     if (o.has("--threads"))
       threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                      size_t(std::stoi(o.get("--threads", "1"))));
+                                                      size_t(o.getInt("--threads", 1, 1, 65536)));
     if (cmd == "generate") return cmdGenerate(o);
     if (cmd == "render") return cmdRender(o);
     if (cmd == "bench") return cmdBench(o);

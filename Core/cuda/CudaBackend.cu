@@ -367,6 +367,11 @@ class CudaBackend final : public Backend {
     else
       f.grid = GridView{d_occ_[cur_].get(), bdims_, brick_, d_distField_};
     f.tree = TreeView{tree_.nodes.get(), tree_.numNodes};
+    // In these modes every skipping builder marches the value ranges (Integrator.h, usesValueRanges).
+    if (usesValueRanges(f.blend) && traversal_ != TraversalKind::Naive) {
+      f.traversal = TraversalKind::Grid;
+      f.grid = GridView{nullptr, bdims_, brick_, nullptr, d_vmin_.get(), d_vmax_.get()};
+    }
     f.tf = TransferFunctionView{d_table_.get(), tableSize_, tfLo_, tfScale_};
     f.depth = nullptr;
     if (depth) {
@@ -398,6 +403,7 @@ class CudaBackend final : public Backend {
       }
     }
     SS_CUDA_CHECK_LAUNCH(renderKernel);
+    SS_CUDA_CHECK(cuda::injectedRenderError());
     SS_CUDA_CHECK(cudaEventRecord(ev1_, stream_));
     out.width = f.width;
     out.height = f.height;

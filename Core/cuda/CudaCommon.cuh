@@ -54,6 +54,14 @@ inline int64_t deviceMemoryLimit() {
   return v > uint64_t(INT64_MAX) ? INT64_MAX : int64_t(v);
 }
 
+/// Testing aid: SPACESKIP_CUDA_FAIL_RENDER=1 makes every render launch report
+/// cudaErrorLaunchFailure, a CUDA error in the middle of a frame, so that the fallback to the CPU
+/// backend's image can be tested on any GPU. Read at every render launch; anything else: off.
+inline cudaError_t injectedRenderError() {
+  const char* s = std::getenv("SPACESKIP_CUDA_FAIL_RENDER");
+  return s && s[0] == '1' && s[1] == '\0' ? cudaErrorLaunchFailure : cudaSuccess;
+}
+
 inline bool overDeviceMemoryLimit(size_t bytes) {
   const int64_t limit = deviceMemoryLimit();
   return limit >= 0 && (bytes > uint64_t(limit) || liveDeviceBytes().load() + int64_t(bytes) > limit);

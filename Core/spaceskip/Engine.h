@@ -9,6 +9,8 @@
 #include "TransferFunction.h"
 #include "Volume.h"
 
+#include <array>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 #include <memory>
@@ -26,7 +28,8 @@ enum class BuilderKind : int {
   KdTreeGPU,      ///< paper 3.2.2, CUDA, host-driven recursion
   KdTreeGPUFast,  ///< ours: level-parallel CUDA k-d tree
   Hybrid,         ///< paper 3.3: shallow k-d tree + 16^3 grid
-  DistanceGrid    ///< ours: the Grid DDA leaping through empty space with a distance field
+  DistanceGrid,   ///< ours: the Grid DDA leaping through empty space with a distance field
+  Auto            ///< measures a few structures (Naive among them) one frame each, keeps the fastest
 };
 enum class LeafCriterion : int { Shallow, Deep };
 enum class BackendKind : int { Auto, CPU, CUDA };
@@ -62,7 +65,52 @@ struct RenderParams {
   unsigned jitterSeed = 0;
   FilterMode filter = FilterMode::Exact;
   bool countSamples = false;   ///< statistics: FrameStats::samples (costs a per-pixel buffer)
+  /// vtkVolumeMapper cropping: six planes (xmin, xmax, ymin, ymax, zmin, zmax) in the volume's
+  /// coordinates (origin + index * spacing) cut the box into 27 regions; region
+  /// i + 3j + 9k is drawn when bit i + 3j + 9k of `croppingFlags` is set (0x2000: the
+  /// sub-volume between the planes, VTK_CROP_SUBVOLUME).
+  bool cropping = false;
+  double croppingPlanes[6] = {0, 0, 0, 0, 0, 0};
+  int croppingFlags = 0x2000;
+  /// Clipping planes in the volume's world frame: a point x is kept where
+  /// n.x + d >= 0 for every plane (nx, ny, nz, d), as vtkPlane's normal points to the kept side.
+  std::vector<std::array<double, 4>> clipPlanes;
+  /// The first sample lies this many sample distances past the ray's entry into the box (>= 0).
+  /// vtkGPUVolumeRayCastMapper starts one step in (1) and takes that first sample even where the
+  /// ray leaves the box before it (clamped to the box); > 0 does the same. 0: at the entry.
+  double firstSampleOffset = 0;
+
+  // Blend modes (vtkVolumeMapper::SetBlendMode semantics, as vtkGPUVolumeRayCastMapper does them).
+  BlendMode blend = BlendMode::Composite;
+  std::vector<double> isoValues;  ///< Isosurface: up to kMaxIsoValues (16); any order
+  /// Additive and average: scalars are normalised to [0, 1] over this range (VTK uses the scalar
+  /// array's range); lo >= hi: the transfer function's range.
+  double scalarRange[2] = {0, 0};
+  /// Average: only samples with value in this range count (vtkVolumeMapper's AverageIPScalarRange).
+  double averageRange[2] = {-HUGE_VAL, HUGE_VAL};
+
+  // Gradient shading (vtkVolumeProperty's Shade, Ambient, Diffuse, Specular, SpecularPower;
+  // VTK's defaults), composite and isosurface modes only, as in VTK.
+  bool shade = false;
+  double ambient = 0.0, diffuse = 0.7, specular = 0.2, specularPower = 10.0;
+  /// World direction from the volume towards a directional white light; (0,0,0): a headlight
+  /// (VTK's default light: at the camera, so every ray is lit along itself).
+  double lightDirection[3] = {0, 0, 0};
 };
+/// At most this many clipping planes (VTK's mappers take six).
+constexpr int kMaxClipPlanes = 6;
+
+/// Bounds on the work per ray (so a typo in Sample Distance cannot freeze ParaView's GUI).
+/// The step is at least the smallest voxel spacing / kMinStepsPerVoxel, and a ray through the
+/// whole volume box takes at most kMaxSamplesPerRay samples (which also keeps every sample
+/// index exact in float).
+constexpr double kMinStepsPerVoxel = 16;
+constexpr double kMaxSamplesPerRay = double(1 << 20);
+
+/// The sample distance the engine renders with for `requested` world units (<= 0: half the
+/// smallest spacing), after the bounds above. When a bound applied, `note` (if given) says
+/// what was clamped and why; otherwise it is left empty.
+double effectiveSampleDistance(const Volume& v, double requested, std::string* note = nullptr);
 
 struct BuildStats {
   BuilderKind builder = BuilderKind::Naive;
@@ -73,6 +121,9 @@ struct BuildStats {
   int height = 0;
   int64_t leaves = 0;
   double occupancy = 0;      ///< fraction of occupied macro cells
+  /// Builder Auto: what it chose and why, one line ("" for the other builders, "exploring ..."
+  /// while it measures).
+  std::string choice;
 };
 
 struct FrameStats {
@@ -142,12 +193,19 @@ class Engine {
   const void* deviceImage() const;
 
   const BuildStats& buildStats() const;
+  /// Builder Auto: true while it still measures its candidates (one frame each).
+  bool exploring() const;
   const FrameStats& frameStats() const;
   const Counters& counters() const;
   /// Host copies for tests and statistics (downloaded from the device if needed).
   const OccupancyGrid& occupancy();
   Tree tree();
+  /// The sample distance rendered with, after effectiveSampleDistance's bounds.
   double sampleDistance() const;
+  /// Floating-point volumes whose magnitudes lie outside [2^-60, 2^60] are sampled through an
+  /// exact power-of-two rescale (a float copy); values are multiplied by 2^valueExponent()
+  /// (0 when not rescaled).
+  int valueExponent() const;
 
  private:
   struct Impl;

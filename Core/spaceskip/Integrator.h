@@ -9,6 +9,18 @@ namespace spaceskip {
 
 enum class TraversalKind : int { Naive = 0, Grid = 1, Tree = 2, Hybrid = 3 };
 
+/// Most iso values the isosurface blend mode takes (they travel in the FrameView).
+constexpr int kMaxIsoValues = 16;
+
+/// Blend modes whose result a brick can change although the TF gives it no opacity (MIP, MinIP:
+/// the extreme sample is mapped after the march; average: transparent samples count), or whose
+/// skipping test depends on the ray (isosurface). They march the range grid with the ray-dependent
+/// test IntervalMarcher::active instead of the opacity occupancy.
+SS_FUNC bool usesValueRanges(BlendMode m) {
+  return m == BlendMode::MaximumIntensity || m == BlendMode::MinimumIntensity ||
+         m == BlendMode::AverageIntensity || m == BlendMode::Isosurface;
+}
+
 /// Everything a pixel needs, plain data (device pointers on the GPU).
 struct FrameView {
   float invViewProj[16];   ///< NDC -> world, column-major
@@ -18,6 +30,7 @@ struct FrameView {
   float dt;                ///< sample distance in world units
   float ertThreshold;      ///< early ray termination when alpha >= this; > 1 disables
   int jitter;              ///< 1: per-pixel random start offset in [0, dt)
+  float firstSample;       ///< first sample at the box entry + firstSample * dt (see RenderParams)
   uint32_t jitterSeed;
   const float* depth;      ///< optional window depth in [0,1] per pixel (opaque geometry)
   TraversalKind traversal;
@@ -25,7 +38,86 @@ struct FrameView {
   TreeView tree;           ///< Tree and Hybrid
   TransferFunctionView tf;
   unsigned* sampleCount;   ///< optional per-pixel count of samples taken (statistics)
+  int numClipPlanes;       ///< index-space half-spaces n.p + d >= 0 kept (convex: one interval)
+  float clip[6][4];
+  int cropping;            ///< 1: only regions of cropFlags between the planes are drawn
+  int cropFlags;           ///< bit i + 3j + 9k: region (i, j, k) of the 3x3x3 split is drawn
+  float crop[6];           ///< index-space planes x0, x1, y0, y1, z0, z1
+  // Blend mode and shading (vtkVolumeMapper / vtkVolumeProperty semantics).
+  BlendMode blend;
+  float normLo, normScale;  ///< additive/average: normalised scalar = (v - normLo) * normScale
+  float avgLo, avgHi;       ///< average: only samples with value in [avgLo, avgHi] count
+  int numIso;               ///< isosurface: iso values, ascending
+  float iso[kMaxIsoValues];
+  int shade;                ///< 1: gradient shading (composite and isosurface, as VTK)
+  float ambient, diffuse, specular, specularPower;
+  vec3f lightDir;           ///< world direction towards the light; (0,0,0): headlight
+  vec3f eyeW;               ///< camera position in world space (the headlight; parallel views too)
 };
+
+/// Clips [tmin, tmax] to the convex intersection of the clipping half-spaces; false if empty.
+SS_FUNC bool clipToPlanes(const FrameView& f, const Ray& r, float& tmin, float& tmax) {
+  for (int i = 0; i < f.numClipPlanes; ++i) {
+    const float* c = f.clip[i];
+    const float num = c[0] * r.org.x + c[1] * r.org.y + c[2] * r.org.z + c[3];
+    const float den = c[0] * r.dir.x + c[1] * r.dir.y + c[2] * r.dir.z;
+    if (den == 0.f) {
+      if (num < 0.f) return false;  // parallel to the plane, on the removed side
+      continue;
+    }
+    const float t = -num / den;
+    if (den > 0.f) tmin = ss_max(tmin, t);  // entering the kept side
+    else tmax = ss_min(tmax, t);
+  }
+  return tmin < tmax;
+}
+
+/// Region index (0..2) of coordinate x between the planes lo and hi of one axis.
+SS_FUNC int cropSlab(float x, float lo, float hi) { return x < lo ? 0 : (x < hi ? 1 : 2); }
+
+/// Calls march(a, b) for each part of [tmin, tmax] that lies in a drawn cropping region, front
+/// to back: the six planes split the ray into at most seven pieces, each inside one region.
+template <class March>
+SS_FUNC void forEachCroppedInterval(const FrameView& f, const Ray& r, float tmin, float tmax, March&& march) {
+  float ts[8];
+  int n = 0;
+  ts[n++] = tmin;
+  for (int a = 0; a < 6; ++a) {
+    const float o = a < 2 ? r.org.x : (a < 4 ? r.org.y : r.org.z);
+    const float d = a < 2 ? r.dir.x : (a < 4 ? r.dir.y : r.dir.z);
+    if (d == 0.f) continue;
+    const float t = (f.crop[a] - o) / d;
+    if (t > tmin && t < tmax) ts[n++] = t;
+  }
+  ts[n++] = tmax;
+  for (int i = 1; i < n; ++i)  // insertion sort: at most 8 values
+    for (int j = i; j > 0 && ts[j] < ts[j - 1]; --j) {
+      const float x = ts[j];
+      ts[j] = ts[j - 1];
+      ts[j - 1] = x;
+    }
+  for (int i = 0; i + 1 < n; ++i) {
+    const float a = ts[i], b = ts[i + 1];
+    if (!(a < b)) continue;
+    const float tm = 0.5f * (a + b);
+    const vec3f p = r.org + r.dir * tm;
+    const int region = cropSlab(p.x, f.crop[0], f.crop[1]) + 3 * cropSlab(p.y, f.crop[2], f.crop[3]) +
+                       9 * cropSlab(p.z, f.crop[4], f.crop[5]);
+    if ((f.cropFlags >> region) & 1)
+      if (!march(a, b)) return;
+  }
+}
+
+/// A voxel as the integrator samples it. +-Inf becomes +-2^100: above every finite value (the
+/// engine rescales floating volumes into [2^-60, 2^60]), so it takes the end entry of the table,
+/// and trilinear weights never form Inf - Inf = NaN next to it. NaN stays NaN.
+SS_FUNC float voxelValue(float v) {
+  const float big = 1.2676506e30f;  // 2^100
+  return v > big ? big : (v < -big ? -big : v);
+}
+SS_FUNC float voxelValue(double v) { return voxelValue(float(v)); }
+template <class T>
+SS_FUNC float voxelValue(T v) { return float(v); }
 
 /// Exact trilinear sampling in float from a linear voxel array (clamped at the border).
 template <class T>
@@ -34,7 +126,7 @@ struct ArraySampler {
   int64_t nx, ny, nz;
 
   SS_FUNC float fetch(int64_t i, int64_t j, int64_t k) const {
-    return float(data[i + nx * (j + ny * k)]);
+    return voxelValue(data[i + nx * (j + ny * k)]);
   }
   SS_FUNC static void axis(float p, int64_t n, int64_t& i0, int64_t& i1, float& f) {
     float x = ss_clamp(p, 0.f, float(n - 1));
@@ -78,41 +170,171 @@ SS_FUNC vec3f unproject(const float* m, float x, float y, float z) {
 }
 
 /// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
-/// never before `nextK`, so adjacent intervals never take a sample twice.
+/// never before `nextK`, so adjacent intervals never take a sample twice. Sample indices are
+/// 64-bit: the engine bounds a ray to kMaxSamplesPerRay samples, but an index computed from a
+/// far interval end must never wrap (a tiny step once overflowed int and drew nothing). It also
+/// keeps each blend mode's running state, from which `active` decides which bricks can still
+/// matter.
 template <class Sampler>
 struct IntervalMarcher {
   const FrameView* f;
   const Sampler* s;
   Ray ray;
   float t0;
-  int nextK;
-  vec4f acc;
+  int64_t nextK;
+  vec4f acc;         ///< composite, isosurface: premultiplied colour so far
   unsigned samples;
+  vec3f lightW, viewW;  ///< shading: towards the light and towards the eye, world space
+  float extreme;     ///< MIP/MinIP: running max/min; average/additive: running sum
+  unsigned count;    ///< MIP/MinIP: samples seen; average: samples counted
+  int isoIndex;      ///< isosurface: the iso interval of the last sample, -1 before the first
+
+  /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
+  SS_FUNC bool active(float lo, float hi) const {
+    switch (f->blend) {
+      case BlendMode::MaximumIntensity: return count == 0 || hi > extreme;
+      case BlendMode::MinimumIntensity: return count == 0 || lo < extreme;
+      case BlendMode::AverageIntensity: return lo <= f->avgHi && hi >= f->avgLo;
+      case BlendMode::Isosurface:  // no crossing possible when [lo, hi] is inside the interval
+        return isoIndex < 0 || !(isoBound(isoIndex) <= lo && hi <= isoBound(isoIndex + 1));
+      default: return true;
+    }
+  }
+  /// Iso interval bounds: -inf, iso[0], ..., iso[n-1], +inf.
+  SS_FUNC float isoBound(int i) const { return i <= 0 ? -INFINITY : i > f->numIso ? INFINITY : f->iso[i - 1]; }
+
+  /// Phong shading as vtkGPUVolumeRayCastMapper does it for its headlight (VTK 9.2): gradient by
+  /// central differences one voxel apart (to world space through the inverse transpose of
+  /// index->world), two-sided diffuse, specular from the reflected light vector, white light,
+  /// specular not tinted, the result clamped to [0, 1].
+  SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p) const {
+    const float gx = s->sample(p + vec3f{1, 0, 0}) - s->sample(p - vec3f{1, 0, 0});
+    const float gy = s->sample(p + vec3f{0, 1, 0}) - s->sample(p - vec3f{0, 1, 0});
+    const float gz = s->sample(p + vec3f{0, 0, 1}) - s->sample(p - vec3f{0, 0, 1});
+    const float* M = f->worldToIndex;
+    vec3f n{M[0] * gx + M[4] * gy + M[8] * gz, M[1] * gx + M[5] * gy + M[9] * gz, M[2] * gx + M[6] * gy + M[10] * gz};
+    const float len = length(n);
+    n = len > 0.f ? n * (1.f / len) : vec3f{0, 0, 0};
+    const float nl = -dot(n, lightW);  // VTK: the gradient points inwards, hence -l
+    const vec3f r = normalize(n * (2.f * nl) + lightW);
+    const float vr = ss_max(-dot(r, viewW), 0.f);
+    const float spec = vr > 0.f ? f->specular * powf(vr, f->specularPower) : 0.f;
+    const float k = f->ambient + f->diffuse * fabsf(nl);
+    return vec3f{ss_clamp(k * rgb.x + spec, 0.f, 1.f), ss_clamp(k * rgb.y + spec, 0.f, 1.f),
+                 ss_clamp(k * rgb.z + spec, 0.f, 1.f)};
+  }
+
+  /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
+  SS_FUNC bool composite(vec4f c, vec3f p) {
+    if (f->shade) {
+      vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p);
+      c.x = rgb.x;
+      c.y = rgb.y;
+      c.z = rgb.z;
+    }
+    float w = (1.f - acc.w) * c.w;
+    acc.x += w * c.x;
+    acc.y += w * c.y;
+    acc.z += w * c.z;
+    acc.w += w;
+    return acc.w < f->ertThreshold;
+  }
+
+  /// Every mode but composite, one sample of value v at p; false: terminate.
+  SS_FUNC bool blendSample(float v, vec3f p) {
+    if (!(v == v)) return true;  // NaN: no contribution, as in classification
+    switch (f->blend) {
+      case BlendMode::MaximumIntensity:
+        if (count == 0 || v > extreme) extreme = v;
+        ++count;
+        return true;
+      case BlendMode::MinimumIntensity:
+        if (count == 0 || v < extreme) extreme = v;
+        ++count;
+        return true;
+      case BlendMode::AverageIntensity:
+        if (v >= f->avgLo && v <= f->avgHi) {
+          extreme += lookup(f->tf, v).w * (v - f->normLo) * f->normScale;
+          ++count;
+        }
+        return true;
+      case BlendMode::Additive:
+        extreme += lookup(f->tf, v).w * (v - f->normLo) * f->normScale;
+        return true;
+      case BlendMode::Isosurface: {
+        // vtkVolumeShaderComposer: the first sample picks its interval; later, leaving the
+        // interval crosses the iso value on that side (one per sample), composited with that
+        // value's colour and opacity and shaded at the sample.
+        if (isoIndex < 0) {
+          int i = 0;
+          while (i < f->numIso && v > f->iso[i]) ++i;
+          isoIndex = i;
+          return true;
+        }
+        float iv;
+        if (v < isoBound(isoIndex)) {
+          iv = isoBound(isoIndex);
+          --isoIndex;
+        } else if (v > isoBound(isoIndex + 1)) {
+          iv = isoBound(isoIndex + 1);
+          ++isoIndex;
+        } else {
+          return true;
+        }
+        vec4f c = lookup(f->tf, iv);
+        return c.w > 0.f ? composite(c, p) : true;
+      }
+      default: return true;
+    }
+  }
 
   SS_FUNC bool operator()(float a, float b) {
     const float dt = f->dt;
-    int kBegin = int(ceilf((a - t0) / dt));
-    int kEnd = int(ceilf((b - t0) / dt));
+    int64_t kBegin = int64_t(ceilf((a - t0) / dt));
+    int64_t kEnd = int64_t(ceilf((b - t0) / dt));
     if (kBegin < nextK) kBegin = nextK;
-    for (int k = kBegin; k < kEnd; ++k) {
+    const bool comp = f->blend == BlendMode::Composite;
+    for (int64_t k = kBegin; k < kEnd; ++k) {
       float t = t0 + float(k) * dt;
-      vec4f c = lookup(f->tf, s->sample(ray.org + ray.dir * t));
-      if (c.w > 0.f) {
-        float w = (1.f - acc.w) * c.w;
-        acc.x += w * c.x;
-        acc.y += w * c.y;
-        acc.z += w * c.z;
-        acc.w += w;
-        if (acc.w >= f->ertThreshold) {
-          samples += unsigned(k + 1 - kBegin);
-          nextK = k + 1;
-          return false;
-        }
+      const vec3f p = ray.org + ray.dir * t;
+      bool go;
+      if (comp) {
+        vec4f c = lookup(f->tf, s->sample(p));
+        go = c.w > 0.f ? composite(c, p) : true;
+      } else {
+        go = blendSample(s->sample(p), p);
+      }
+      if (!go) {
+        samples += unsigned(k + 1 - kBegin);
+        nextK = k + 1;
+        return false;
       }
     }
     if (kEnd > kBegin) samples += unsigned(kEnd - kBegin);
     if (kEnd > nextK) nextK = kEnd;
     return true;
+  }
+
+  /// The pixel's premultiplied RGBA once the march is over.
+  SS_FUNC vec4f result() const {
+    switch (f->blend) {
+      case BlendMode::MaximumIntensity:
+      case BlendMode::MinimumIntensity: {
+        if (count == 0) return vec4f{0, 0, 0, 0};
+        vec4f c = lookup(f->tf, extreme);
+        return vec4f{c.x * c.w, c.y * c.w, c.z * c.w, c.w};
+      }
+      case BlendMode::AverageIntensity: {
+        if (count == 0) return vec4f{0, 0, 0, 0};
+        const float g = ss_clamp(extreme / float(count), 0.f, 1.f);
+        return vec4f{g, g, g, 1.f};
+      }
+      case BlendMode::Additive: {
+        const float g = ss_clamp(extreme, 0.f, 1.f);
+        return vec4f{g, g, g, 1.f};
+      }
+      default: return acc;
+    }
   }
 };
 
@@ -162,24 +384,61 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
 
-  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u};
-  if (f.jitter) m.t0 += f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f);
-  switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
-    case TraversalKind::Naive: m(tEnter, tExit); break;
-    case TraversalKind::Grid: traverseGrid(f.grid, r, inv, tEnter, tExit, m); break;
-    case TraversalKind::Tree: {
-      TreeLeaf<Sampler> leaf{&m};
-      traverseTree(f.tree, r, inv, tEnter, tExit, leaf);
-      break;
+  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
+                             0.f, 0u, -1};
+  if (f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
+    const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
+    const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
+    m.lightW = head ? toEye : normalize(f.lightDir);
+    m.viewW = toEye;
+  }
+  // The sample lattice is anchored where the ray enters the drawn part of the volume (the box,
+  // cut by the clipping planes, and the first drawn cropping region), as VTK's mapper does by
+  // clipping its proxy geometry: no wood grain on cut faces; firstSample steps in and the
+  // jitter follow. The anchor depends on the ray and the planes only, never on the skipping
+  // structure, so every builder takes the same samples.
+  float lead = f.firstSample * f.dt +
+                     (f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f);
+  bool anchored = false;
+  auto march = [&](float a, float b) -> bool {
+    if (!anchored) {
+      m.t0 = a + lead;
+      anchored = true;
     }
-    case TraversalKind::Hybrid: {
-      HybridLeaf<Sampler> leaf{&m, inv};
-      traverseTree(f.tree, r, inv, tEnter, tExit, leaf);
-      break;
+    switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
+      case TraversalKind::Naive: return m(a, b);
+      case TraversalKind::Grid: return traverseGrid(f.grid, r, inv, a, b, m);
+      case TraversalKind::Tree: {
+        TreeLeaf<Sampler> leaf{&m};
+        return traverseTree(f.tree, r, inv, a, b, leaf);
+      }
+      case TraversalKind::Hybrid: {
+        HybridLeaf<Sampler> leaf{&m, inv};
+        return traverseTree(f.tree, r, inv, a, b, leaf);
+      }
+    }
+    return true;
+  };
+  float a = tEnter, b = tExit;
+  if (f.numClipPlanes == 0 || clipToPlanes(f, r, a, b)) {
+    if (f.cropping) {
+      // VTK starts cropped rays on the face of the first drawn region itself, not one step in
+      // (measured against vtkGPUVolumeRayCastMapper: sub-volume 43.5 dB this way, 38.9 dB one
+      // step in, 40.7 dB on the box's lattice).
+      lead -= f.firstSample * f.dt;
+      forEachCroppedInterval(f, r, a, b, march);
+    } else if (f.firstSample > 0.f && !(a + lead < b)) {
+      // Starting one or more steps in, the ray may leave the box before its first sample: that
+      // sample is still taken (clamped to the box), as vtkGPUVolumeRayCastMapper does; every
+      // traversal alike.
+      m.t0 = a + lead;
+      m(m.t0, m.t0 + f.dt);
+    } else {
+      march(a, b);
     }
   }
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
-  return m.acc;
+  return m.result();
 }
 
 }  // namespace spaceskip

@@ -8,6 +8,16 @@
 
 namespace spaceskip {
 
+/// How the samples along a ray combine (vtkVolumeMapper's blend modes, same numbering).
+enum class BlendMode : int {
+  Composite = 0,         ///< front-to-back emission-absorption
+  MaximumIntensity = 1,  ///< the largest sample, mapped through colour and opacity
+  MinimumIntensity = 2,  ///< the smallest sample, mapped through colour and opacity
+  AverageIntensity = 3,  ///< grey: mean of opacity * normalised scalar over samples in a range
+  Additive = 4,          ///< grey: sum of opacity * normalised scalar, clamped to 1
+  Isosurface = 5         ///< composite of the iso values the ray crosses
+};
+
 /// A control point: scalar value -> colour and opacity (opacity per unit distance).
 struct TFPoint {
   double value;
@@ -41,6 +51,9 @@ SS_FUNC float correctOpacity(float a, float dt, float unitDistance) {
 
 /// The table after opacity correction for sample distance dt.
 std::vector<vec4f> correctedTable(const TransferFunction& tf, float dt);
+/// The table a blend mode samples, as vtkOpenGLVolumeOpacityTable prepares it: composite
+/// corrects opacity for dt, additive scales it by dt/unitDistance, the others use it raw.
+std::vector<vec4f> tableForBlend(const TransferFunction& tf, float dt, BlendMode mode);
 
 /// Plain view of a (corrected) table for the integrator; device pointers on the GPU.
 struct TransferFunctionView {

@@ -13,6 +13,13 @@ struct GridView {
   /// Optional (DistanceGrid): per brick 0 when occupied, else the Chebyshev distance in bricks
   /// to the nearest occupied brick (DistanceField.h). When set, `occ` is not read.
   const uint8_t* dist = nullptr;
+  /// Optional (value-range skipping, the MIP/MinIP/average/isosurface blend modes): per-brick
+  /// min/max of the voxels a sample inside can interpolate (RangeGrid, +1 halo). When set,
+  /// neither `occ` nor `dist` is read: a brick is visited when `visit.active(vmin, vmax)` says
+  /// its samples can still change the ray's result, which depends on what the ray has seen so
+  /// far; so every visited brick is handed over on its own, before the next one is decided.
+  const float* vmin = nullptr;
+  const float* vmax = nullptr;
 };
 
 struct TreeView {
@@ -21,7 +28,7 @@ struct TreeView {
 };
 
 /// 3-D DDA (Amanatides & Woo 1987) over the bricks of `g`, restricted to t in [tmin, tmax).
-/// Consecutive occupied bricks are merged into one interval. With a distance field, an empty
+/// Consecutive occupied bricks are merged into one interval (not with value ranges, see GridView). With a distance field, an empty
 /// brick at distance d >= 2 is left together with the (2d-1)^3 empty bricks around it: the ray
 /// jumps to where it exits that cube (proximity clouds), then the DDA restarts there.
 template <class Visit>
@@ -50,7 +57,9 @@ SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin
   bool inRun = false;
   while (t < tmax) {
     const int64_t idx = cell[0] + int64_t(g.dims.x) * (cell[1] + int64_t(g.dims.y) * cell[2]);
-    const int dist = g.dist ? int(g.dist[idx]) : (g.occ[idx] != 0 ? 0 : 1);
+    const int dist = g.vmin ? (visit.active(g.vmin[idx], g.vmax[idx]) ? 0 : 1)
+                     : g.dist ? int(g.dist[idx])
+                              : (g.occ[idx] != 0 ? 0 : 1);
     const bool occ = dist == 0;
     if (occ && !inRun) {
       runStart = t;
@@ -90,6 +99,10 @@ SS_FUNC bool traverseGrid(const GridView& g, const Ray& r, vec3f inv, float tmin
     }
     int axis = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
     float tExit = ss_max(t, ss_min(tNext[axis], tmax));
+    if (g.vmin && inRun) {  // ray-dependent decisions: hand this brick over before the next
+      if (!visit(runStart, tExit)) return false;
+      inRun = false;
+    }
     t = tExit;
     cell[axis] += step[axis];
     tNext[axis] += tDelta[axis];

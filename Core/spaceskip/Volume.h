@@ -41,12 +41,27 @@ struct Volume {
   double value(int64_t i, int64_t j, int64_t k) const;
   /// Finite min/max of the voxels (NaN and +-Inf skipped); false if no finite voxel exists.
   bool scalarRange(double& lo, double& hi) const;
-  /// Allocates owned storage of dims*voxelSize bytes (zeroed).
+  /// Allocates owned storage of dims*voxelSize bytes (zeroed). Throws std::runtime_error when a
+  /// dimension is not positive or the byte count overflows 64 bits (see checkedByteSize).
   void allocate(vec3l d, VoxelType t);
   unsigned char* mutableData() { return storage ? storage->data() : nullptr; }
 };
 
-/// Throws std::runtime_error on bad dims (non-positive, or > 2^31 cells per axis).
+/// Throws std::runtime_error on bad dims (non-positive, > 2^30 voxels per axis, or a voxel or
+/// byte count that overflows 64 bits), missing data, or non-positive/non-finite spacing.
 void validate(const Volume& v);
+
+/// Largest axis length any volume may have (cell indices are 32-bit in the traversals).
+constexpr int64_t kMaxAxisVoxels = int64_t(1) << 30;
+
+/// Default cap on a volume's voxel bytes for readers and generators: SPACESKIP_MAX_VOLUME_BYTES
+/// when set (bytes, or with a K/M/G/T suffix), else min(64 GiB, physical memory). Throws
+/// std::runtime_error when that variable is set but malformed.
+uint64_t defaultMaxVolumeBytes();
+
+/// dims.x*dims.y*dims.z*voxelSize(t), checked: throws std::runtime_error starting with `what`
+/// when a dimension is not positive or exceeds kMaxAxisVoxels, the product overflows 64 bits,
+/// or it exceeds maxBytes (the message names the cap and how to raise it).
+uint64_t checkedByteSize(vec3l dims, VoxelType t, uint64_t maxBytes, const std::string& what);
 
 }  // namespace spaceskip

@@ -69,6 +69,11 @@ class CpuBackend final : public Backend {
     const OccupancyGrid& g = traversal_ == TraversalKind::Hybrid ? hybridGrid_ : occ_;
     f.grid = GridView{g.occ.data(), g.dims, g.brick, dist_.empty() ? nullptr : dist_.data()};
     f.tree = TreeView{tree_.nodes.data(), int(tree_.nodes.size())};
+    // In these modes every skipping builder marches the value ranges (Integrator.h, usesValueRanges).
+    if (usesValueRanges(f.blend) && traversal_ != TraversalKind::Naive) {
+      f.traversal = TraversalKind::Grid;
+      f.grid = GridView{nullptr, ranges_.dims, ranges_.brick, nullptr, ranges_.vmin.data(), ranges_.vmax.data()};
+    }
     f.tf = TransferFunctionView{table_.data(), int(table_.size()), tfLo_, tfScale_};
     out.width = f.width;
     out.height = f.height;

@@ -7,6 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <cstdio>
+#include <limits>
+#include <set>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace spaceskip {
 
@@ -29,6 +36,7 @@ constexpr BuilderName kBuilders[] = {
     {BuilderKind::KdTreeGPUFast, "KdTreeGPUFast", "kdtree-gpu-fast"},
     {BuilderKind::Hybrid, "Hybrid", "hybrid"},
     {BuilderKind::DistanceGrid, "DistanceGrid", "distance-grid"},
+    {BuilderKind::Auto, "Auto", "auto"},
 };
 
 std::string lower(std::string s) {
@@ -54,12 +62,81 @@ bool parseBuilder(const std::string& s, BuilderKind& out) {
   return false;
 }
 
+namespace {
+// Largest finite |v| of a floating-point voxel array, in parallel (0 when none is finite).
+template <class T>
+double maxFiniteMagnitude(const T* p, int64_t n) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, n, int64_t(1) << 16), 0.0,
+      [p](const tbb::blocked_range<int64_t>& r, double m) {
+        for (int64_t i = r.begin(); i < r.end(); ++i) {
+          const double a = std::fabs(double(p[i]));
+          if (a > m && std::isfinite(a)) m = a;
+        }
+        return m;
+      },
+      [](double a, double b) { return std::max(a, b); });
+}
+
+template <class T>
+void scaleToFloat(const T* in, float* out, int64_t n, int exponent) {
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, n, int64_t(1) << 16), [=](const tbb::blocked_range<int64_t>& r) {
+    for (int64_t i = r.begin(); i < r.end(); ++i) out[i] = float(std::ldexp(double(in[i]), exponent));
+  });
+}
+}  // namespace
+
+double effectiveSampleDistance(const Volume& v, double requested, std::string* note) {
+  const double minSpacing = std::min({v.spacing[0], v.spacing[1], v.spacing[2]});
+  const double voxel = minSpacing > 0 && std::isfinite(minSpacing) ? minSpacing : 1.0;
+  const bool automatic = !(requested > 0) || !std::isfinite(requested);
+  double dt = automatic ? 0.5 * voxel : requested;
+  const vec3i cd = v.cellDims();
+  const double ex = cd.x * v.spacing[0], ey = cd.y * v.spacing[1], ez = cd.z * v.spacing[2];
+  const double diagonal = std::sqrt(ex * ex + ey * ey + ez * ez);
+  const double floorDt = voxel / kMinStepsPerVoxel, capDt = diagonal / kMaxSamplesPerRay;
+  std::string why;
+  if (dt < floorDt) {
+    dt = floorDt;
+    why = "below the floor of 1/" + std::to_string(int(kMinStepsPerVoxel)) + " of the smallest voxel spacing";
+  }
+  if (dt < capDt) {
+    dt = capDt;
+    why = "more than " + std::to_string(int64_t(kMaxSamplesPerRay)) + " samples along the volume's diagonal";
+  }
+  if (note) {
+    note->clear();
+    if (!why.empty()) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "sample distance %g %s: using %g world units (%s)", requested,
+                    "clamped", dt, why.c_str());
+      *note = buf;
+    }
+  }
+  return dt;
+}
+
+namespace {
+// The voxel-to-table mapping in float for the integrator: lo and entries-per-unit, finite and
+// overflow-free for any finite range (ranges are clamped to float; empty ones get one unit).
+void tableMapping(const TransferFunction& tf, int size, float& lo, float& scale) {
+  const double big = double(std::numeric_limits<float>::max());
+  double a = std::isfinite(tf.rangeMin) ? std::clamp(tf.rangeMin, -big, big) : 0.0;
+  double b = std::isfinite(tf.rangeMax) ? std::clamp(tf.rangeMax, -big, big) : a + 1.0;
+  double width = b - a;
+  if (!(width > 0)) width = std::max(std::fabs(a) * 1e-6, 1e-30);
+  lo = float(a);
+  scale = float(std::min(double(size - 1) / width, big));
+}
+}  // namespace
+
 struct Engine::Impl {
   BackendKind requested;
   std::unique_ptr<Backend> backend;
   std::function<void(const std::string&)> log = [](const std::string& m) { std::cerr << "spaceskip: " << m << "\n"; };
 
   Volume volume;
+  int valueExponent = 0;  ///< voxel values (and so the TF range) times 2^this; see setVolume
   bool haveVolume = false;
   TransferFunction tf;
   bool haveTF = false;
@@ -71,6 +148,77 @@ struct Engine::Impl {
   FrameStats frame;
   Counters counters;
 
+  // Builder Auto ("never slower than naive"): skipping is lossless, so every candidate draws the
+  // same image and only its speed differs. Each candidate renders one frame, the fastest is kept;
+  // the candidates are measured again when the occupancy moves by more than kAutoReexplore or
+  // the image size changes, otherwise an occupancy change rebuilds the chosen one only.
+  struct AutoState {
+    std::vector<BuildParams> candidates;
+    std::vector<double> seconds;  ///< measured frame time per candidate, < 0: not yet
+    int current = -1;             ///< the candidate built now
+    bool exploring = false;
+    double occupancy = -1;        ///< when the choice was made
+    int width = 0, height = 0;
+    std::string choice;
+  } autoState;
+  static constexpr double kAutoReexplore = 0.1;
+
+  std::vector<BuildParams> autoCandidates() const {
+    auto with = [&](BuilderKind k, int mls) {
+      BuildParams p = build;
+      p.builder = k;
+      p.leaf = LeafCriterion::Deep;
+      p.maxLeafSize = mls;
+      return p;
+    };
+    if (backend->kind() == BackendKind::CUDA)
+      return {with(BuilderKind::Naive, 0), with(BuilderKind::Grid, 0), with(BuilderKind::DistanceGrid, 0),
+              with(BuilderKind::KdTreeGPUFast, 128), with(BuilderKind::LBVH, 0)};
+    return {with(BuilderKind::Naive, 0), with(BuilderKind::Grid, 0), with(BuilderKind::DistanceGrid, 0),
+            with(BuilderKind::KdTreeCPU, 32)};
+  }
+
+  void startAutoExploration() {
+    autoState.candidates = autoCandidates();
+    autoState.seconds.assign(autoState.candidates.size(), -1.0);
+    autoState.current = 0;
+    autoState.exploring = true;
+    autoState.choice = "Auto: measuring " + std::to_string(autoState.candidates.size()) + " structures";
+    buildDirty = true;
+  }
+
+  /// After a frame of `seconds` at width x height: records it and picks the next build.
+  void autoFrameDone(double seconds, int width, int height) {
+    AutoState& a = autoState;
+    if (!a.exploring) {
+      if (width != a.width || height != a.height) startAutoExploration();
+      return;
+    }
+    a.seconds[size_t(a.current)] = seconds;
+    a.width = width;
+    a.height = height;
+    if (size_t(a.current) + 1 < a.candidates.size()) {
+      ++a.current;
+      buildDirty = true;
+      return;
+    }
+    int best = 0;
+    for (size_t i = 1; i < a.seconds.size(); ++i)
+      if (a.seconds[i] < a.seconds[size_t(best)]) best = int(i);
+    a.exploring = false;
+    a.occupancy = backend->occupancy().occupancy();
+    char line[512];
+    int n = std::snprintf(line, sizeof line, "Auto: %s (%.3g ms/frame) at occupancy %.3f; measured", builderName(a.candidates[size_t(best)].builder),
+                          1e3 * a.seconds[size_t(best)], a.occupancy);
+    for (size_t i = 0; i < a.seconds.size() && n > 0 && size_t(n) < sizeof line; ++i)
+      n += std::snprintf(line + n, sizeof line - size_t(n), "%s %s %.3g", i ? "," : "", builderName(a.candidates[i].builder),
+                         1e3 * a.seconds[i]);
+    a.choice = line;
+    if (best != a.current) buildDirty = true;
+    a.current = best;
+    stats.choice = a.choice;
+  }
+
   void chooseBackend() {
     if (requested == BackendKind::CPU) {
       backend = makeCpuBackend();
@@ -79,21 +227,36 @@ struct Engine::Impl {
     try {
       backend = makeCudaBackend();
     } catch (const BackendError& e) {
-      if (requested == BackendKind::CUDA) log(std::string("CUDA backend unavailable (") + e.what() + "); using the CPU backend");
+      if (requested == BackendKind::CUDA) warn(std::string("CUDA backend unavailable (") + e.what() + "); using the CPU backend");
       backend = makeCpuBackend();
     }
   }
 
+  // Each distinct message is said once per engine: a soak of TF edits or builder switches must
+  // not repeat the same fallback hundreds of times in ParaView's output window.
+  std::set<std::string> said;
+  void warn(const std::string& m) {
+    if (said.insert(m).second) log(m);
+  }
+
   void fallBackToCpu(const std::string& why) {
-    log("CUDA backend failed (" + why + "); falling back to the CPU backend");
+    warn("CUDA backend failed (" + why + "); falling back to the CPU backend");
     backend = makeCpuBackend();
     rangesDirty = opacityDirty = buildDirty = tableDirty = true;
+    autoState = AutoState{};
+  }
+
+  TransferFunction scaledTF() const {
+    if (valueExponent == 0) return tf;
+    TransferFunction t = tf;
+    t.rangeMin = std::ldexp(t.rangeMin, valueExponent);
+    t.rangeMax = std::ldexp(t.rangeMax, valueExponent);
+    return t;
   }
 
   double dt() const {
-    if (render.sampleDistance > 0) return render.sampleDistance;
-    double s = std::min({volume.spacing[0], volume.spacing[1], volume.spacing[2]});
-    return 0.5 * (s > 0 ? s : 1.0);
+    std::string note;
+    return effectiveSampleDistance(volume, render.sampleDistance, &note);
   }
 
   void update() {
@@ -108,25 +271,33 @@ struct Engine::Impl {
     }
     if (opacityDirty) {
       auto t0 = Clock::now();
-      bool changed = backend->classify(tf);
+      bool changed = backend->classify(scaledTF());
       stats.classifySeconds = since(t0);
       ++counters.classifications;
       opacityDirty = false;
       tableDirty = true;
       if (changed) buildDirty = true;
+      if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
+          std::fabs(backend->occupancy().occupancy() - autoState.occupancy) > kAutoReexplore)
+        startAutoExploration();
     }
+    if (build.builder == BuilderKind::Auto && autoState.candidates.empty()) startAutoExploration();
     if (tableDirty || colorDirty) {
       if (!tableDirty) ++counters.colorUpdates;
-      const float lo = float(tf.rangeMin);
-      const float scale = float(double(tf.table.size() - 1) / std::max(tf.rangeMax - tf.rangeMin, 1e-30));
-      backend->setTransferTable(correctedTable(tf, float(dt())), lo, scale);
+      std::string note;
+      const double step = effectiveSampleDistance(volume, render.sampleDistance, &note);
+      if (!note.empty()) warn(note);
+      float lo, scale;
+      tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
+      backend->setTransferTable(tableForBlend(tf, float(step), render.blend), lo, scale);
       tableDirty = colorDirty = false;
     }
     if (buildDirty) {
-      BuildParams p = build;
+      const bool isAuto = build.builder == BuilderKind::Auto;
+      BuildParams p = isAuto ? autoState.candidates[size_t(autoState.current)] : build;
       bool gpuOnly = p.builder == BuilderKind::KdTreeGPU || p.builder == BuilderKind::KdTreeGPUFast;
       if (gpuOnly && backend->kind() != BackendKind::CUDA) {
-        log(std::string("builder ") + builderName(p.builder) + " needs the CUDA backend; building KdTreeCPU with the same parameters");
+        warn(std::string("builder ") + builderName(p.builder) + " needs the CUDA backend; building KdTreeCPU with the same parameters");
         p.builder = BuilderKind::KdTreeCPU;
       }
       BuildStats s;
@@ -134,13 +305,14 @@ struct Engine::Impl {
         backend->build(p, s);
       } catch (const BackendError& e) {
         if (backend->kind() == BackendKind::CUDA) throw;
-        log(std::string(e.what()) + "; using the Grid traversal");
+        warn(std::string(e.what()) + "; using the Grid traversal");
         p.builder = BuilderKind::Grid;
         backend->build(p, s);
       }
       s.builder = p.builder;
       s.classifySeconds = stats.classifySeconds;
       s.occupancy = backend->occupancy().occupancy();
+      s.choice = isAuto ? autoState.choice : std::string();
       stats = s;
       ++counters.builds;
       buildDirty = false;
@@ -166,6 +338,31 @@ void Engine::setLogger(std::function<void(const std::string&)> log) { impl_->log
 void Engine::setVolume(const Volume& v) {
   validate(v);
   impl_->volume = v;
+  impl_->valueExponent = 0;
+  impl_->autoState = Impl::AutoState{};
+  // The integrator samples in float: magnitudes near the ends of double's (or float's) range
+  // would overflow trilinear interpolation or the table mapping (+-1e308 gave a blank image),
+  // and denormal-scale data would collapse to one table entry. Such volumes are sampled from a
+  // float copy scaled by an exact power of two; the TF range is scaled alike, so the image is
+  // the one of the unscaled data. NaN stays NaN and +-Inf stays +-Inf in the copy.
+  if (v.type == VoxelType::Float32 || v.type == VoxelType::Float64) {
+    const int64_t n = v.voxelCount();
+    const double m = v.type == VoxelType::Float32 ? maxFiniteMagnitude(static_cast<const float*>(v.data), n)
+                                                  : maxFiniteMagnitude(static_cast<const double*>(v.data), n);
+    if (m > 0 && (m > 0x1p60 || m < 0x1p-60)) {
+      int e = 0;
+      std::frexp(m, &e);
+      auto copy = std::make_shared<std::vector<unsigned char>>(size_t(n) * sizeof(float));
+      float* out = reinterpret_cast<float*>(copy->data());
+      // m * 2^-e lies in [0.5, 1); ldexp is exact and reaches denormal scales a factor can't.
+      if (v.type == VoxelType::Float32) scaleToFloat(static_cast<const float*>(v.data), out, n, -e);
+      else scaleToFloat(static_cast<const double*>(v.data), out, n, -e);
+      impl_->volume.type = VoxelType::Float32;
+      impl_->volume.storage = copy;
+      impl_->volume.data = copy->data();
+      impl_->valueExponent = -e;
+    }
+  }
   impl_->haveVolume = true;
   impl_->rangesDirty = true;
   impl_->tableDirty = true;  // the default sample distance follows the spacing
@@ -187,13 +384,16 @@ void Engine::setBuildParams(const BuildParams& p) {
     throw std::invalid_argument("bins must be 0 (sweep every brick boundary) or >= 2, got " + std::to_string(p.bins));
   Impl& d = *impl_;
   if (p.brick != d.build.brick) d.rangesDirty = true;
-  if (p != d.build) d.buildDirty = true;
+  if (p != d.build) {
+    d.buildDirty = true;
+    d.autoState = Impl::AutoState{};  // Auto measures again with the new parameters
+  }
   d.build = p;
   d.build.brick = std::max(1, p.brick);
 }
 
 void Engine::setRenderParams(const RenderParams& p) {
-  if (p.sampleDistance != impl_->render.sampleDistance) impl_->tableDirty = true;
+  if (p.sampleDistance != impl_->render.sampleDistance || p.blend != impl_->render.blend) impl_->tableDirty = true;
   impl_->render = p;
 }
 
@@ -211,16 +411,63 @@ void Engine::update() {
   }
 }
 
+namespace {
+/// The blend-mode and shading part of the frame from the render parameters.
+template <class Impl>
+void fillBlend(Impl& d, FrameView& f) {
+  const RenderParams& r = d.render;
+  f.blend = r.blend;
+  // Scalar values in the frame are in the sampled units: times 2^valueExponent (setVolume).
+  auto scaled = [&](double v) { return std::ldexp(v, d.valueExponent); };
+  double lo = r.scalarRange[0], hi = r.scalarRange[1];
+  if (!(lo < hi)) {
+    lo = d.tf.rangeMin;
+    hi = d.tf.rangeMax;
+  }
+  lo = scaled(lo);
+  hi = scaled(hi);
+  f.normLo = float(lo);
+  f.normScale = hi > lo ? float(1.0 / (hi - lo)) : 0.f;
+  f.avgLo = float(std::max(scaled(r.averageRange[0]), -double(HUGE_VALF)));
+  f.avgHi = float(std::min(scaled(r.averageRange[1]), double(HUGE_VALF)));
+  std::vector<double> iso = r.isoValues;
+  std::sort(iso.begin(), iso.end());
+  if (iso.size() > size_t(kMaxIsoValues)) {
+    d.warn("isosurface: " + std::to_string(iso.size()) + " iso values, using the lowest " +
+           std::to_string(kMaxIsoValues));
+    iso.resize(size_t(kMaxIsoValues));
+  }
+  f.numIso = int(iso.size());
+  for (int i = 0; i < f.numIso; ++i) f.iso[i] = float(scaled(iso[size_t(i)]));
+  f.shade = r.shade && (r.blend == BlendMode::Composite || r.blend == BlendMode::Isosurface) ? 1 : 0;
+  f.ambient = float(r.ambient);
+  f.diffuse = float(r.diffuse);
+  f.specular = float(r.specular);
+  f.specularPower = float(r.specularPower);
+  f.lightDir = vec3f{float(r.lightDirection[0]), float(r.lightDirection[1]), float(r.lightDirection[2])};
+}
+}  // namespace
+
 void Engine::render(const Camera& cam, int width, int height, Image& out, const float* depth) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("render size must be positive");
   update();
   Impl& d = *impl_;
   FrameView f{};
+  // The kernels march in float in a frame relative to the volume's origin: both matrices are
+  // composed with the origin shift here in double, so georeferenced data (origin 1e6..1e7,
+  // where a float ulp is ~1 world unit) renders exactly like the same volume at the origin.
   mat4 vp = multiply(cam.proj, cam.view), ivp;
   if (!invert(vp, ivp)) throw std::invalid_argument("camera matrix is singular");
-  for (int i = 0; i < 16; ++i) f.invViewProj[i] = float(ivp.m[i]);
+  mat4 toOrigin = identity4();
+  Volume atOrigin = d.volume;
+  for (int i = 0; i < 3; ++i) {
+    toOrigin.m[12 + i] = -d.volume.origin[i];
+    atOrigin.origin[i] = 0;
+  }
+  const mat4 ivpRel = multiply(toOrigin, ivp);
+  for (int i = 0; i < 16; ++i) f.invViewProj[i] = float(ivpRel.m[i]);
   mat4 w2i;
-  if (!invert(d.volume.indexToWorld(), w2i)) throw std::invalid_argument("volume direction/spacing is singular");
+  if (!invert(atOrigin.indexToWorld(), w2i)) throw std::invalid_argument("volume direction/spacing is singular");
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) f.worldToIndex[r * 4 + c] = float(w2i.m[c * 4 + r]);
   f.width = width;
@@ -229,8 +476,41 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.boxHi = vec3f{float(cd.x), float(cd.y), float(cd.z)};
   f.dt = float(d.dt());
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
+  // Clipping planes and cropping planes into the index space of the integrator (in double).
+  const mat4 indexToWorldRel = atOrigin.indexToWorld();
+  const double* L = indexToWorldRel.m;  // column-major: index axis c is column c
+  f.numClipPlanes = 0;
+  if (int(d.render.clipPlanes.size()) > kMaxClipPlanes)
+    d.warn("more than " + std::to_string(kMaxClipPlanes) + " clipping planes: using the first " +
+           std::to_string(kMaxClipPlanes));
+  for (const auto& pl : d.render.clipPlanes) {
+    if (f.numClipPlanes == kMaxClipPlanes) break;
+    if (!(std::isfinite(pl[0]) && std::isfinite(pl[1]) && std::isfinite(pl[2]) && std::isfinite(pl[3]))) {
+      d.warn("a clipping plane with a non-finite normal or offset is ignored");
+      continue;
+    }
+    float* c = f.clip[f.numClipPlanes++];
+    for (int k = 0; k < 3; ++k) c[k] = float(pl[0] * L[k * 4] + pl[1] * L[k * 4 + 1] + pl[2] * L[k * 4 + 2]);
+    c[3] = float(pl[0] * d.volume.origin[0] + pl[1] * d.volume.origin[1] + pl[2] * d.volume.origin[2] + pl[3]);
+  }
+  f.cropping = d.render.cropping ? 1 : 0;
+  f.cropFlags = d.render.croppingFlags & 0x7ffffff;
+  for (int a = 0; a < 3; ++a) {
+    double lo = d.render.croppingPlanes[2 * a], hi = d.render.croppingPlanes[2 * a + 1];
+    if (lo > hi) std::swap(lo, hi);
+    const double o = d.volume.origin[a], sp = d.volume.spacing[a];
+    f.crop[2 * a] = float(std::clamp((lo - o) / sp, -1e30, 1e30));
+    f.crop[2 * a + 1] = float(std::clamp((hi - o) / sp, -1e30, 1e30));
+  }
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
+  f.firstSample = float(std::max(0.0, d.render.firstSampleOffset));
+  mat4 iv;
+  if (!invert(cam.view, iv)) throw std::invalid_argument("camera view matrix is singular");
+  // The eye in the same origin-relative frame as the rays (subtracted in double).
+  f.eyeW = vec3f{float(iv.m[12] - d.volume.origin[0]), float(iv.m[13] - d.volume.origin[1]),
+                 float(iv.m[14] - d.volume.origin[2])};
+  fillBlend(d, f);
   std::vector<unsigned> counts;
   if (d.render.countSamples) {
     counts.assign(size_t(width) * size_t(height), 0u);
@@ -254,12 +534,17 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   }
   d.frame.backend = d.backend->name();
   ++d.counters.frames;
+  if (d.build.builder == BuilderKind::Auto)
+    d.autoFrameDone(d.frame.deviceSeconds > 0 ? d.frame.deviceSeconds : d.frame.seconds, width, height);
 }
 
 bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }
 const void* Engine::deviceImage() const { return impl_->backend->deviceImage(); }
 
 const BuildStats& Engine::buildStats() const { return impl_->stats; }
+bool Engine::exploring() const {
+  return impl_->build.builder == BuilderKind::Auto && (impl_->autoState.exploring || impl_->autoState.candidates.empty());
+}
 const FrameStats& Engine::frameStats() const { return impl_->frame; }
 const Counters& Engine::counters() const { return impl_->counters; }
 const OccupancyGrid& Engine::occupancy() {
@@ -271,5 +556,6 @@ Tree Engine::tree() {
   return impl_->backend->tree();
 }
 double Engine::sampleDistance() const { return impl_->dt(); }
+int Engine::valueExponent() const { return impl_->valueExponent; }
 
 }  // namespace spaceskip

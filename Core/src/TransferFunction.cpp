@@ -1,6 +1,8 @@
 // Transfer-function tables, presets and the sparse-table range-max query.
 #include "spaceskip/TransferFunction.h"
 
+#include "spaceskip/TransferFunctionIO.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -19,7 +21,9 @@ TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double l
   tf.rangeMax = hi;
   tf.table.resize(size_t(size));
   for (int i = 0; i < size; ++i) {
-    double v = size == 1 ? lo : lo + (hi - lo) * double(i) / double(size - 1);
+    // lo*(1-t) + hi*t and halved differences: no overflow for ranges as wide as +-1e308.
+    const double t = size == 1 ? 0.0 : double(i) / double(size - 1);
+    double v = lo * (1.0 - t) + hi * t;
     auto it = std::lower_bound(pts.begin(), pts.end(), v, [](const TFPoint& p, double x) { return p.value < x; });
     TFPoint p;
     if (it == pts.begin()) p = pts.front();
@@ -27,7 +31,7 @@ TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double l
     else {
       const TFPoint& a = *(it - 1);
       const TFPoint& b = *it;
-      double f = b.value > a.value ? (v - a.value) / (b.value - a.value) : 0.0;
+      double f = b.value > a.value ? (0.5 * v - 0.5 * a.value) / (0.5 * b.value - 0.5 * a.value) : 0.0;
       auto mix = [f](float x, float y) { return float(x + (y - x) * f); };
       p = TFPoint{v, mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b), mix(a.a, b.a)};
     }
@@ -37,8 +41,7 @@ TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double l
 }
 
 TransferFunction TransferFunction::preset(const std::string& name, double lo, double hi, int size) {
-  const double w = hi - lo;
-  auto at = [&](double f) { return lo + f * w; };
+  auto at = [&](double f) { return lo * (1.0 - f) + hi * f; };
   std::vector<TFPoint> p;
   if (name == "ramp") {
     p = {{at(0.0), 0.2f, 0.3f, 0.9f, 0.f}, {at(0.1), 0.2f, 0.3f, 0.9f, 0.f},
@@ -68,42 +71,7 @@ TransferFunction TransferFunction::preset(const std::string& name, double lo, do
 }
 
 TransferFunction TransferFunction::load(const std::string& path, double lo, double hi) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open transfer-function file");
-  std::vector<TFPoint> pts;
-  int size = 1024;
-  double unit = 1.0;
-  std::string line;
-  int lineNo = 0;
-  while (std::getline(in, line)) {
-    ++lineNo;
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ls(line);
-    std::string first;
-    ls >> first;
-    if (first.empty()) continue;
-    if (first == "range") {
-      if (!(ls >> lo >> hi)) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad range");
-    } else if (first == "size") {
-      if (!(ls >> size) || size < 2) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad size");
-    } else if (first == "unit") {
-      if (!(ls >> unit) || !(unit > 0)) throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": bad unit");
-    } else {
-      TFPoint p{};
-      try {
-        p.value = std::stod(first);
-      } catch (...) {
-        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected 'value r g b a'");
-      }
-      if (!(ls >> p.r >> p.g >> p.b >> p.a))
-        throw std::runtime_error(path + ":" + std::to_string(lineNo) + ": expected 'value r g b a'");
-      pts.push_back(p);
-    }
-  }
-  if (pts.empty()) throw std::runtime_error(path + ": no control points");
-  TransferFunction tf = fromPoints(pts, lo, hi, size);
-  tf.unitDistance = unit;
-  return tf;
+  return loadTransferFunction(path, lo, hi);  // bounded, strict parser: TransferFunctionIO.cpp
 }
 
 bool TransferFunction::sameOpacity(const TransferFunction& o) const {
@@ -125,6 +93,16 @@ bool TransferFunction::sameColor(const TransferFunction& o) const {
 std::vector<vec4f> correctedTable(const TransferFunction& tf, float dt) {
   std::vector<vec4f> out(tf.table);
   for (auto& e : out) e.w = correctOpacity(e.w, dt, float(tf.unitDistance));
+  return out;
+}
+
+std::vector<vec4f> tableForBlend(const TransferFunction& tf, float dt, BlendMode mode) {
+  if (mode == BlendMode::Composite) return correctedTable(tf, dt);
+  std::vector<vec4f> out(tf.table);
+  if (mode == BlendMode::Additive) {
+    const float factor = dt / float(tf.unitDistance);
+    for (auto& e : out) e.w *= factor;
+  }
   return out;
 }
 

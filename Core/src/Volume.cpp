@@ -1,8 +1,13 @@
 // Volume metadata helpers.
 #include "spaceskip/Volume.h"
 
+#include "spaceskip/Parse.h"
+
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <type_traits>
@@ -158,19 +163,58 @@ bool Volume::scalarRange(double& lo, double& hi) const {
 }
 
 void Volume::allocate(vec3l d, VoxelType t) {
+  // Checked first: a wrapped product would allocate a small buffer that later reads overrun.
+  const uint64_t bytes = checkedByteSize(d, t, std::numeric_limits<uint64_t>::max(), "volume");
+  auto buf = std::make_shared<std::vector<unsigned char>>(size_t(bytes));
   dims = d;
   type = t;
-  storage = std::make_shared<std::vector<unsigned char>>(byteSize());
+  storage = std::move(buf);
   data = storage->data();
 }
 
+namespace {
+std::string dimsText(vec3l d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+}  // namespace
+
+uint64_t defaultMaxVolumeBytes() {
+  if (const char* env = std::getenv("SPACESKIP_MAX_VOLUME_BYTES")) {
+    uint64_t v = 0;
+    if (!parseByteCount(env, v) || v == 0)
+      throw std::runtime_error(std::string("SPACESKIP_MAX_VOLUME_BYTES='") + env +
+                               "' is not a positive byte count (e.g. 68719476736 or 64G)");
+    return v;
+  }
+  // A volume is read into host memory whole, so more than physical memory cannot succeed.
+  uint64_t cap = uint64_t(64) << 30;
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && page > 0 && uint64_t(pages) <= std::numeric_limits<uint64_t>::max() / uint64_t(page))
+    cap = std::min(cap, uint64_t(pages) * uint64_t(page));
+  return cap;
+}
+
+uint64_t checkedByteSize(vec3l d, VoxelType t, uint64_t maxBytes, const std::string& what) {
+  if (d.x <= 0 || d.y <= 0 || d.z <= 0)
+    throw std::runtime_error(what + ": empty or negative extent " + dimsText(d));
+  if (d.x > kMaxAxisVoxels || d.y > kMaxAxisVoxels || d.z > kMaxAxisVoxels)
+    throw std::runtime_error(what + ": extent " + dimsText(d) + " has an axis longer than 2^30 voxels");
+  uint64_t n = 0, bytes = 0;
+  if (__builtin_mul_overflow(uint64_t(d.x), uint64_t(d.y), &n) || __builtin_mul_overflow(n, uint64_t(d.z), &n) ||
+      __builtin_mul_overflow(n, uint64_t(voxelSize(t)), &bytes) ||
+      bytes > uint64_t(std::numeric_limits<int64_t>::max()))
+    throw std::runtime_error(what + ": extent " + dimsText(d) + " of " + voxelTypeName(t) +
+                             " overflows a 64-bit byte count");
+  if (bytes > maxBytes)
+    throw std::runtime_error(what + ": extent " + dimsText(d) + " of " + voxelTypeName(t) + " needs " +
+                             std::to_string(bytes) + " bytes, more than the limit of " + std::to_string(maxBytes) +
+                             " (raise it with SPACESKIP_MAX_VOLUME_BYTES or --max-volume-bytes)");
+  return bytes;
+}
+
 void validate(const Volume& v) {
-  if (v.dims.x <= 0 || v.dims.y <= 0 || v.dims.z <= 0)
-    throw std::runtime_error("empty volume extent (" + std::to_string(v.dims.x) + "x" +
-                             std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z) + ")");
-  const int64_t maxAxis = int64_t(1) << 30;
-  if (v.dims.x > maxAxis || v.dims.y > maxAxis || v.dims.z > maxAxis)
-    throw std::runtime_error("volume axis longer than 2^30 voxels");
+  // Overflow and axis checks, no size cap: the voxels are already in memory.
+  checkedByteSize(v.dims, v.type, std::numeric_limits<uint64_t>::max(), "volume");
   if (!v.data) throw std::runtime_error("volume has no voxel data");
   for (int i = 0; i < 3; ++i)
     if (!(v.spacing[i] > 0) || !std::isfinite(v.spacing[i]))

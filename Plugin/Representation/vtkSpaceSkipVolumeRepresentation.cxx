@@ -1,9 +1,12 @@
 // ParaView's image-data volume representation with vtkSpaceSkippingVolumeMapper installed.
 #include "vtkSpaceSkipVolumeRepresentation.h"
 
+#include "vtkColorTransferFunction.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVLODVolume.h"
+#include "vtkScalarsToColors.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
+#include "vtkVolumeProperty.h"
 
 vtkStandardNewMacro(vtkSpaceSkipVolumeRepresentation);
 
@@ -20,6 +23,23 @@ vtkSpaceSkipVolumeRepresentation::vtkSpaceSkipVolumeRepresentation()
 
 //------------------------------------------------------------------------------
 vtkSpaceSkipVolumeRepresentation::~vtkSpaceSkipVolumeRepresentation() = default;
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
+{
+  this->Superclass::UpdateMapperParameters();
+  // Same rule as the base class for vtkSmartVolumeMapper: with independent components the
+  // colour map's vector mode and component, else component 0.
+  vtkVolumeProperty* prop = this->Property;
+  vtkColorTransferFunction* ctf = prop ? prop->GetRGBTransferFunction(0) : nullptr;
+  if (!ctf)
+  {
+    return;
+  }
+  const bool indep = prop->GetIndependentComponents() != 0;
+  this->SpaceSkipMapper->SetVectorMode(indep ? ctf->GetVectorMode() : vtkScalarsToColors::COMPONENT);
+  this->SpaceSkipMapper->SetVectorComponent(indep ? ctf->GetVectorComponent() : 0);
+}
 
 //------------------------------------------------------------------------------
 // Setters: the mapper's own Modified() makes the next render rebuild what the change needs.
@@ -87,6 +107,24 @@ int vtkSpaceSkipVolumeRepresentation::GetEarlyRayTermination()
 {
   return this->SpaceSkipMapper->GetEarlyRayTermination() ? 1 : 0;
 }
+void vtkSpaceSkipVolumeRepresentation::SetUseJittering(int v)
+{
+  this->SpaceSkipMapper->SetUseJittering(v != 0);
+}
+int vtkSpaceSkipVolumeRepresentation::GetUseJittering()
+{
+  return this->SpaceSkipMapper->GetUseJittering() ? 1 : 0;
+}
+
+void vtkSpaceSkipVolumeRepresentation::SetExtraBlendMode(int mode)
+{
+  this->SpaceSkipMapper->SetBlendModeOverride(mode);
+}
+
+int vtkSpaceSkipVolumeRepresentation::GetExtraBlendMode()
+{
+  return this->SpaceSkipMapper->GetBlendModeOverride();
+}
 
 //------------------------------------------------------------------------------
 double vtkSpaceSkipVolumeRepresentation::GetLastBuildSeconds()
@@ -100,6 +138,10 @@ double vtkSpaceSkipVolumeRepresentation::GetLastClassifySeconds()
 double vtkSpaceSkipVolumeRepresentation::GetLastRenderSeconds()
 {
   return this->SpaceSkipMapper->GetLastRenderSeconds();
+}
+double vtkSpaceSkipVolumeRepresentation::GetSampleDistanceUsed()
+{
+  return this->SpaceSkipMapper->GetSampleDistanceUsed();
 }
 double vtkSpaceSkipVolumeRepresentation::GetNodeCount()
 {
@@ -118,6 +160,12 @@ double vtkSpaceSkipVolumeRepresentation::GetOccupancy()
   return this->SpaceSkipMapper->GetOccupancy();
 }
 // The string getters copy: the wrapped caller reads the value after the mapper may change it.
+const char* vtkSpaceSkipVolumeRepresentation::GetBuilderChoice()
+{
+  const char* text = this->SpaceSkipMapper->GetBuilderChoice();
+  this->BuilderChoiceText = text ? text : "";
+  return this->BuilderChoiceText.c_str();
+}
 const char* vtkSpaceSkipVolumeRepresentation::GetBuilderUsed()
 {
   const char* name = this->SpaceSkipMapper->GetBuilderUsed();

@@ -47,6 +47,12 @@ public:
   int GetBackend();
   void SetEarlyRayTermination(int on);
   int GetEarlyRayTermination();
+  void SetUseJittering(int on);
+  int GetUseJittering();
+  /// The blend modes ParaView 5.11's Blend Mode menu lacks (vtkSpaceSkippingVolumeMapper's
+  /// BlendModeOverride): -1 follows Blend Mode.
+  void SetExtraBlendMode(int mode);
+  int GetExtraBlendMode();
   ///@}
 
   ///@{
@@ -54,12 +60,14 @@ public:
   double GetLastBuildSeconds();
   double GetLastClassifySeconds();
   double GetLastRenderSeconds();
+  double GetSampleDistanceUsed();
   double GetNodeCount();
   int GetTreeHeight();
   double GetLeafCount();
   double GetOccupancy();
   const char* GetBackendUsed();
   const char* GetBuilderUsed();
+  const char* GetBuilderChoice();
   int GetBuildCount();
   int GetClassifyCount();
   int GetColorUpdateCount();
@@ -73,10 +81,15 @@ protected:
   vtkSpaceSkipVolumeRepresentation();
   ~vtkSpaceSkipVolumeRepresentation() override;
 
+  /// The base class hands the colour map's Magnitude/Component choice only to VTK's own
+  /// mappers; this passes it to ours as well.
+  void UpdateMapperParameters() override;
+
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
   std::string BackendUsedName;
   std::string BuilderUsedName;
+  std::string BuilderChoiceText;
 
 private:
   vtkSpaceSkipVolumeRepresentation(const vtkSpaceSkipVolumeRepresentation&) = delete;

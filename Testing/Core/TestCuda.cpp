@@ -626,6 +626,39 @@ TEST(CudaBackend, DeviceOutOfMemoryFallsBackToCpu) {
   }
 }
 
+TEST(CudaBackend, ErrorMidFrameFallsBackToTheCpuImage) {
+  REQUIRE_CUDA();
+  Volume v = generateVolume("nbody", vec3l{64, 64, 64}, 4);
+  TransferFunction tf = tfFor(v, "ramp");
+  const int size = 96;
+  double b[6];
+  v.worldBounds(b);
+  const Camera cam = orbitCamera(b, 30, 20, 1.0, false, 1.0);
+  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::KdTreeGPUFast}) {
+    SCOPED_TRACE(builderName(k));
+    Built cpu = run(v, tf, params(k), BackendKind::CPU, 30, 20, false, FilterMode::Exact, size);
+    ASSERT_GT(test::coverage(cpu.img), 0.001);
+    std::vector<std::string> log;
+    Engine e(BackendKind::Auto, [&](const std::string& m) { log.push_back(m); });
+    ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+    e.setVolume(v);
+    e.setTransferFunction(tf);
+    e.setBuildParams(params(k));
+    Image img;
+    e.render(cam, size, size, img);  // a good CUDA frame first
+    ::setenv("SPACESKIP_CUDA_FAIL_RENDER", "1", 1);
+    Image failed;
+    EXPECT_NO_THROW(e.render(cam, size, size, failed));
+    ::unsetenv("SPACESKIP_CUDA_FAIL_RENDER");
+    EXPECT_EQ(e.backendKind(), BackendKind::CPU);
+    EXPECT_EQ(cudaDeviceBytesInUse(), 0) << "the failed CUDA backend left device memory allocated";
+    ASSERT_EQ(log.size(), 1u);
+    EXPECT_TRUE(contains(log[0], "cudaErrorLaunchFailure")) << log[0];
+    EXPECT_TRUE(contains(log[0], "falling back to the CPU backend")) << log[0];
+    EXPECT_EQ(compareImages(cpu.img, failed).maxAbs, 0.f) << "the fallback frame is the CPU image";
+  }
+}
+
 TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
   // SPACESKIP_CUDA_RESIDENT switches the render kernels to a persistent launch (blocks taking
   // tiles from a counter); every pixel must still be rendered once, with the same result. A

@@ -158,6 +158,127 @@ TEST(Extremes, CudaRequestWithoutDeviceFallsBackToCpu) {
   EXPECT_GT(test::coverage(img), 0.0);
 }
 
+// --- Hostile input and extremes (issue 14): bounded work per ray, precision, value extremes.
+
+TEST(Extremes, TinySampleDistanceIsClampedOnceAndBounded) {
+  Volume v = generateVolume("shell", vec3l{32, 32, 32});
+  auto tf = TransferFunction::preset("ramp", 0, 255);
+  double b[6];
+  v.worldBounds(b);
+  const Camera cam = orbitCamera(b, 20, 30, 1.0, false, 1.0);
+  const double floorDt = 1.0 / kMinStepsPerVoxel;  // spacing 1
+  Image ref;
+  {
+    Engine e(BackendKind::CPU);
+    e.setLogger([](const std::string&) {});
+    e.setVolume(v);
+    e.setTransferFunction(tf);
+    RenderParams rp;
+    rp.sampleDistance = floorDt;
+    e.setRenderParams(rp);
+    e.render(cam, 32, 32, ref);
+  }
+  // 1e-4 ran for minutes; 1e-12 overflowed the int sample index and drew nothing.
+  for (double dt : {1e-4, 1e-12, 1e-300}) {
+    std::vector<std::string> log;
+    Engine e(BackendKind::CPU, [&](const std::string& m) { log.push_back(m); });
+    e.setVolume(v);
+    e.setTransferFunction(tf);
+    RenderParams rp;
+    rp.sampleDistance = dt;
+    rp.countSamples = true;
+    e.setRenderParams(rp);
+    Image img;
+    for (int frame = 0; frame < 3; ++frame) e.render(cam, 32, 32, img);
+    EXPECT_DOUBLE_EQ(e.sampleDistance(), floorDt);
+    ASSERT_EQ(log.size(), 1u) << "one warning for three frames";
+    EXPECT_NE(log[0].find("clamped"), std::string::npos) << log[0];
+    // Work bound: at most the box diagonal / floor (+1 per ray) samples per pixel.
+    const double diagonal = std::sqrt(3.0) * 32;
+    EXPECT_LE(e.frameStats().samples, int64_t(32 * 32 * (diagonal / floorDt + 1)));
+    EXPECT_GT(test::coverage(img), 0.01);
+    EXPECT_EQ(compareImages(ref, img).maxAbs, 0.f);
+  }
+}
+
+TEST(Extremes, SamplesPerRayAreCappedOnVeryLongAxes) {
+  Volume v = filled(vec3l{int64_t(1) << 22, 1, 1}, VoxelType::UInt8, 0);  // 4 MiB, 2^22 cells long
+  std::string note;
+  const double dt = effectiveSampleDistance(v, 0, &note);
+  EXPECT_NEAR(double(int64_t(1) << 22) / dt, kMaxSamplesPerRay, 1.0);
+  EXPECT_NE(note.find("samples"), std::string::npos) << note;
+  EXPECT_EQ(effectiveSampleDistance(filled(vec3l{8, 8, 8}, VoxelType::UInt8, 0), 0.25, &note), 0.25);
+  EXPECT_TRUE(note.empty()) << note;
+}
+
+TEST(Extremes, FarFromTheOriginEqualsAtTheOrigin) {
+  // Georeferenced data: origins of 1e6..1e7 (a float ulp is 0.06..1 world unit there).
+  Volume v = generateVolume("nbody", vec3l{40, 40, 40});
+  auto tf = TransferFunction::preset("ramp", 0, 255);
+  for (bool persp : {false, true}) {
+    Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 30, 25, persp, 64);
+    ASSERT_GT(test::coverage(ref), 0.01);
+    for (double o : {1e6, 1e7, -3.3e7}) {
+      Volume w = v;
+      w.origin[0] = o;
+      w.origin[1] = -0.7 * o;
+      w.origin[2] = 0.3 * o;
+      for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::KdTreeCPU}) {
+        Image img = test::renderWith(w, tf, test::builder(k), 30, 25, persp, 64);
+        EXPECT_LE(compareImages(ref, img).maxAbs, 1.f / 255.f) << "origin " << o << " persp " << persp;
+      }
+    }
+  }
+}
+
+namespace {
+// `v`'s values mapped by `f` into a float64 volume with the same layout.
+template <class F>
+Volume mapToDouble(const Volume& v, F f) {
+  Volume w;
+  w.allocate(v.dims, VoxelType::Float64);
+  double* d = reinterpret_cast<double*>(w.mutableData());
+  for (int64_t i = 0; i < v.voxelCount(); ++i)
+    d[i] = f(double(reinterpret_cast<const uint8_t*>(v.data)[i]));
+  return w;
+}
+}  // namespace
+
+TEST(Extremes, ValuesNearTheEndsOfDoubleRenderLikeModestOnes) {
+  // +-1e308 gave a blank image (float overflow in sampling); denormals collapsed to one entry.
+  Volume v = generateVolume("nbody", vec3l{32, 32, 32});  // uint8
+  auto modest = mapToDouble(v, [](double x) { return (x - 127.5) / 127.5; });
+  auto tf = TransferFunction::preset("ramp", -1, 1);
+  Image ref = test::renderWith(modest, tf, test::builder(BuilderKind::Grid), 15, 40, false, 48);
+  ASSERT_GT(test::coverage(ref), 0.01);
+  for (double scale : {1e308, 1e-310, 3e38, 1e-40}) {
+    auto w = mapToDouble(v, [&](double x) { return (x - 127.5) / 127.5 * scale; });
+    auto tfw = TransferFunction::preset("ramp", -scale, scale);
+    for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid}) {
+      Engine e(BackendKind::CPU);
+      e.setVolume(w);
+      EXPECT_NE(e.valueExponent(), 0) << scale;
+      Image img = test::renderWith(w, tfw, test::builder(k), 15, 40, false, 48);
+      EXPECT_FALSE(hasNonFinite(img));
+      EXPECT_LE(compareImages(ref, img).maxAbs, 2.f / 255.f) << "scale " << scale;
+    }
+  }
+}
+
+TEST(Extremes, InfinityTakesTheEndOfTheTableAndNeverMakesNaN) {
+  // A float32 volume of +Inf in one half and finite values in the other: no NaN pixel, the Inf
+  // half drawn with the table's last entry (as a value above the range would be), lossless.
+  Volume v = filled(vec3l{16, 16, 16}, VoxelType::Float32, 0.25);
+  float* d = reinterpret_cast<float*>(v.mutableData());
+  for (int64_t i = 0; i < v.voxelCount(); ++i)
+    if (i % 16 >= 8) d[i] = INFINITY;
+  auto tf = TransferFunction::fromPoints({{0, 0, 0, 1, 0.f}, {0.5, 0, 0, 1, 0.f}, {1, 1, 0, 0, 1.f}}, 0, 1, 256);
+  Image naive = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 0, 0, false, 32);
+  EXPECT_FALSE(hasNonFinite(naive));
+  EXPECT_GT(test::coverage(naive), 0.1);  // the Inf half is opaque red
+  checkAllBuilders(v, tf, 0, 0, true);
+}
+
 // The parallel range pass (many chunks) equals the serial definition: finite values only, the
 // extremes found wherever they lie, and no finite value at all reports an empty range.
 TEST(Extremes, ScalarRangeParallelSkipsNonFinite) {

@@ -82,9 +82,9 @@ TEST(VolumeIO, NrrdRoundTripAndErrors) {
   writeFile(dir / "badtype.nrrd", "NRRD0004\ntype: quaternion\ndimension: 3\nsizes: 2 2 2\n\n");
   EXPECT_NE(errorOf((dir / "badtype.nrrd").string()).find("unsupported NRRD type"), std::string::npos);
   writeFile(dir / "nosizes.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\n\n");
-  EXPECT_NE(errorOf((dir / "nosizes.nrrd").string()).find("lacks"), std::string::npos);
+  EXPECT_NE(errorOf((dir / "nosizes.nrrd").string()).find("field 'sizes': required field missing"), std::string::npos);
   writeFile(dir / "zero.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 0 2 2\nencoding: raw\n\n");
-  EXPECT_NE(errorOf((dir / "zero.nrrd").string()).find("empty extent"), std::string::npos);
+  EXPECT_NE(errorOf((dir / "zero.nrrd").string()).find("field 'sizes': '0' is not a positive"), std::string::npos);
   std::string header = "NRRD0004\ntype: uint16\nendian: big\ndimension: 1\nsizes: 2\nencoding: raw\n\n";
   writeFile(dir / "big.nrrd", header + std::string("\x01\x02\x00\x05", 4));
   Volume b = loadVolume((dir / "big.nrrd").string());

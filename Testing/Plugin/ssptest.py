@@ -113,7 +113,8 @@ def stats(disp):
     disp.UpdatePropertyInformation()
     names = ["BuilderUsed", "BackendUsed", "LastBuildSeconds", "LastClassifySeconds",
              "LastRenderSeconds", "NodeCount", "LeafCount", "TreeHeight", "Occupancy",
-             "BuildCount", "ClassifyCount", "ColorUpdateCount", "FrameCount"]
+             "BuildCount", "ClassifyCount", "ColorUpdateCount", "FrameCount",
+             "SampleDistanceUsed", "BuilderChoice"]
     return {n: disp.GetPropertyValue(n) for n in names}
 
 

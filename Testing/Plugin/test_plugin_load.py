@@ -19,7 +19,7 @@ ok.check("Volume" in types, "the stock 'Volume' type is still offered")
 
 enums = {
     "Builder": ["Naive", "Grid", "LBVH", "LBVHCPU", "KdTreeCPU", "KdTreeGPU", "KdTreeGPUFast",
-                "Hybrid", "DistanceGrid"],
+                "Hybrid", "DistanceGrid", "Auto"],
     "LeafCriterion": ["Shallow", "Deep"],
     "Backend": ["Auto", "CPU", "CUDA"],
 }
@@ -40,6 +40,8 @@ ok.check(dom is not None and dom.GetMinimumExists(0) and dom.GetMinimum(0) == 0.
          "SampleDistance range domain min 0")
 ok.check(disp.GetPropertyValue("MacroCellSize") == 8, "MacroCellSize defaults to 8 (%r)"
          % disp.GetPropertyValue("MacroCellSize"))
+ok.check(disp.GetPropertyValue("Builder") == "Auto", "Builder defaults to Auto (%r)"
+         % disp.GetPropertyValue("Builder"))
 ok.check(disp.GetProperty("EarlyRayTermination").SMProperty.GetDomain("bool") is not None,
          "EarlyRayTermination boolean domain")
 
@@ -53,7 +55,8 @@ for name in ["Builder", "LeafCriterion", "MaxLeafSize", "BinCount", "MacroCellSi
 
 for name in ["BuilderUsed", "BackendUsed", "LastBuildSeconds", "LastClassifySeconds",
              "LastRenderSeconds", "NodeCount", "LeafCount", "TreeHeight", "Occupancy",
-             "BuildCount", "ClassifyCount", "ColorUpdateCount", "FrameCount"]:
+             "BuildCount", "ClassifyCount", "ColorUpdateCount", "FrameCount", "BuilderChoice",
+             "SampleDistanceUsed"]:
     prop = disp.GetProperty(name)
     ok.check(prop is not None and prop.SMProperty.GetInformationOnly(),
              "%s is an information (read-only) property" % name)

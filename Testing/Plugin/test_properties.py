@@ -44,7 +44,19 @@ for i, name in enumerate(names):
     p = ssptest.psnr(naive, img)
     ok.check(p >= 40.0, "Builder %s (ran %s): image == Naive image (PSNR %.2f dB)"
              % (name, s["BuilderUsed"], p))
-    if name != "Naive":
+    if name == "Auto":
+        # One measured frame per candidate (CPU: Naive, Grid, DistanceGrid, KdTreeCPU), each the
+        # Naive image; then the fastest is kept and says why.
+        for k in range(4):
+            img = shot("prop_builder_Auto_%d.png" % k)
+            p = min(p, ssptest.psnr(naive, img))
+        s = ssptest.stats(disp)
+        ok.check(p >= 40.0, "Builder Auto: every measuring frame == Naive image (PSNR %.2f dB)" % p)
+        ok.check(s["BuilderChoice"].startswith("Auto: " + s["BuilderUsed"]),
+                 "Builder Auto: kept %s and says why (%s)" % (s["BuilderUsed"], s["BuilderChoice"]))
+        ok.check(s["BuildCount"] >= before["BuildCount"] + 4,
+                 "Builder Auto: built each candidate (%d -> %d)" % (before["BuildCount"], s["BuildCount"]))
+    elif name != "Naive":
         ok.check(s["BuildCount"] == before["BuildCount"] + 1,
                  "Builder %s: exactly one rebuild (%d -> %d)" % (name, before["BuildCount"],
                                                                s["BuildCount"]))
@@ -53,7 +65,7 @@ for i, name in enumerate(names):
         ok.check(s["NodeCount"] >= 1 and s["LeafCount"] >= 1,
                  "Builder %s: hierarchy reported (%d nodes, %d leaves, height %d)"
                  % (name, s["NodeCount"], s["LeafCount"], s["TreeHeight"]))
-    if s["BuilderUsed"] != name:
+    if s["BuilderUsed"] != name and name != "Auto":
         print("note: Builder %s fell back to %s on this machine" % (name, s["BuilderUsed"]))
     ok.check(0.0 < s["Occupancy"] < 1.0, "Builder %s: occupancy %.3f in (0, 1)"
              % (name, s["Occupancy"]))
@@ -171,6 +183,14 @@ fine = shot("prop_sd025.png")
 p_fine = ssptest.psnr(ref, fine)
 ok.check(p_fine > p_coarse, "a finer distance (0.25) stays closer to auto (0.5) than 2.0 does "
          "(%.2f > %.2f dB)" % (p_fine, p_coarse))
+# A typo far below the voxel size (1e-4 ran for minutes and froze the GUI) is clamped to 1/16
+# of the smallest spacing (1 here: auto is 0.5), said once, and shown as Sample Distance Used.
+roundtrip("SampleDistance", 1e-6, 1e-6)
+tiny = shot("prop_sd_tiny.png")
+used = ssptest.stats(disp)["SampleDistanceUsed"]
+ok.check(used >= 1.0 / 16 * 0.999 and used <= 1.0 / 16 * 1.001,
+         "SampleDistance 1e-6 is clamped to 1/16 of the spacing (used %g)" % used)
+ok.check(ssptest.psnr(ref, tiny) > 30.0, "... and draws the volume")
 roundtrip("SampleDistance", 0.0, 0.0)
 again = shot("prop_sd_auto.png")
 ok.check(ssptest.psnr(ref, again) >= 60.0, "SampleDistance 0 (auto) renders the first image again")

@@ -5,6 +5,7 @@
 
 #include "vtkColorTransferFunction.h"
 #include "vtkCommand.h"
+#include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkPiecewiseFunction.h"
@@ -13,6 +14,7 @@
 #include "vtkRenderWindow.h"
 #include "vtkSmartPointer.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 #include "vtkWindowToImageFilter.h"
 
@@ -69,6 +71,29 @@ inline vtkSmartPointer<vtkImageData> Capture(vtkRenderWindow* win)
   vtkSmartPointer<vtkImageData> img = vtkSmartPointer<vtkImageData>::New();
   img->DeepCopy(w2i->GetOutput());
   return img;
+}
+
+// Points `volume` at `mapper`, renders the window and captures it.
+inline vtkSmartPointer<vtkImageData> RenderWith(
+  vtkRenderWindow* win, vtkVolume* volume, vtkAbstractVolumeMapper* mapper)
+{
+  volume->SetMapper(mapper);
+  win->Render();
+  return Capture(win);
+}
+
+// VTK's own GPU ray caster at a fixed sample distance, without jitter: the reference of the
+// comparison tests.
+inline vtkSmartPointer<vtkGPUVolumeRayCastMapper> ReferenceGPUMapper(
+  vtkImageData* image, double sampleDistance)
+{
+  auto gpu = vtkSmartPointer<vtkGPUVolumeRayCastMapper>::New();
+  gpu->SetInputData(image);
+  gpu->AutoAdjustSampleDistancesOff();
+  gpu->LockSampleDistanceToInputSpacingOff();
+  gpu->SetSampleDistance(sampleDistance);
+  gpu->UseJitteringOff();
+  return gpu;
 }
 
 inline unsigned char* Pixels(vtkImageData* img)

@@ -38,6 +38,8 @@ int TestSpaceSkippingVolumeMultiple(int argc, char* argv[])
   m8->SetInputConnection(toU8->GetOutputPort());
   m16->SetInputConnection(toI16->GetOutputPort());
   mf->SetInputData(wavelet);
+  m8->SetBuilderToGrid(); // a fixed structure each: the test counts builds
+  mf->SetBuilderToGrid();
   m16->SetBuilderToNaive();
 
   vtkNew<vtkVolumeProperty> p8, p16, pf;

@@ -54,6 +54,7 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
   mapper->SetInputData(image);
   mapper->SetBackendToCPU();
+  mapper->SetBuilderToGrid(); // Auto would measure several structures: the test counts builds
   vtkNew<vtkVolumeProperty> prop;
   sstest::SetupProperty(prop, lo, hi, 0.6);
   vtkNew<vtkVolume> volume;

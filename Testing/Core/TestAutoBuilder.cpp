@@ -1,0 +1,104 @@
+// Builder Auto: one measured frame per candidate (Naive among them), then the fastest; every
+// frame equals Naive's image; measured again only when the occupancy moves or the size changes.
+#include "TestUtil.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace spaceskip;
+
+namespace {
+struct Scene {
+  Volume v = generateVolume("nbody", vec3l{64, 64, 64});
+  TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
+  Camera cam;
+  Scene() {
+    double b[6];
+    v.worldBounds(b);
+    cam = orbitCamera(b, 30, 20, 1.0, false, 1.0);
+  }
+};
+}  // namespace
+
+TEST(AutoBuilder, EveryFrameEqualsNaiveAndTheFastestIsKept) {
+  Scene s;
+  Image naive = test::renderWith(s.v, s.tf, test::builder(BuilderKind::Naive), 30, 20, false, 64);
+  Engine e(BackendKind::CPU);
+  e.setLogger([](const std::string&) {});
+  e.setVolume(s.v);
+  e.setTransferFunction(s.tf);
+  e.setBuildParams(test::builder(BuilderKind::Auto));
+  std::vector<BuilderKind> used;
+  Image img;
+  int frames = 0;
+  while (e.exploring() && frames < 10) {
+    e.render(s.cam, 64, 64, img);
+    ++frames;
+    used.push_back(e.buildStats().builder);
+    EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f) << "frame " << frames;
+  }
+  ASSERT_FALSE(e.exploring());
+  ASSERT_EQ(frames, 4) << "one frame per CPU candidate";
+  EXPECT_EQ(used[0], BuilderKind::Naive);  // the reference is always measured
+  const std::string choice = e.buildStats().choice;
+  EXPECT_EQ(choice.rfind("Auto: ", 0), 0u) << choice;
+  EXPECT_NE(choice.find("Naive"), std::string::npos) << choice;
+  // The kept structure is the one the line names first, and the next frame draws with it.
+  e.render(s.cam, 64, 64, img);
+  EXPECT_EQ(choice.find(std::string("Auto: ") + builderName(e.buildStats().builder)), 0u) << choice;
+  EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f);
+  // Settled: more frames build nothing.
+  const int builds = e.counters().builds;
+  for (int i = 0; i < 3; ++i) e.render(s.cam, 64, 64, img);
+  EXPECT_EQ(e.counters().builds, builds);
+  EXPECT_FALSE(e.exploring());
+}
+
+TEST(AutoBuilder, SmallOccupancyChangesRebuildOnlyTheChoiceLargeOnesMeasureAgain) {
+  Scene s;
+  Engine e(BackendKind::CPU);
+  e.setLogger([](const std::string&) {});
+  e.setVolume(s.v);
+  e.setTransferFunction(s.tf);
+  e.setBuildParams(test::builder(BuilderKind::Auto));
+  Image img;
+  while (e.exploring()) e.render(s.cam, 48, 48, img);
+  // A slightly higher threshold: a few cells change, the chosen structure is rebuilt once.
+  auto tf1 = TransferFunction::fromPoints({{0, 1, 1, 1, 0.f}, {30, 1, 1, 1, 0.f}, {255, 1, 0, 0, 0.8f}}, 0, 255, 256);
+  auto tf2 = TransferFunction::fromPoints({{0, 1, 1, 1, 0.f}, {34, 1, 1, 1, 0.f}, {255, 1, 0, 0, 0.8f}}, 0, 255, 256);
+  e.setTransferFunction(tf1);
+  e.render(s.cam, 48, 48, img);
+  while (e.exploring()) e.render(s.cam, 48, 48, img);
+  const double occ1 = e.buildStats().occupancy;
+  const int builds1 = e.counters().builds;
+  e.setTransferFunction(tf2);
+  e.render(s.cam, 48, 48, img);
+  const double occ2 = e.buildStats().occupancy;
+  ASSERT_LT(std::fabs(occ2 - occ1), 0.1) << "test premise: a small change";
+  EXPECT_FALSE(e.exploring());
+  EXPECT_LE(e.counters().builds, builds1 + 1);
+  // Opaque everywhere: every cell occupied, a large change: measured again.
+  e.setTransferFunction(TransferFunction::preset("opaque", 0, 255, 256));
+  e.render(s.cam, 48, 48, img);
+  ASSERT_GT(std::fabs(e.buildStats().occupancy - occ2), 0.1) << "test premise: a large change";
+  EXPECT_TRUE(e.exploring());
+}
+
+TEST(AutoBuilder, ANewViewSizeOrParametersMeasureAgain) {
+  Scene s;
+  Engine e(BackendKind::CPU);
+  e.setLogger([](const std::string&) {});
+  e.setVolume(s.v);
+  e.setTransferFunction(s.tf);
+  e.setBuildParams(test::builder(BuilderKind::Auto));
+  Image img;
+  while (e.exploring()) e.render(s.cam, 48, 48, img);
+  e.render(s.cam, 64, 48, img);
+  EXPECT_TRUE(e.exploring()) << "a frame time at another size is not comparable";
+  while (e.exploring()) e.render(s.cam, 64, 48, img);
+  BuildParams p = test::builder(BuilderKind::Auto);
+  p.brick = 4;
+  e.setBuildParams(p);
+  EXPECT_TRUE(e.exploring());
+}
