@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Packs, on the development machine (Debian 12 + ParaView 5.11), what the VTK mapper tests and the
 # window benchmark need on a GPU machine that has no VTK, X server or GL loader (DEVICE.md):
-#   .vtkbundle/vtk.tar.xz  bin/: vtkSpaceSkipCxxTests, spaceskip_window_bench, spaceskip (CLI);
+#   .vtkbundle/vtk.tar.xz  bin/: vtkSpaceSkipCxxTests, spaceskip_window_bench, spaceskip (CLI),
+#                          spaceskip_core_tests (Core's GoogleTest binary, when built);
 #                          lib/: libvtkSpaceSkip.so (built with CUDA), libEGL (glvnd) + the closure of shared
 #                          libraries they load (ldd), minus glibc and libstdc++/libgcc_s (the
 #                          GPU machine's own are newer);
@@ -50,10 +51,15 @@ copy_libs() {  # DESTDIR FILE...
 # --- VTK part ---------------------------------------------------------------------------------
 v=$stage/vtk
 mkdir -p "$v/bin" "$v/lib"
-for exe in bin/vtkSpaceSkipCxxTests bin/spaceskip_window_bench Core/spaceskip; do
+# BUNDLE_NO_CLI=1 leaves the CLI out (its CUDA kernels are ~5 MB of xz) when the bundle must shrink.
+exes="bin/vtkSpaceSkipCxxTests bin/spaceskip_window_bench"
+[ "${BUNDLE_NO_CLI:-0}" = 1 ] || exes="$exes Core/spaceskip"
+for exe in $exes; do
   [ -x "$build/$exe" ] || { echo "bundle-vtk: $build/$exe missing (build first)" >&2; exit 1; }
   cp "$build/$exe" "$v/bin/"
 done
+# Core's GoogleTest binary (CUDA tests included): run and sanitized on the device without a build.
+[ -x "$build/Testing/spaceskip_core_tests" ] && cp "$build/Testing/spaceskip_core_tests" "$v/bin/"
 cp -L "$build/lib/libvtkSpaceSkip.so" "$v/lib/"
 copy_libs "$v/lib" "$v/bin/"* "$build/lib/libvtkSpaceSkip.so"
 # glvnd's libEGL, dlopen()ed by the window benchmark's --egl mode (NVIDIA's headless EGL).

@@ -9,10 +9,13 @@
 #
 #   Testing/gpu/run-gpu-vtk.sh OUTDIR [PHASE...]
 #   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
-#          bench-ert
+#          bench-ert core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
+#          its CUDA tests: core.log) auto (the CLI's Builder Auto against fixed builders, dense and
+#          sparse 1024^3: cli-bench.log)
 #          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024
 #          bench-host bench-float bench-ert)
-#   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), DEADLINE (epoch seconds: phases that would
+#   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), TESTS_ASIS (1: the tests once more
+#          without the CUDA override), DEADLINE (epoch seconds: phases that would
 #          start after it are skipped), MEMCHECK_TESTS, BENCH_BUILDERS, VTK_GPU (1: also time
 #          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks), REQUIRE_NVIDIA_GL (set: stop
 #          when only Mesa works), BENCH_N (every benchmark at this size instead: quick checks)
@@ -145,9 +148,9 @@ run_tests() {  # BACKEND LOGNAME (BACKEND "asis": no override, each test's own B
 if has tests && ! late; then
   log "VTK mapper tests, CUDA forced"
   run_tests cuda tests-cuda.log
-  run_tests asis tests-asis.log
-  { grep -E "^SUMMARY|rc=|SpaceSkip: backend|Backend|PSNR|max diff|check failed|ERROR|Warning|error" \
-      "$work/tests-cuda.log" | head -400; grep -E "^SUMMARY" "$work/tests-asis.log"; } > "$out/tests.log"
+  [ "${TESTS_ASIS:-1}" = 1 ] && run_tests asis tests-asis.log
+  { grep -E "^SUMMARY|rc=|SpaceSkip: backend|Backend|PSNR|max diff|check failed|ERROR|Warning|error|RSS|device bytes" \
+      "$work/tests-cuda.log" | head -400; grep -hE "^SUMMARY" "$work"/tests-asis.log 2>/dev/null; } > "$out/tests.log"
 fi
 
 # --- compute-sanitizer memcheck on mapper tests (CUDA) ----------------------------------------
@@ -218,6 +221,39 @@ has bench-float && ITEMS=Grid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[
 if has bench-ert; then
   ITEMS=Naive,Grid,KdTreeGPUFast:mls32,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --ert
   ITEMS=Naive,Grid,KdTreeGPUFast:mls32,Hybrid window_bench menger 1024 "${v2[@]}" --ert
+fi
+
+# --- Core's tests (CUDA included) and compute-sanitizer on its CUDA tests ------------------------
+coretests=$B/vtk/bin/spaceskip_core_tests
+if has core && ! late && [ -x "$coretests" ]; then
+  log "Core tests"
+  timeout 400 "$coretests" > "$work/core-tests.log" 2>&1
+  rc=$?
+  log "Core tests rc=$rc"
+  [ $rc -eq 0 ] || status=1
+  { echo "==== spaceskip_core_tests rc=$rc"; grep -E "^\[  (PASSED|FAILED|SKIPPED) |tests ran|FAILED TEST" "$work/core-tests.log" | head -40; } > "$out/core.log"
+  filter=${CORE_SANITIZE_FILTER:-CudaBackend.*:BlendModes.CudaEqualsCpu*:Volumes/CudaImage.EqualsCpuForEveryBuilder/nbody_*}
+  for tool in memcheck racecheck; do
+    late && break
+    log "compute-sanitizer $tool on $filter"
+    timeout 240 compute-sanitizer --tool $tool --error-exitcode 99 "$coretests" --gtest_filter="$filter" \
+      > "$work/core-$tool.log" 2>&1
+    rc=$?
+    log "$tool rc=$rc"
+    [ $rc -eq 0 ] || status=1
+    { echo "==== $tool ($filter) rc=$rc"; grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race|^\[  (PASSED|FAILED) " "$work/core-$tool.log" | head -20; } >> "$out/core.log"
+  done
+fi
+
+# --- Builder Auto against fixed builders (CLI, kernel fps), a dense and a sparse volume ----------
+if has auto && ! late; then
+  for shape in menger nbody; do
+    log "CLI bench auto gen:$shape:${BENCH_N:-1024}"
+    timeout 300 "$cli" bench "gen:$shape:${BENCH_N:-1024}" --backend cuda --size 1024x1024 --frames "$frames" \
+      --builders naive,grid,distance-grid,kdtree-gpu-fast:deep:mls128,lbvh,auto >> "$work/cli-bench.log" 2>&1
+    log "CLI bench rc=$?"
+  done
+  cp "$work/cli-bench.log" "$out/cli-bench.log"
 fi
 
 stop_xvfb
