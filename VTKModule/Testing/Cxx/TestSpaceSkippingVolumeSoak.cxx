@@ -174,7 +174,9 @@ int TestSpaceSkippingVolumeSoak(int, char*[])
   }
   SS_CHECK(said >= 1); // at least the clamped sample distance was reported
   SS_CHECK(said <= 8);
-  SS_CHECK(rss3 - rss2 <= 4.0 * 1048576.0);
+  // Each backend switch makes a new engine (and CUDA stream/events on a GPU): a bound, not zero.
+  // Measured on the H100: +0.95 MB; under compute-sanitizer memcheck +5 MB (its own bookkeeping).
+  SS_CHECK(rss3 - rss2 <= 8.0 * 1048576.0);
   vtkOutputWindow::SetInstance(nullptr);
   return ok ? EXIT_SUCCESS : EXIT_FAILURE;
 }
