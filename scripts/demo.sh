@@ -13,7 +13,7 @@ echo "== render a 256^3 Menger sponge (paper's data set shape), naive vs grid sk
 "$cli" render gen:menger:256 --builder naive --size 512x512 -o "$out/menger_naive.png"
 "$cli" render gen:menger:256 --builder grid --size 512x512 -o "$out/menger_grid.png" --compare "$out/menger_naive.png"
 echo "== benchmark (paper protocol at 512x512 on the CPU backend: orthographic, rotating camera, no ERT)"
-"$cli" bench gen:menger:256 gen:nbody:256 --builders naive,grid,distance-grid --size 512x512 --frames 4 --json "$out/bench.json"
+"$cli" bench gen:menger:256 gen:nbody:256 --builders naive,grid,distance-grid,auto --size 512x512 --frames 4 --json "$out/bench.json"
 plugin="$root/build/lib/paraview-5.11/plugins/SpaceSkip/SpaceSkip.so"
 if [ -f "$plugin" ]; then
   echo "== ParaView: pvbatch loads the SpaceSkip plugin and renders the MNI152 brain per builder"
