@@ -13,7 +13,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 namespace spaceskip {
 
@@ -63,21 +62,7 @@ bool parseBuilder(const std::string& s, BuilderKind& out) {
 }
 
 namespace {
-// Largest finite |v| of a floating-point voxel array, in parallel (0 when none is finite).
-template <class T>
-double maxFiniteMagnitude(const T* p, int64_t n) {
-  return tbb::parallel_reduce(
-      tbb::blocked_range<int64_t>(0, n, int64_t(1) << 16), 0.0,
-      [p](const tbb::blocked_range<int64_t>& r, double m) {
-        for (int64_t i = r.begin(); i < r.end(); ++i) {
-          const double a = std::fabs(double(p[i]));
-          if (a > m && std::isfinite(a)) m = a;
-        }
-        return m;
-      },
-      [](double a, double b) { return std::max(a, b); });
-}
-
+// out[i] = in[i] * 2^exponent in float, in parallel (ldexp: exact, NaN and +-Inf kept).
 template <class T>
 void scaleToFloat(const T* in, float* out, int64_t n, int exponent) {
   tbb::parallel_for(tbb::blocked_range<int64_t>(0, n, int64_t(1) << 16), [=](const tbb::blocked_range<int64_t>& r) {
@@ -235,13 +220,16 @@ struct Engine::Impl {
 
   void describeAutoChoice() {
     AutoState& a = autoState;
-    char line[512];
-    int n = std::snprintf(line, sizeof line, "Auto: %s (%.3g ms/frame) at occupancy %.3f%s; measured",
-                          builderName(a.candidates[size_t(a.current)].builder), 1e3 * a.seconds[size_t(a.current)],
-                          a.occupancy, a.switches ? (", switched " + std::to_string(a.switches) + "x").c_str() : "");
-    for (size_t i = 0; i < a.seconds.size() && n > 0 && size_t(n) < sizeof line; ++i)
-      n += std::snprintf(line + n, sizeof line - size_t(n), "%s %s %.3g", i ? "," : "", builderName(a.candidates[i].builder),
-                         1e3 * a.seconds[i]);
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "Auto: %s (%.3g ms/frame) at occupancy %.3f",
+                  builderName(a.candidates[size_t(a.current)].builder), 1e3 * a.seconds[size_t(a.current)], a.occupancy);
+    std::string line = buf;
+    if (a.switches) line += ", switched " + std::to_string(a.switches) + "x";
+    line += "; measured";
+    for (size_t i = 0; i < a.seconds.size(); ++i) {
+      std::snprintf(buf, sizeof buf, "%s %s %.3g", i ? "," : "", builderName(a.candidates[i].builder), 1e3 * a.seconds[i]);
+      line += buf;
+    }
     a.choice = line;
     stats.choice = a.choice;
   }
@@ -281,10 +269,7 @@ struct Engine::Impl {
     return t;
   }
 
-  double dt() const {
-    std::string note;
-    return effectiveSampleDistance(volume, render.sampleDistance, &note);
-  }
+  double dt() const { return effectiveSampleDistance(volume, render.sampleDistance); }
 
   void update() {
     if (!haveVolume) throw std::runtime_error("no volume set");
@@ -374,8 +359,8 @@ void Engine::setVolume(const Volume& v) {
   // the one of the unscaled data. NaN stays NaN and +-Inf stays +-Inf in the copy.
   if (v.type == VoxelType::Float32 || v.type == VoxelType::Float64) {
     const int64_t n = v.voxelCount();
-    const double m = v.type == VoxelType::Float32 ? maxFiniteMagnitude(static_cast<const float*>(v.data), n)
-                                                  : maxFiniteMagnitude(static_cast<const double*>(v.data), n);
+    double lo = 0, hi = 0;  // the parallel finite range pass (NaN and +-Inf skipped)
+    const double m = v.scalarRange(lo, hi) ? std::max(std::fabs(lo), std::fabs(hi)) : 0.0;
     if (m > 0 && (m > 0x1p60 || m < 0x1p-60)) {
       int e = 0;
       std::frexp(m, &e);
@@ -493,8 +478,9 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   }
   const mat4 ivpRel = multiply(toOrigin, ivp);
   for (int i = 0; i < 16; ++i) f.invViewProj[i] = float(ivpRel.m[i]);
+  const mat4 indexToWorldRel = atOrigin.indexToWorld();
   mat4 w2i;
-  if (!invert(atOrigin.indexToWorld(), w2i)) throw std::invalid_argument("volume direction/spacing is singular");
+  if (!invert(indexToWorldRel, w2i)) throw std::invalid_argument("volume direction/spacing is singular");
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) f.worldToIndex[r * 4 + c] = float(w2i.m[c * 4 + r]);
   f.width = width;
@@ -504,7 +490,6 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.dt = float(d.dt());
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
   // Clipping planes and cropping planes into the index space of the integrator (in double).
-  const mat4 indexToWorldRel = atOrigin.indexToWorld();
   const double* L = indexToWorldRel.m;  // column-major: index axis c is column c
   f.numClipPlanes = 0;
   if (int(d.render.clipPlanes.size()) > kMaxClipPlanes)
