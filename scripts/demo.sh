@@ -17,13 +17,7 @@ echo "== benchmark (paper protocol at 512x512 on the CPU backend: orthographic, 
 plugin="$root/build/lib/paraview-5.11/plugins/SpaceSkip/SpaceSkip.so"
 if [ -f "$plugin" ]; then
   echo "== ParaView: pvbatch loads the SpaceSkip plugin and renders the MNI152 brain per builder"
-  if [ -z "${DISPLAY:-}" ]; then
-    export DISPLAY=:${SPACESKIP_XVFB_DISPLAY:-92}
-    Xvfb "$DISPLAY" -screen 0 1280x1024x24 -nolisten tcp -noreset >/dev/null 2>&1 &
-    xvfb_pid=$!
-    trap 'kill $xvfb_pid 2>/dev/null || true' EXIT
-    sleep 1
-  fi
+  source "$root/scripts/xvfb.sh" 92
   timeout 600 pvbatch "$root/scripts/demo_pvbatch.py" "$plugin" "$root/Data" "$out"
 fi
 echo "images and bench.json in $out"

@@ -9,13 +9,7 @@ bash "$root/scripts/setup-debian.sh"
 bash "$root/scripts/build.sh"
 
 # One Xvfb for all rendering tests (VTK/ParaView here need an X server).
-if [ -z "${DISPLAY:-}" ]; then
-  export DISPLAY=:${SPACESKIP_XVFB_DISPLAY:-91}
-  Xvfb "$DISPLAY" -screen 0 1280x1024x24 -nolisten tcp -noreset >/dev/null 2>&1 &
-  xvfb_pid=$!
-  trap 'kill $xvfb_pid 2>/dev/null || true' EXIT
-  sleep 1
-fi
+source "$root/scripts/xvfb.sh" 91
 (cd "$root/build" && ctest --output-on-failure -j "$(nproc)" --timeout 600)
 
 echo "== Core tests under ASan + UBSan"

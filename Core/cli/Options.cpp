@@ -32,6 +32,18 @@ const std::set<std::string>& flagOptions() {
   static const std::set<std::string> s = {"--perspective", "--jitter"};
   return s;
 }
+
+/// `s` cut at every `sep`, empty pieces kept ("4,,5" -> "4", "", "5").
+std::vector<std::string> splitAt(const std::string& s, char sep) {
+  std::vector<std::string> parts;
+  size_t pos = 0;
+  for (;;) {
+    const size_t x = s.find(sep, pos);
+    parts.push_back(s.substr(pos, x == std::string::npos ? std::string::npos : x - pos));
+    if (x == std::string::npos) return parts;
+    pos = x + 1;
+  }
+}
 }  // namespace
 
 int64_t parseIntArg(const std::string& text, const std::string& what, int64_t lo, int64_t hi) {
@@ -88,14 +100,7 @@ Options parseArgs(int argc, const char* const* argv, int first) {
 }
 
 vec3l parseDims(const std::string& s, const std::string& what) {
-  std::vector<std::string> parts;
-  size_t pos = 0;
-  for (;;) {
-    size_t x = s.find('x', pos);
-    parts.push_back(s.substr(pos, x == std::string::npos ? std::string::npos : x - pos));
-    if (x == std::string::npos) break;
-    pos = x + 1;
-  }
+  const std::vector<std::string> parts = splitAt(s, 'x');
   if (parts.size() != 1 && parts.size() != 3) throw bad(what, s, "is not N or XxYxZ");
   int64_t v[3];
   for (size_t i = 0; i < parts.size(); ++i) v[i] = parseIntArg(parts[i], what + " (dims)", 1, kMaxAxisVoxels);
@@ -110,14 +115,7 @@ void parseSize(const std::string& s, int& w, int& h) {
 }
 
 void parseCamera(const std::string& s, double& az, double& el, double& zoom) {
-  std::vector<std::string> p;
-  size_t pos = 0;
-  for (;;) {
-    size_t c = s.find(',', pos);
-    p.push_back(s.substr(pos, c == std::string::npos ? std::string::npos : c - pos));
-    if (c == std::string::npos) break;
-    pos = c + 1;
-  }
+  const std::vector<std::string> p = splitAt(s, ',');
   if (p.size() < 2 || p.size() > 3) throw bad("--camera", s, "is not AZ,EL[,ZOOM]");
   // Angles wrap; the bound only keeps them meaningful in float. Zoom > 0 keeps the view finite.
   az = parseDoubleArg(p[0], "--camera (azimuth)", -1e6, 1e6);

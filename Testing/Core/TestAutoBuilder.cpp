@@ -12,11 +12,13 @@ namespace {
 struct Scene {
   Volume v = generateVolume("nbody", vec3l{64, 64, 64});
   TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
-  Camera cam;
-  Scene() {
-    double b[6];
-    v.worldBounds(b);
-    cam = orbitCamera(b, 30, 20, 1.0, false, 1.0);
+  Camera cam = test::orbit(v, 30, 20);
+  Engine e{BackendKind::CPU};  // on this scene with Builder Auto
+  Image img;
+  Scene() { test::load(e, v, tf, test::builder(BuilderKind::Auto)); }
+  /// Frames of `w` x `h` until Auto has measured its candidates and settled.
+  void settle(int w, int h) {
+    while (e.exploring()) e.render(cam, w, h, img);
   }
 };
 }  // namespace
@@ -24,13 +26,9 @@ struct Scene {
 TEST(AutoBuilder, EveryFrameEqualsNaiveAndTheFastestIsKept) {
   Scene s;
   Image naive = test::renderWith(s.v, s.tf, test::builder(BuilderKind::Naive), 30, 20, false, 64);
-  Engine e(BackendKind::CPU);
-  e.setLogger([](const std::string&) {});
-  e.setVolume(s.v);
-  e.setTransferFunction(s.tf);
-  e.setBuildParams(test::builder(BuilderKind::Auto));
+  Engine& e = s.e;
+  Image& img = s.img;
   std::vector<BuilderKind> used;
-  Image img;
   int frames = 0;
   while (e.exploring() && frames < 10) {
     e.render(s.cam, 64, 64, img);
@@ -62,19 +60,15 @@ TEST(AutoBuilder, EveryFrameEqualsNaiveAndTheFastestIsKept) {
 
 TEST(AutoBuilder, SmallOccupancyChangesRebuildOnlyTheChoiceLargeOnesMeasureAgain) {
   Scene s;
-  Engine e(BackendKind::CPU);
-  e.setLogger([](const std::string&) {});
-  e.setVolume(s.v);
-  e.setTransferFunction(s.tf);
-  e.setBuildParams(test::builder(BuilderKind::Auto));
-  Image img;
-  while (e.exploring()) e.render(s.cam, 48, 48, img);
+  Engine& e = s.e;
+  Image& img = s.img;
+  s.settle(48, 48);
   // A slightly higher threshold: a few cells change, the chosen structure is rebuilt once.
   auto tf1 = TransferFunction::fromPoints({{0, 1, 1, 1, 0.f}, {30, 1, 1, 1, 0.f}, {255, 1, 0, 0, 0.8f}}, 0, 255, 256);
   auto tf2 = TransferFunction::fromPoints({{0, 1, 1, 1, 0.f}, {34, 1, 1, 1, 0.f}, {255, 1, 0, 0, 0.8f}}, 0, 255, 256);
   e.setTransferFunction(tf1);
   e.render(s.cam, 48, 48, img);
-  while (e.exploring()) e.render(s.cam, 48, 48, img);
+  s.settle(48, 48);
   const double occ1 = e.buildStats().occupancy;
   const int builds1 = e.counters().builds;
   e.setTransferFunction(tf2);
@@ -92,16 +86,12 @@ TEST(AutoBuilder, SmallOccupancyChangesRebuildOnlyTheChoiceLargeOnesMeasureAgain
 
 TEST(AutoBuilder, ANewViewSizeOrParametersMeasureAgain) {
   Scene s;
-  Engine e(BackendKind::CPU);
-  e.setLogger([](const std::string&) {});
-  e.setVolume(s.v);
-  e.setTransferFunction(s.tf);
-  e.setBuildParams(test::builder(BuilderKind::Auto));
-  Image img;
-  while (e.exploring()) e.render(s.cam, 48, 48, img);
+  Engine& e = s.e;
+  Image& img = s.img;
+  s.settle(48, 48);
   e.render(s.cam, 64, 48, img);
   EXPECT_TRUE(e.exploring()) << "a frame time at another size is not comparable";
-  while (e.exploring()) e.render(s.cam, 64, 48, img);
+  s.settle(64, 48);
   BuildParams p = test::builder(BuilderKind::Auto);
   p.brick = 4;
   e.setBuildParams(p);

@@ -292,24 +292,12 @@ TEST(BlendModes, ValueRangesSkipSamplesInMip) {
   // Not a timing assertion: on sparse data MIP with value-range skipping takes fewer samples.
   Volume v = generateVolume("nbody", vec3l{128, 128, 128});
   auto tf = TransferFunction::preset("ramp", 0, 255);
-  double b[6];
-  v.worldBounds(b);
-  const Camera cam = orbitCamera(b, 10, 10, 1, false, 1);
+  const Camera cam = test::orbit(v, 10, 10);
+  RenderParams mip;
+  mip.blend = BlendMode::MaximumIntensity;
   int64_t samples[2];
-  Image img[2];
-  for (int i = 0; i < 2; ++i) {
-    Engine e(BackendKind::CPU);
-    e.setLogger([](const std::string&) {});
-    e.setVolume(v);
-    e.setTransferFunction(tf);
-    e.setBuildParams(test::builder(i == 0 ? BuilderKind::Naive : BuilderKind::Grid));
-    RenderParams rp;
-    rp.blend = BlendMode::MaximumIntensity;
-    rp.countSamples = true;
-    e.setRenderParams(rp);
-    e.render(cam, 64, 64, img[i]);
-    samples[i] = e.frameStats().samples;
-  }
+  Image img[2] = {test::renderCounting(v, tf, BuilderKind::Naive, cam, 64, samples[0], mip),
+                  test::renderCounting(v, tf, BuilderKind::Grid, cam, 64, samples[1], mip)};
   EXPECT_GT(samples[0], 0);
   EXPECT_LT(samples[1] * 2, samples[0]) << "naive " << samples[0] << " value ranges " << samples[1];
   EXPECT_LE(compareImages(img[0], img[1]).maxAbs, 1.f / 255.f);

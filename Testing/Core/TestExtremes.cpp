@@ -163,9 +163,7 @@ TEST(Extremes, CudaRequestWithoutDeviceFallsBackToCpu) {
 TEST(Extremes, TinySampleDistanceIsClampedOnceAndBounded) {
   Volume v = generateVolume("shell", vec3l{32, 32, 32});
   auto tf = TransferFunction::preset("ramp", 0, 255);
-  double b[6];
-  v.worldBounds(b);
-  const Camera cam = orbitCamera(b, 20, 30, 1.0, false, 1.0);
+  const Camera cam = test::orbit(v, 20, 30);
   const double floorDt = 1.0 / kMinStepsPerVoxel;  // spacing 1
   Image ref;
   {

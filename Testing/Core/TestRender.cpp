@@ -51,9 +51,7 @@ TEST(Render, GridTakesFarFewerSamplesOnSparseData) {
   // image; the speed ratio itself is printed by `spaceskip bench`.
   Volume v = generateVolume("nbody", vec3l{256, 256, 256});
   auto tf = TransferFunction::preset("ramp", 0, 255);
-  double b[6];
-  v.worldBounds(b);
-  const Camera cam = orbitCamera(b, 10, 10, 1, false, 1);
+  const Camera cam = test::orbit(v, 10, 10);
   int64_t samples[2];
   Image img[2] = {test::renderCounting(v, tf, BuilderKind::Naive, cam, 64, samples[0]),
                   test::renderCounting(v, tf, BuilderKind::Grid, cam, 64, samples[1])};
@@ -84,9 +82,7 @@ TEST(Render, DepthBufferClipsTheVolume) {
   Engine e(BackendKind::CPU);
   e.setVolume(v);
   e.setTransferFunction(tf);
-  double b[6];
-  v.worldBounds(b);
-  Camera cam = orbitCamera(b, 0, 0, 1, false, 1);
+  Camera cam = test::orbit(v, 0, 0);
   Image all, none, half;
   e.render(cam, 32, 32, all);
   std::vector<float> depth(32 * 32, 0.f);  // geometry at the near plane hides everything

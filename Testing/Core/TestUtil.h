@@ -11,20 +11,30 @@
 
 namespace spaceskip::test {
 
+/// An orbit camera around `v`'s world box (zoom 1, square view unless told).
+inline Camera orbit(const Volume& v, double az, double el, bool persp = false, double aspect = 1.0) {
+  double b[6];
+  v.worldBounds(b);
+  return orbitCamera(b, az, el, 1.0, persp, aspect);
+}
+
+/// Gives `e` a volume, a transfer function and build parameters; its log goes nowhere.
+inline void load(Engine& e, const Volume& v, const TransferFunction& tf, const BuildParams& p) {
+  e.setLogger([](const std::string&) {});
+  e.setVolume(v);
+  e.setTransferFunction(tf);
+  e.setBuildParams(p);
+}
+
 /// Renders `v` with builder `b` (CPU backend unless told) from an orbit camera.
 inline Image renderWith(const Volume& v, const TransferFunction& tf, BuildParams p, double az, double el,
                         bool persp = false, int size = 96, BackendKind backend = BackendKind::CPU,
                         RenderParams rp = RenderParams{}) {
   Engine e(backend);
-  e.setLogger([](const std::string&) {});
-  e.setVolume(v);
-  e.setTransferFunction(tf);
-  e.setBuildParams(p);
+  load(e, v, tf, p);
   e.setRenderParams(rp);
-  double b[6];
-  v.worldBounds(b);
   Image img;
-  e.render(orbitCamera(b, az, el, 1.0, persp, 1.0), size, size, img);
+  e.render(orbit(v, az, el, persp), size, size, img);
   return img;
 }
 
@@ -68,15 +78,11 @@ inline OccupancyGrid randomBrickGrid(vec3i dims, double p, unsigned seed) {
   return g;
 }
 
-/// One CPU frame of builder `k` from an orbit camera, with the samples it took.
+/// One CPU frame of builder `k` from `cam` (with render parameters `rp`), with the samples it took.
 inline Image renderCounting(const Volume& v, const TransferFunction& tf, BuilderKind k, const Camera& cam, int size,
-                            int64_t& samples) {
+                            int64_t& samples, RenderParams rp = RenderParams{}) {
   Engine e(BackendKind::CPU);
-  e.setLogger([](const std::string&) {});
-  e.setVolume(v);
-  e.setTransferFunction(tf);
-  e.setBuildParams(builder(k));
-  RenderParams rp;
+  load(e, v, tf, builder(k));
   rp.countSamples = true;
   e.setRenderParams(rp);
   Image img;

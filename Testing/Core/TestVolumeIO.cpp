@@ -73,18 +73,25 @@ TEST(VolumeIO, NrrdRoundTripAndErrors) {
   EXPECT_DOUBLE_EQ(r.spacing[2], 2.0);
   EXPECT_DOUBLE_EQ(r.value(3, 2, 1), v.value(3, 2, 1));
 
-  writeFile(dir / "nomagic.nrrd", "HELLO\n");
-  EXPECT_NE(errorOf((dir / "nomagic.nrrd").string()).find("not a NRRD"), std::string::npos);
-  writeFile(dir / "gzip.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n");
-  EXPECT_NE(errorOf((dir / "gzip.nrrd").string()).find("encoding"), std::string::npos);
-  writeFile(dir / "short.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\nabc");
-  EXPECT_NE(errorOf((dir / "short.nrrd").string()).find("too short"), std::string::npos);
-  writeFile(dir / "badtype.nrrd", "NRRD0004\ntype: quaternion\ndimension: 3\nsizes: 2 2 2\n\n");
-  EXPECT_NE(errorOf((dir / "badtype.nrrd").string()).find("unsupported NRRD type"), std::string::npos);
-  writeFile(dir / "nosizes.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\n\n");
-  EXPECT_NE(errorOf((dir / "nosizes.nrrd").string()).find("field 'sizes': required field missing"), std::string::npos);
-  writeFile(dir / "zero.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 0 2 2\nencoding: raw\n\n");
-  EXPECT_NE(errorOf((dir / "zero.nrrd").string()).find("field 'sizes': '0' is not a positive"), std::string::npos);
+  // Malformed files: each error names what is wrong.
+  struct Bad {
+    const char* file;
+    const char* bytes;
+    const char* error;
+  };
+  const Bad bad[] = {
+      {"nomagic.nrrd", "HELLO\n", "not a NRRD"},
+      {"gzip.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n", "encoding"},
+      {"short.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\nabc", "too short"},
+      {"badtype.nrrd", "NRRD0004\ntype: quaternion\ndimension: 3\nsizes: 2 2 2\n\n", "unsupported NRRD type"},
+      {"nosizes.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\n\n", "field 'sizes': required field missing"},
+      {"zero.nrrd", "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 0 2 2\nencoding: raw\n\n",
+       "field 'sizes': '0' is not a positive"},
+  };
+  for (const Bad& c : bad) {
+    writeFile(dir / c.file, c.bytes);
+    EXPECT_NE(errorOf((dir / c.file).string()).find(c.error), std::string::npos) << c.file;
+  }
   std::string header = "NRRD0004\ntype: uint16\nendian: big\ndimension: 1\nsizes: 2\nencoding: raw\n\n";
   writeFile(dir / "big.nrrd", header + std::string("\x01\x02\x00\x05", 4));
   Volume b = loadVolume((dir / "big.nrrd").string());

@@ -30,6 +30,18 @@ def roundtrip(name, value, expected):
              "%s = %r round-trips (proxy %r, mapper %r)" % (name, value, got_proxy, got_vtk))
 
 
+def change(builder, first, name, value, expected, second):
+    """With `builder`: a frame (saved as `first`), then `name` = `value` round-tripped and a
+    frame (saved as `second`). Returns the statistics before, the second frame and the
+    statistics after."""
+    disp.Builder = builder
+    shot(first)
+    before = ssptest.stats(disp)
+    roundtrip(name, value, expected)
+    img = shot(second)
+    return before, img, ssptest.stats(disp)
+
+
 naive = shot("prop_naive.png")
 s0 = ssptest.stats(disp)
 ok.check(s0["BuilderUsed"] == "Naive", "Naive ran (%s)" % s0["BuilderUsed"])
@@ -71,12 +83,8 @@ for i, name in enumerate(names):
              % (name, s["Occupancy"]))
 
 # -- MacroCellSize: 4^3 cells (DistanceGrid's best on sparse data) re-classify, image stays ----
-disp.Builder = "DistanceGrid"
-shot("prop_dg_cell8.png")
-before = ssptest.stats(disp)
-roundtrip("MacroCellSize", 4, 4)
-cell4_img = shot("prop_dg_cell4.png")
-after = ssptest.stats(disp)
+before, cell4_img, after = change("DistanceGrid", "prop_dg_cell8.png", "MacroCellSize", 4, 4,
+                                  "prop_dg_cell4.png")
 ok.check(after["BuilderUsed"] == "DistanceGrid",
          "DistanceGrid ran with MacroCellSize 4 (ran %s)" % after["BuilderUsed"])
 ok.check(after["ClassifyCount"] == before["ClassifyCount"] + 1
@@ -132,12 +140,8 @@ if kd_available:
 roundtrip("MaxLeafSize", 0, 0)
 
 # -- BinCount: parameter of the GPU k-d trees; a change rebuilds, the image stays ------------
-disp.Builder = "KdTreeGPUFast"
-shot("prop_gpufast.png")
-before = ssptest.stats(disp)
-roundtrip("BinCount", 8, 8)
-bins_img = shot("prop_bins8.png")
-after = ssptest.stats(disp)
+before, bins_img, after = change("KdTreeGPUFast", "prop_gpufast.png", "BinCount", 8, 8,
+                                 "prop_bins8.png")
 ok.check(after["BuildCount"] == before["BuildCount"] + 1, "BinCount change rebuilds once")
 ok.check(ssptest.psnr(naive, bins_img) >= 40.0, "BinCount 8 renders the Naive image")
 # 0: the sweep (KdTreeCPU's candidates); 1 has no candidate plane and clamps to 2 in the mapper.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reruns the CPU-builder measurements quoted in Testing/results/cpu-builders-256.md.
+# Reruns the CPU-builder measurements quoted in docs/results/cpu-builders-256.md.
 # usage: Testing/scripts/cpu-builders-bench.sh OUT_DIR [SPACESKIP_BINARY]
 #   THREADS="1 2" (default) oneTBB thread counts for the build-time sweep; BRICKS="8 4 2 1".
 set -euo pipefail

@@ -1,25 +1,40 @@
 // Shared scene pieces of the vtkSpaceSkippingVolumeMapper tests: a procedural volume, a transfer
-// function with empty space, window capture, image metrics and a message-collecting observer.
+// function with empty space, the window/renderer/camera scene, window capture, image metrics and
+// a message-collecting observer.
 #ifndef SpaceSkipTestHelpers_h
 #define SpaceSkipTestHelpers_h
 
+#include "vtkActor.h"
+#include "vtkCamera.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkCommand.h"
 #include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
 #include "vtkNew.h"
+#include "vtkPNGWriter.h"
 #include "vtkPiecewiseFunction.h"
 #include "vtkPointData.h"
+#include "vtkPolyDataAlgorithm.h"
+#include "vtkPolyDataMapper.h"
+#include "vtkProperty.h"
 #include "vtkRTAnalyticSource.h"
+#include "vtkRegressionTestImage.h"
 #include "vtkRenderWindow.h"
+#include "vtkRenderWindowInteractor.h"
+#include "vtkRenderer.h"
 #include "vtkSmartPointer.h"
+#include "vtkSpaceSkippingVolumeMapper.h"
+#include "vtkSphereSource.h"
+#include "vtkTestUtilities.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 #include "vtkWindowToImageFilter.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <initializer_list>
 #include <iostream>
 #include <limits>
 #include <string>
@@ -41,22 +56,42 @@ inline vtkSmartPointer<vtkImageData> MakeWavelet(int n = 64)
   return img;
 }
 
+// Replaces `prop`'s colour function by the points {x, r, g, b} and its opacity function by the
+// points {x, a}, in the order given.
+inline void SetFunctions(vtkVolumeProperty* prop, std::initializer_list<std::array<double, 4>> rgb,
+  std::initializer_list<std::array<double, 2>> opacity)
+{
+  vtkNew<vtkColorTransferFunction> ctf;
+  for (const auto& p : rgb)
+  {
+    ctf->AddRGBPoint(p[0], p[1], p[2], p[3]);
+  }
+  vtkNew<vtkPiecewiseFunction> pwf;
+  for (const auto& p : opacity)
+  {
+    pwf->AddPoint(p[0], p[1]);
+  }
+  prop->SetColor(ctf);
+  prop->SetScalarOpacity(pwf);
+}
+
 // Colour ramp over [lo, hi]; opacity 0 below 55% of the range (empty space), rising to `top`.
 inline void SetupProperty(vtkVolumeProperty* prop, double lo, double hi, double top = 0.6)
 {
-  vtkNew<vtkColorTransferFunction> ctf;
-  ctf->AddRGBPoint(lo, 0.1, 0.2, 0.9);
-  ctf->AddRGBPoint(lo + 0.6 * (hi - lo), 0.9, 0.9, 0.9);
-  ctf->AddRGBPoint(hi, 0.9, 0.3, 0.1);
-  vtkNew<vtkPiecewiseFunction> pwf;
-  pwf->AddPoint(lo, 0.0);
-  pwf->AddPoint(lo + 0.55 * (hi - lo), 0.0);
-  pwf->AddPoint(hi, top);
-  prop->SetColor(ctf);
-  prop->SetScalarOpacity(pwf);
+  SetFunctions(prop,
+    { { lo, 0.1, 0.2, 0.9 }, { lo + 0.6 * (hi - lo), 0.9, 0.9, 0.9 }, { hi, 0.9, 0.3, 0.1 } },
+    { { lo, 0.0 }, { lo + 0.55 * (hi - lo), 0.0 }, { hi, top } });
   prop->SetInterpolationTypeToLinear();
   prop->ShadeOff();
   prop->SetScalarOpacityUnitDistance(1.0);
+}
+
+// The same over `image`'s scalar range.
+inline void SetupProperty(vtkVolumeProperty* prop, vtkImageData* image, double top = 0.6)
+{
+  double range[2];
+  image->GetScalarRange(range);
+  SetupProperty(prop, range[0], range[1], top);
 }
 
 // The window's current RGB image (back buffer, after Render()).
@@ -80,6 +115,20 @@ inline vtkSmartPointer<vtkImageData> RenderWith(
   volume->SetMapper(mapper);
   win->Render();
   return Capture(win);
+}
+
+// vtkSpaceSkippingVolumeMapper on `image` with `builder`, at `sampleDistance` (0: the mapper's
+// own), with or without early ray termination.
+inline vtkSmartPointer<vtkSpaceSkippingVolumeMapper> NewMapper(vtkImageData* image,
+  int builder = vtkSpaceSkippingVolumeMapper::AutoBuilder, double sampleDistance = 0.0,
+  bool earlyRayTermination = true)
+{
+  auto mapper = vtkSmartPointer<vtkSpaceSkippingVolumeMapper>::New();
+  mapper->SetInputData(image);
+  mapper->SetBuilder(builder);
+  mapper->SetSampleDistance(sampleDistance);
+  mapper->SetEarlyRayTermination(earlyRayTermination);
+  return mapper;
 }
 
 // VTK's own GPU ray caster at a fixed sample distance, without jitter: the reference of the
@@ -192,6 +241,156 @@ public:
   int ErrorCount = 0, WarningCount = 0;
 };
 
+// Observes `object`'s warnings and errors with `messages`.
+inline void Observe(vtkObject* object, MessageCollector* messages)
+{
+  object->AddObserver(vtkCommand::WarningEvent, messages);
+  object->AddObserver(vtkCommand::ErrorEvent, messages);
+}
+
+// An opaque actor of `source`'s output in colour (r, g, b).
+inline vtkSmartPointer<vtkActor> MakeActor(vtkPolyDataAlgorithm* source, double r, double g, double b)
+{
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputConnection(source->GetOutputPort());
+  auto actor = vtkSmartPointer<vtkActor>::New();
+  actor->SetMapper(mapper);
+  actor->GetProperty()->SetColor(r, g, b);
+  return actor;
+}
+
+// A green sphere through the middle of the wavelet's box (part inside, part outside): opaque
+// geometry the rays must stop at.
+inline vtkSmartPointer<vtkActor> MakeSphereActor()
+{
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(8, 4, 6);
+  sphere->SetRadius(11);
+  sphere->SetThetaResolution(48);
+  sphere->SetPhiResolution(48);
+  return MakeActor(sphere, 0.2, 0.8, 0.3);
+}
+
+// The test's temporary directory (-T or VTK_TEMP_DIR), where the comparison tests leave images.
+inline std::string TempDir(int argc, char* argv[])
+{
+  char* tempDir =
+    vtkTestUtilities::GetArgOrEnvOrDefault("-T", argc, argv, "VTK_TEMP_DIR", "Testing/Temporary");
+  const std::string dir = tempDir;
+  delete[] tempDir;
+  return dir;
+}
+
+inline void WritePNG(vtkImageData* img, const std::string& path)
+{
+  vtkNew<vtkPNGWriter> png;
+  png->SetFileName(path.c_str());
+  png->SetInputData(img);
+  png->Write();
+}
+
+// Prints "case <name>: PSNR(<reference>, ours) = .. dB, max |diff| = ../255, drawn pixels <ref>
+// .. ours .." (no newline: callers add their own details) and returns the PSNR.
+inline double PrintComparison(const std::string& name, vtkImageData* reference, vtkImageData* ours,
+  const char* referenceName = "vtkGPUVolumeRayCastMapper", const char* shortName = "gpu")
+{
+  const double bg[3] = { 0, 0, 0 };
+  const double psnr = PSNR(reference, ours);
+  std::cout << "case " << name << ": PSNR(" << referenceName << ", ours) = " << psnr
+            << " dB, max |diff| = " << MaxDiff(reference, ours) << "/255, drawn pixels "
+            << shortName << " " << CountNonBackground(reference, bg) << " ours "
+            << CountNonBackground(ours, bg);
+  return psnr;
+}
+
+// The image tests' background.
+constexpr double kNavy[3] = { 0.1, 0.1, 0.2 };
+constexpr double kBlack[3] = { 0, 0, 0 };
+
+// What every test draws in: `mapper` with `Property` as `Volume`, in one renderer with background
+// `bg`, in a `width` x `height` window without multisampling (the baselines are made without).
+// `interactive` gives the window an interactor before its first frame (the image tests: their -I
+// option starts it).
+class Scene
+{
+public:
+  Scene(vtkAbstractVolumeMapper* mapper, int width, int height, const double bg[3] = kBlack,
+    bool interactive = false)
+  {
+    this->Volume->SetMapper(mapper);
+    this->Volume->SetProperty(this->Property);
+    this->Renderer->SetBackground(bg[0], bg[1], bg[2]);
+    this->Renderer->AddVolume(this->Volume);
+    this->Window->SetMultiSamples(0);
+    this->Window->SetSize(width, height);
+    this->Window->AddRenderer(this->Renderer);
+    if (interactive)
+    {
+      this->Interactor = vtkSmartPointer<vtkRenderWindowInteractor>::New();
+      this->Interactor->SetRenderWindow(this->Window);
+    }
+  }
+
+  vtkCamera* Camera() { return this->Renderer->GetActiveCamera(); }
+
+  // The camera reset on everything shown (or on `bounds`), turned by `azimuth` then `elevation`
+  // degrees (0: not turned), its view-up orthogonalized if asked, zoomed, clipping range reset.
+  void View(double azimuth, double elevation, double zoom = 1.0, bool orthogonalize = false,
+    const double* bounds = nullptr)
+  {
+    if (bounds)
+    {
+      this->Renderer->ResetCamera(bounds);
+    }
+    else
+    {
+      this->Renderer->ResetCamera();
+    }
+    vtkCamera* cam = this->Camera();
+    if (azimuth != 0)
+    {
+      cam->Azimuth(azimuth);
+    }
+    if (elevation != 0)
+    {
+      cam->Elevation(elevation);
+    }
+    if (orthogonalize)
+    {
+      cam->OrthogonalizeViewUp();
+    }
+    if (zoom != 1.0)
+    {
+      cam->Zoom(zoom);
+    }
+    this->Renderer->ResetCameraClippingRange();
+  }
+
+  // Renders a frame and captures it.
+  vtkSmartPointer<vtkImageData> Shot()
+  {
+    this->Window->Render();
+    return Capture(this->Window);
+  }
+
+  // The last frame against the test's baseline (vtkRegressionTestImage); the test's exit code.
+  int Regression(int argc, char* argv[])
+  {
+    const int retVal = vtkRegressionTestImage(this->Window);
+    if (retVal == vtkRegressionTester::DO_INTERACTOR && this->Interactor)
+    {
+      this->Interactor->Start();
+    }
+    return !retVal;
+  }
+
+  vtkNew<vtkVolumeProperty> Property;
+  vtkNew<vtkVolume> Volume;
+  vtkNew<vtkRenderer> Renderer;
+  vtkNew<vtkRenderWindow> Window;
+  vtkSmartPointer<vtkRenderWindowInteractor> Interactor;
+};
+
 #define SS_CHECK(cond)                                                                            \
   do                                                                                              \
   {                                                                                               \
@@ -201,6 +400,47 @@ public:
       return EXIT_FAILURE;                                                                        \
     }                                                                                             \
   } while (0)
+
+
+// The image tests' scene: the wavelet on n^3 points through `Mapper` on the CPU backend (the
+// baselines are CPU images; CUDA, forced by run-gpu-vtk.sh, equals them up to rounding) with
+// SetupProperty's transfer function, 300 x 300 on kNavy, the camera turned 30 degrees in azimuth
+// and 20 in elevation.
+struct ImageTest
+{
+  explicit ImageTest(int n = 64)
+    : Image(MakeWavelet(n))
+  {
+    this->Mapper->SetInputData(this->Image);
+    this->Mapper->SetBackendToCPU();
+    SetupProperty(this->Stage.Property, this->Image);
+    this->Stage.View(30, 20);
+  }
+
+  // Renders and prints what was drawn (non-background pixels), by which backend and builder.
+  vtkIdType Render()
+  {
+    const vtkIdType drawn = CountNonBackground(this->Stage.Shot(), kNavy);
+    std::cout << "non-background pixels: " << drawn << " of " << 300 * 300 << ", backend "
+              << this->Mapper->GetBackendUsed() << ", builder " << this->Mapper->GetBuilderUsed()
+              << ", frame " << this->Mapper->GetLastRenderSeconds() << " s\n";
+    return drawn;
+  }
+
+  // The checks of every image test, then the baseline: the volume drew something, and only
+  // where its box projects; a backend ran (CPU here, CUDA where run-gpu-vtk.sh forces it: the
+  // same baseline holds for both).
+  int Check(int argc, char* argv[], vtkIdType drawn)
+  {
+    SS_CHECK(drawn > 5000 && drawn < 300 * 300);
+    SS_CHECK(std::string(this->Mapper->GetBackendUsed()) != "none");
+    return this->Stage.Regression(argc, argv);
+  }
+
+  vtkSmartPointer<vtkImageData> Image;
+  vtkNew<vtkSpaceSkippingVolumeMapper> Mapper;
+  Scene Stage{ this->Mapper, 300, 300, kNavy, true };
+};
 
 } // namespace sstest
 

@@ -3,48 +3,19 @@
 // this build yet fall back with a logged warning; the test covers them all the same. All builders
 // run with the default 8^3 macro cells and again with 4^3 ones (MacroCellSize 4, what DistanceGrid
 // is fastest with on sparse data), against the Naive image of the 8^3 pass.
-#include "vtkCamera.h"
-#include "vtkNew.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
-
 #include "SpaceSkipTestHelpers.h"
 
 int TestSpaceSkippingVolumeBuilders(int, char*[])
 {
   auto image = sstest::MakeWavelet(80);
-  double range[2];
-  image->GetScalarRange(range);
-
-  vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
-  mapper->SetInputData(image);
-  mapper->SetSampleDistance(0.5);
+  auto mapper = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::AutoBuilder, 0.5);
   vtkNew<sstest::MessageCollector> messages;
-  mapper->AddObserver(vtkCommand::WarningEvent, messages);
-  mapper->AddObserver(vtkCommand::ErrorEvent, messages);
-  vtkNew<vtkVolumeProperty> prop;
-  sstest::SetupProperty(prop, range[0], range[1], 0.7);
-  vtkNew<vtkVolume> volume;
-  volume->SetMapper(mapper);
-  volume->SetProperty(prop);
-
-  vtkNew<vtkRenderer> ren;
-  const double bg[3] = { 0, 0, 0 };
-  ren->SetBackground(bg[0], bg[1], bg[2]);
-  ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(200, 200);
-  win->AddRenderer(ren);
-  ren->ResetCamera();
-  ren->GetActiveCamera()->Azimuth(20);
-  ren->GetActiveCamera()->Elevation(35);
-  ren->GetActiveCamera()->OrthogonalizeViewUp();
-  ren->GetActiveCamera()->Zoom(1.5);
-  ren->ResetCameraClippingRange();
+  sstest::Observe(mapper, messages);
+  sstest::Scene scene(mapper, 200, 200);
+  sstest::SetupProperty(scene.Property, image, 0.7);
+  scene.View(20, 35, 1.5, true);
+  vtkRenderWindow* win = scene.Window;
+  const double* bg = sstest::kBlack;
 
   // MacroCellSize is clamped to [1, 64].
   SS_CHECK(mapper->GetMacroCellSize() == 8);

@@ -1,42 +1,18 @@
 // Parallel and perspective cameras, side by side in two viewports of one window (so the mapper
 // also has to honour the renderer's viewport when it reads depth and draws). Regression image,
 // plus the same two viewports through vtkGPUVolumeRayCastMapper as an independent check.
-#include "vtkActor.h"
-#include "vtkCamera.h"
 #include "vtkCubeSource.h"
-#include "vtkGPUVolumeRayCastMapper.h"
-#include "vtkNew.h"
-#include "vtkPolyDataMapper.h"
-#include "vtkProperty.h"
-#include "vtkRegressionTestImage.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderWindowInteractor.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
 
 #include "SpaceSkipTestHelpers.h"
 
 int TestSpaceSkippingVolumeCameras(int argc, char* argv[])
 {
   auto image = sstest::MakeWavelet(64);
-  double range[2];
-  image->GetScalarRange(range);
-
-  vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
-  mapper->SetInputData(image);
-  mapper->SetBuilderToGrid();
+  auto mapper = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::Grid, 0.5);
   mapper->SetBackendToCPU();
-  mapper->SetSampleDistance(0.5);
-  vtkNew<vtkGPUVolumeRayCastMapper> gpu;
-  gpu->SetInputData(image);
-  gpu->AutoAdjustSampleDistancesOff();
-  gpu->LockSampleDistanceToInputSpacingOff();
-  gpu->SetSampleDistance(0.5);
-
+  auto gpu = sstest::ReferenceGPUMapper(image, 0.5);
   vtkNew<vtkVolumeProperty> prop;
-  sstest::SetupProperty(prop, range[0], range[1], 0.5);
+  sstest::SetupProperty(prop, image, 0.5);
 
   // A thin opaque bar through the volume in both views (depth read per viewport).
   vtkNew<vtkCubeSource> bar;

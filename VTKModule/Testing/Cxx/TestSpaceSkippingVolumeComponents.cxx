@@ -1,21 +1,9 @@
 // Multi-component scalars: a selected component and the magnitude, against
 // vtkSmartVolumeMapper (VTK's GPU ray caster underneath) with the same VectorMode/VectorComponent
 // in the same window (PSNR), every builder equal to Naive, and dependent components warned once.
-#include "vtkCamera.h"
-#include "vtkCommand.h"
 #include "vtkFloatArray.h"
-#include "vtkImageData.h"
-#include "vtkNew.h"
-#include "vtkPNGWriter.h"
-#include "vtkTestUtilities.h"
-#include "vtkPointData.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
 #include "vtkScalarsToColors.h"
 #include "vtkSmartVolumeMapper.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
 
 #include "SpaceSkipTestHelpers.h"
 
@@ -30,10 +18,7 @@ constexpr double kMinPSNR = 40.0;
 
 int TestSpaceSkippingVolumeComponents(int argc, char* argv[])
 {
-  char* tempDir =
-    vtkTestUtilities::GetArgOrEnvOrDefault("-T", argc, argv, "VTK_TEMP_DIR", "Testing/Temporary");
-  const std::string dir = tempDir;
-  delete[] tempDir;
+  const std::string dir = sstest::TempDir(argc, argv);
 
   // Three components built from the wavelet: w, 300 - w, and a ball of radius 30; magnitude differs
   // from every component.
@@ -65,28 +50,12 @@ int TestSpaceSkippingVolumeComponents(int argc, char* argv[])
   smart->SetAutoAdjustSampleDistances(0);
   smart->SetSampleDistance(0.5);
 
-  vtkNew<vtkSpaceSkippingVolumeMapper> ours;
-  ours->SetInputData(image);
-  ours->SetSampleDistance(0.5);
-  ours->SetEarlyRayTermination(0);
-
-  vtkNew<vtkVolumeProperty> prop;
-  vtkNew<vtkVolume> volume;
-  volume->SetProperty(prop);
-  vtkNew<vtkRenderer> ren;
-  ren->SetBackground(0, 0, 0);
-  ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(200, 200);
-  win->AddRenderer(ren);
-  volume->SetMapper(ours);
-  ren->ResetCamera();
-  ren->GetActiveCamera()->Azimuth(30);
-  ren->GetActiveCamera()->Elevation(20);
-  ren->GetActiveCamera()->OrthogonalizeViewUp();
-  ren->GetActiveCamera()->Zoom(1.4);
-  ren->ResetCameraClippingRange();
+  auto ours = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::AutoBuilder, 0.5, false);
+  sstest::Scene scene(ours, 200, 200);
+  scene.View(30, 20, 1.4, true);
+  vtkVolumeProperty* prop = scene.Property;
+  vtkVolume* volume = scene.Volume;
+  vtkRenderWindow* win = scene.Window;
 
   struct Case
   {
@@ -118,19 +87,12 @@ int TestSpaceSkippingVolumeComponents(int argc, char* argv[])
     ours->SetBuilderToNaive();
     auto a = sstest::RenderWith(win, volume, smart);
     auto naive = sstest::RenderWith(win, volume, ours);
-    const double psnr = sstest::PSNR(a, naive);
-    std::cout << k.name << ": PSNR(vtkSmartVolumeMapper, ours) = " << psnr << " dB, max |diff| "
-              << sstest::MaxDiff(a, naive) << "/255, pixels " << sstest::CountNonBackground(naive, bg)
-              << "\n";
-    for (int k2 = 0; k2 < 2; ++k2)
-    {
-      vtkNew<vtkPNGWriter> png;
-      png->SetFileName((dir + "/TestSpaceSkippingVolumeComponents-" + std::to_string(&k - cases) +
-        (k2 ? "-ours" : "-smart") + ".png")
-                         .c_str());
-      png->SetInputData(k2 ? naive : a);
-      png->Write();
-    }
+    const double psnr = sstest::PrintComparison(k.name, a, naive, "vtkSmartVolumeMapper", "smart");
+    std::cout << "\n";
+    const std::string prefix =
+      dir + "/TestSpaceSkippingVolumeComponents-" + std::to_string(&k - cases);
+    sstest::WritePNG(a, prefix + "-smart.png");
+    sstest::WritePNG(naive, prefix + "-ours.png");
     SS_CHECK(sstest::CountNonBackground(naive, bg) > 500);
     SS_CHECK(psnr >= kMinPSNR);
     if (previous)

@@ -1,27 +1,16 @@
 // Cropping (vtkVolumeMapper's region planes and flags, as ParaView's Use Cropping sets them),
 // clipping planes (vtkAbstractMapper) and jittering against VTK's vtkGPUVolumeRayCastMapper in
 // the same window: PSNR per case, and every builder's image equal to Naive's (max 1/255).
-#include "vtkCamera.h"
-#include "vtkGPUVolumeRayCastMapper.h"
-#include "vtkNew.h"
-#include "vtkPNGWriter.h"
 #include "vtkMatrix4x4.h"
 #include "vtkPlane.h"
 #include "vtkPlaneCollection.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkTestUtilities.h"
 #include "vtkTransform.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
 
 #include "SpaceSkipTestHelpers.h"
 
 namespace
 {
 constexpr double kMinPSNR = 40.0;
-
 
 // The same cropping and clipping on both mappers.
 void Configure(vtkVolumeMapper* m, bool crop, int flags, const double planes[6],
@@ -37,47 +26,22 @@ void Configure(vtkVolumeMapper* m, bool crop, int flags, const double planes[6],
 int TestSpaceSkippingVolumeCropClip(int argc, char* argv[])
 {
   auto image = sstest::MakeWavelet(64);
-  double range[2], bounds[6];
-  image->GetScalarRange(range);
+  double bounds[6];
   image->GetBounds(bounds);
   const double sampleDistance = 0.5;
-
   auto gpu = sstest::ReferenceGPUMapper(image, sampleDistance);
-
-  vtkNew<vtkSpaceSkippingVolumeMapper> ours;
-  ours->SetInputData(image);
-  ours->SetSampleDistance(sampleDistance);
-  ours->SetEarlyRayTermination(0);
-
-  vtkNew<vtkVolumeProperty> prop;
-  sstest::SetupProperty(prop, range[0], range[1], 0.3);
-  vtkNew<vtkVolume> volume;
-  volume->SetProperty(prop);
+  auto ours = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::AutoBuilder, sampleDistance, false);
+  sstest::Scene scene(ours, 256, 256);
+  sstest::SetupProperty(scene.Property, image, 0.3);
+  vtkVolume* volume = scene.Volume;
+  vtkRenderWindow* win = scene.Window;
   // A volume matrix, so that world-space clipping planes must be carried into the data's frame.
   vtkNew<vtkTransform> xf;
   xf->Translate(5, -3, 2);
   xf->RotateZ(20);
   volume->SetUserTransform(xf);
-
-  vtkNew<vtkRenderer> ren;
-  ren->SetBackground(0, 0, 0);
-  ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(256, 256);
-  win->AddRenderer(ren);
-  volume->SetMapper(ours);
-  ren->ResetCamera();
-  ren->GetActiveCamera()->Azimuth(35);
-  ren->GetActiveCamera()->Elevation(25);
-  ren->GetActiveCamera()->OrthogonalizeViewUp();
-  ren->GetActiveCamera()->Zoom(1.4);
-  ren->ResetCameraClippingRange();
-
-  char* tempDir =
-    vtkTestUtilities::GetArgOrEnvOrDefault("-T", argc, argv, "VTK_TEMP_DIR", "Testing/Temporary");
-  const std::string dir = tempDir;
-  delete[] tempDir;
+  scene.View(35, 25, 1.4, true);
+  const std::string dir = sstest::TempDir(argc, argv);
 
   // Cropping planes at 30% and 65% of each axis (data coordinates).
   double planes[6];
@@ -138,21 +102,12 @@ int TestSpaceSkippingVolumeCropClip(int argc, char* argv[])
     ours->SetBuilderToNaive();
     auto a = sstest::RenderWith(win, volume, gpu);
     auto naive = sstest::RenderWith(win, volume, ours);
-    const double psnr = sstest::PSNR(a, naive);
-    std::cout << "case " << k.name << ": PSNR(vtkGPUVolumeRayCastMapper, ours) = " << psnr
-              << " dB, max |diff| = " << sstest::MaxDiff(a, naive) << "/255, drawn pixels gpu "
-              << sstest::CountNonBackground(a, bg) << " ours "
-              << sstest::CountNonBackground(naive, bg) << ", PSNR vs uncut "
-              << sstest::PSNR(uncut, naive) << " dB; backend " << ours->GetBackendUsed() << "\n";
-    for (int w = 0; w < 2; ++w)
-    {
-      vtkNew<vtkPNGWriter> png;
-      png->SetFileName(
-        (dir + "/TestSpaceSkippingVolumeCropClip-" + k.name + (w ? "-ours" : "-gpu") + ".png")
-          .c_str());
-      png->SetInputData(w ? naive : a);
-      png->Write();
-    }
+    const double psnr = sstest::PrintComparison(k.name, a, naive);
+    std::cout << ", PSNR vs uncut " << sstest::PSNR(uncut, naive) << " dB; backend "
+              << ours->GetBackendUsed() << "\n";
+    const std::string prefix = dir + "/TestSpaceSkippingVolumeCropClip-" + k.name;
+    sstest::WritePNG(a, prefix + "-gpu.png");
+    sstest::WritePNG(naive, prefix + "-ours.png");
     worst = std::min(worst, psnr);
     SS_CHECK(sstest::CountNonBackground(naive, bg) > 500);
     SS_CHECK(sstest::PSNR(uncut, naive) < 35.0); // the cut is visible

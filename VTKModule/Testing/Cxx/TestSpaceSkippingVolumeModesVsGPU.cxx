@@ -1,19 +1,7 @@
 // Shading and every blend mode through vtkGPUVolumeRayCastMapper and vtkSpaceSkippingVolumeMapper
 // in the same scene (same sample distance, linear interpolation, no jitter): prints the PSNR per
 // case and checks it, and that each case draws something and differs from the composite image.
-#include "vtkCamera.h"
-#include "vtkColorTransferFunction.h"
 #include "vtkContourValues.h"
-#include "vtkGPUVolumeRayCastMapper.h"
-#include "vtkNew.h"
-#include "vtkPNGWriter.h"
-#include "vtkPiecewiseFunction.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkTestUtilities.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
 
 #include "SpaceSkipTestHelpers.h"
 
@@ -36,16 +24,9 @@ vtkSmartPointer<vtkImageData> RenderWith(vtkRenderWindow* win, vtkVolume* volume
 // Opaque at low values, fading towards high ones (MinIP has something to show).
 void SetupLowProperty(vtkVolumeProperty* prop, double lo, double hi)
 {
-  vtkNew<vtkColorTransferFunction> ctf;
-  ctf->AddRGBPoint(lo, 0.9, 0.8, 0.2);
-  ctf->AddRGBPoint(lo + 0.5 * (hi - lo), 0.2, 0.6, 0.9);
-  ctf->AddRGBPoint(hi, 0.1, 0.1, 0.8);
-  vtkNew<vtkPiecewiseFunction> pwf;
-  pwf->AddPoint(lo, 0.9);
-  pwf->AddPoint(lo + 0.5 * (hi - lo), 0.3);
-  pwf->AddPoint(hi, 0.05);
-  prop->SetColor(ctf);
-  prop->SetScalarOpacity(pwf);
+  sstest::SetFunctions(prop,
+    { { lo, 0.9, 0.8, 0.2 }, { lo + 0.5 * (hi - lo), 0.2, 0.6, 0.9 }, { hi, 0.1, 0.1, 0.8 } },
+    { { lo, 0.9 }, { lo + 0.5 * (hi - lo), 0.3 }, { hi, 0.05 } });
 }
 }
 
@@ -57,43 +38,17 @@ int TestSpaceSkippingVolumeModesVsGPU(int argc, char* argv[])
   const double lo = range[0], hi = range[1];
   const double sampleDistance = 0.5;
 
-  vtkNew<vtkGPUVolumeRayCastMapper> gpu;
-  gpu->SetInputData(image);
-  gpu->AutoAdjustSampleDistancesOff();
-  gpu->LockSampleDistanceToInputSpacingOff();
-  gpu->SetSampleDistance(sampleDistance);
-  gpu->UseJitteringOff();
-
-  vtkNew<vtkSpaceSkippingVolumeMapper> ours;
-  ours->SetInputData(image);
-  ours->SetBuilderToGrid();
-  ours->SetSampleDistance(sampleDistance);
-  ours->SetEarlyRayTermination(0);
-
-  vtkNew<vtkVolumeProperty> prop;
-  vtkNew<vtkVolume> volume;
-  volume->SetProperty(prop);
-  volume->SetMapper(ours); // bounds for ResetCamera
-
-  vtkNew<vtkRenderer> ren;
-  ren->SetBackground(0, 0, 0);
-  ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(256, 256);
-  win->AddRenderer(ren);
-  ren->ResetCamera();
-  vtkCamera* cam = ren->GetActiveCamera();
-  cam->Zoom(1.6);
-  cam->Azimuth(35);
-  cam->Elevation(25);
-  cam->OrthogonalizeViewUp();
-  ren->ResetCameraClippingRange();
-
-  char* tempDir =
-    vtkTestUtilities::GetArgOrEnvOrDefault("-T", argc, argv, "VTK_TEMP_DIR", "Testing/Temporary");
-  const std::string dir = tempDir;
-  delete[] tempDir;
+  auto gpu = sstest::ReferenceGPUMapper(image, sampleDistance);
+  auto ours = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::Grid, sampleDistance, false);
+  sstest::Scene scene(ours, 256, 256);
+  // Zoom (the view angle) and the turns commute: the order of the calls does not matter.
+  scene.View(35, 25, 1.6, true);
+  vtkVolumeProperty* prop = scene.Property;
+  vtkVolume* volume = scene.Volume;
+  vtkRenderer* ren = scene.Renderer;
+  vtkRenderWindow* win = scene.Window;
+  vtkCamera* cam = scene.Camera();
+  const std::string dir = sstest::TempDir(argc, argv);
 
   struct Case
   {
@@ -156,21 +111,12 @@ int TestSpaceSkippingVolumeModesVsGPU(int argc, char* argv[])
     ren->ResetCameraClippingRange();
     auto a = RenderWith(win, volume, gpu, c.blend);
     auto b = RenderWith(win, volume, ours, c.blend);
-    const double psnr = sstest::PSNR(a, b);
-    const double bg[3] = { 0, 0, 0 };
-    const vtkIdType drawn = sstest::CountNonBackground(b, bg);
-    std::cout << "case " << c.name << ": PSNR(vtkGPUVolumeRayCastMapper, ours) = " << psnr
-              << " dB, max |diff| = " << sstest::MaxDiff(a, b) << "/255, drawn pixels gpu "
-              << sstest::CountNonBackground(a, bg) << " ours " << drawn << "\n";
-    for (int k = 0; k < 2; ++k)
-    {
-      vtkNew<vtkPNGWriter> w;
-      w->SetFileName(
-        (dir + "/TestSpaceSkippingVolumeModesVsGPU-" + c.name + (k ? "-ours" : "-gpu") + ".png")
-          .c_str());
-      w->SetInputData(k ? b : a);
-      w->Write();
-    }
+    const double psnr = sstest::PrintComparison(c.name, a, b);
+    std::cout << "\n";
+    const vtkIdType drawn = sstest::CountNonBackground(b, sstest::kBlack);
+    const std::string prefix = dir + "/TestSpaceSkippingVolumeModesVsGPU-" + c.name;
+    sstest::WritePNG(a, prefix + "-gpu.png");
+    sstest::WritePNG(b, prefix + "-ours.png");
     worst = std::min(worst, psnr);
     if (drawn < 1000 || psnr < kMinPSNR)
     {

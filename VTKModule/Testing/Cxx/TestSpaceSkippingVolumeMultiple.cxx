@@ -1,17 +1,7 @@
 // Several volumes of different voxel types in one offscreen window, one placed by its vtkVolume
 // matrix (scale, rotation, translation), drawn again after a resize: regression image of the last
 // frame; resizing must not rebuild anything.
-#include "vtkActor.h"
-#include "vtkCamera.h"
 #include "vtkImageShiftScale.h"
-#include "vtkNew.h"
-#include "vtkRegressionTestImage.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderWindowInteractor.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
 
 #include "SpaceSkipTestHelpers.h"
 
@@ -42,13 +32,15 @@ int TestSpaceSkippingVolumeMultiple(int argc, char* argv[])
   mf->SetBuilderToGrid();
   m16->SetBuilderToNaive();
 
-  vtkNew<vtkVolumeProperty> p8, p16, pf;
-  sstest::SetupProperty(p8, 0, 255, 0.7);
+  const double bg[3] = { 0.15, 0.15, 0.15 };
+  sstest::Scene scene(m8, 300, 150, bg, true);
+  scene.Window->SetOffScreenRendering(1);
+  vtkVolume* v8 = scene.Volume;
+  vtkNew<vtkVolumeProperty> p16, pf;
+  sstest::SetupProperty(scene.Property, 0, 255, 0.7);
   sstest::SetupProperty(p16, -1000, 1000, 0.7);
   sstest::SetupProperty(pf, range[0], range[1], 0.7);
-  vtkNew<vtkVolume> v8, v16, vf;
-  v8->SetMapper(m8);
-  v8->SetProperty(p8);
+  vtkNew<vtkVolume> v16, vf;
   v8->SetPosition(-50, 0, 0);
   v16->SetMapper(m16);
   v16->SetProperty(p16);
@@ -59,29 +51,14 @@ int TestSpaceSkippingVolumeMultiple(int argc, char* argv[])
   vf->SetProperty(pf);
   vf->SetPosition(50, 0, 0);
 
-  vtkNew<vtkRenderer> ren;
-  ren->SetBackground(0.15, 0.15, 0.15);
-  ren->AddVolume(v8);
-  ren->AddVolume(v16);
-  ren->AddVolume(vf);
-  vtkNew<vtkRenderWindow> win;
-  win->SetOffScreenRendering(1);
-  win->SetMultiSamples(0);
-  win->SetSize(300, 150);
-  win->AddRenderer(ren);
-  vtkNew<vtkRenderWindowInteractor> iren;
-  iren->SetRenderWindow(win);
-  ren->ResetCamera();
-  ren->GetActiveCamera()->Elevation(20);
-  ren->GetActiveCamera()->OrthogonalizeViewUp();
-  ren->GetActiveCamera()->Zoom(1.5);
-  ren->ResetCameraClippingRange();
+  scene.Renderer->AddVolume(v16);
+  scene.Renderer->AddVolume(vf);
+  scene.View(0, 20, 1.5, true);
 
+  vtkRenderWindow* win = scene.Window;
   win->Render();
   win->SetSize(360, 180);
-  win->Render();
-  auto shot = sstest::Capture(win);
-  const double bg[3] = { 0.15, 0.15, 0.15 };
+  auto shot = scene.Shot();
   std::cout << "pixels drawn " << sstest::CountNonBackground(shot, bg) << " at "
             << shot->GetDimensions()[0] << "x" << shot->GetDimensions()[1] << "; builds "
             << m8->GetBuildCount() << " " << m16->GetBuildCount() << " " << mf->GetBuildCount()
@@ -89,11 +66,5 @@ int TestSpaceSkippingVolumeMultiple(int argc, char* argv[])
   SS_CHECK(shot->GetDimensions()[0] == 360 && shot->GetDimensions()[1] == 180);
   SS_CHECK(m8->GetBuildCount() == 1 && m16->GetBuildCount() == 1 && mf->GetBuildCount() == 1);
   SS_CHECK(m8->GetFrameCount() >= 2);
-
-  int retVal = vtkRegressionTestImage(win);
-  if (retVal == vtkRegressionTester::DO_INTERACTOR)
-  {
-    iren->Start();
-  }
-  return !retVal;
+  return scene.Regression(argc, argv);
 }

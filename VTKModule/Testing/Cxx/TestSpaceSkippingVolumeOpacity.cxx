@@ -2,16 +2,6 @@
 // ScalarOpacityUnitDistance u, seen along its thickness L, has alpha = 1 - (1 - a)^(L / u).
 // White emission over a black background makes the pixel value alpha * 255. The same scene
 // through vtkGPUVolumeRayCastMapper is printed for comparison (not asserted).
-#include "vtkCamera.h"
-#include "vtkGPUVolumeRayCastMapper.h"
-#include "vtkNew.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkUnsignedCharArray.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
-
 #include "SpaceSkipTestHelpers.h"
 
 int TestSpaceSkippingVolumeOpacity(int, char*[])
@@ -36,38 +26,16 @@ int TestSpaceSkippingVolumeOpacity(int, char*[])
     v->SetValue(0, 0); // a non-degenerate scalar range; the TF is flat anyway
     img->GetPointData()->SetScalars(v);
 
-    vtkNew<vtkVolumeProperty> prop;
-    vtkNew<vtkColorTransferFunction> ctf;
-    ctf->AddRGBPoint(0, 1, 1, 1);
-    ctf->AddRGBPoint(100, 1, 1, 1);
-    vtkNew<vtkPiecewiseFunction> pwf;
-    pwf->AddPoint(0, c.a);
-    pwf->AddPoint(100, c.a);
-    prop->SetColor(ctf);
-    prop->SetScalarOpacity(pwf);
+    auto ours = sstest::NewMapper(img, vtkSpaceSkippingVolumeMapper::AutoBuilder, c.sampleDistance, false);
+    auto gpu = sstest::ReferenceGPUMapper(img, c.sampleDistance);
+    sstest::Scene scene(ours, 64, 64);
+    vtkVolumeProperty* prop = scene.Property;
+    sstest::SetFunctions(prop, { { 0, 1, 1, 1 }, { 100, 1, 1, 1 } }, { { 0, c.a }, { 100, c.a } });
     prop->SetInterpolationTypeToLinear();
     prop->SetScalarOpacityUnitDistance(c.unit);
-
-    vtkNew<vtkSpaceSkippingVolumeMapper> ours;
-    ours->SetInputData(img);
-    ours->SetSampleDistance(c.sampleDistance);
-    ours->EarlyRayTerminationOff();
-    vtkNew<vtkGPUVolumeRayCastMapper> gpu;
-    gpu->SetInputData(img);
-    gpu->AutoAdjustSampleDistancesOff();
-    gpu->LockSampleDistanceToInputSpacingOff();
-    gpu->SetSampleDistance(c.sampleDistance);
-    vtkNew<vtkVolume> volume;
-    volume->SetProperty(prop);
-    volume->SetMapper(ours);
-
-    vtkNew<vtkRenderer> ren;
-    ren->AddVolume(volume);
-    vtkNew<vtkRenderWindow> win;
-    win->SetMultiSamples(0);
-    win->SetSize(64, 64);
-    win->AddRenderer(ren);
-    vtkCamera* cam = ren->GetActiveCamera();
+    vtkVolume* volume = scene.Volume;
+    vtkRenderWindow* win = scene.Window;
+    vtkCamera* cam = scene.Camera();
     const double L = (n - 1) * c.spacingZ;
     cam->ParallelProjectionOn();
     cam->SetFocalPoint(31.5, 31.5, L / 2);

@@ -4,17 +4,8 @@
 // grow (RSS <= 1 MB after a warm-up), that every frame still draws, and that each warning
 // (a builder falling back, a CUDA request without a device, a clamped sample distance) is said
 // once, not once per edit or switch.
-#include "vtkCamera.h"
-#include "vtkColorTransferFunction.h"
-#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOutputWindow.h"
-#include "vtkPiecewiseFunction.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
 
 #include "SpaceSkipTestHelpers.h"
 
@@ -64,18 +55,11 @@ int TestSpaceSkippingVolumeSoak(int, char*[])
   vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
   mapper->SetInputData(image);
   mapper->SetBackendToAuto(); // CUDA where a device is usable (device memory checked too)
-  vtkNew<vtkVolumeProperty> prop;
+  sstest::Scene scene(mapper, 64, 64);
+  vtkVolumeProperty* prop = scene.Property;
   sstest::SetupProperty(prop, lo, hi, 0.6);
-  vtkNew<vtkVolume> volume;
-  volume->SetMapper(mapper);
-  volume->SetProperty(prop);
-  vtkNew<vtkRenderer> ren;
-  ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(64, 64);
-  win->AddRenderer(ren);
-  ren->ResetCamera();
+  vtkRenderWindow* win = scene.Window;
+  scene.Renderer->ResetCamera();
 
   vtkPiecewiseFunction* pwf = prop->GetScalarOpacity(0);
   vtkColorTransferFunction* ctf = prop->GetRGBTransferFunction(0);

@@ -5,16 +5,6 @@
 //  - opacity edit, new support  -> classification and build;
 //  - a replaced (equal) colour function / a replaced property -> nothing redone;
 //  - ScalarOpacityUnitDistance  -> re-classification (the opacity table changes), no build.
-#include "vtkCamera.h"
-#include "vtkColorTransferFunction.h"
-#include "vtkNew.h"
-#include "vtkPiecewiseFunction.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
-
 #include "SpaceSkipTestHelpers.h"
 
 namespace
@@ -55,19 +45,13 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   mapper->SetInputData(image);
   mapper->SetBackendToCPU();
   mapper->SetBuilderToGrid(); // Auto would measure several structures: the test counts builds
-  vtkNew<vtkVolumeProperty> prop;
+  sstest::Scene scene(mapper, 160, 160);
+  vtkVolumeProperty* prop = scene.Property;
   sstest::SetupProperty(prop, lo, hi, 0.6);
-  vtkNew<vtkVolume> volume;
-  volume->SetMapper(mapper);
-  volume->SetProperty(prop);
-  vtkNew<vtkRenderer> ren;
-  ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(160, 160);
-  win->AddRenderer(ren);
-  ren->ResetCamera();
-  ren->GetActiveCamera()->Zoom(1.4);
+  vtkVolume* volume = scene.Volume;
+  vtkRenderWindow* win = scene.Window;
+  scene.Renderer->ResetCamera();
+  scene.Camera()->Zoom(1.4);
 
   win->Render();
   Counts c0 = Read(mapper);

@@ -1,16 +1,5 @@
 // The same scene through VTK's vtkGPUVolumeRayCastMapper and vtkSpaceSkippingVolumeMapper at the
 // same sample distance, linear interpolation, no shading, no jitter: prints the PSNR between them.
-#include "vtkCamera.h"
-#include "vtkGPUVolumeRayCastMapper.h"
-#include "vtkNew.h"
-#include "vtkPNGWriter.h"
-#include "vtkRenderWindow.h"
-#include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
-#include "vtkTestUtilities.h"
-#include "vtkVolume.h"
-#include "vtkVolumeProperty.h"
-
 #include "SpaceSkipTestHelpers.h"
 
 namespace
@@ -32,31 +21,16 @@ int TestSpaceSkippingVolumeVsGPU(int argc, char* argv[])
   const double sampleDistance = 0.5;
 
   auto gpu = sstest::ReferenceGPUMapper(image, sampleDistance);
-
-  vtkNew<vtkSpaceSkippingVolumeMapper> ours;
-  ours->SetInputData(image);
-  ours->SetBuilderToGrid();
-  ours->SetSampleDistance(sampleDistance);
-
-  vtkNew<vtkVolumeProperty> prop;
-  vtkNew<vtkVolume> volume;
-  volume->SetProperty(prop);
-  volume->SetMapper(ours);
-
-  vtkNew<vtkRenderer> ren;
-  ren->SetBackground(0, 0, 0);
-  ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(256, 256);
-  win->AddRenderer(ren);
+  auto ours = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::Grid, sampleDistance);
+  sstest::Scene scene(ours, 256, 256);
+  vtkVolumeProperty* prop = scene.Property;
+  vtkVolume* volume = scene.Volume;
+  vtkRenderer* ren = scene.Renderer;
+  vtkRenderWindow* win = scene.Window;
+  // Each case below turns the camera further from here.
   ren->ResetCamera();
   ren->GetActiveCamera()->Zoom(1.6);
-
-  char* tempDir =
-    vtkTestUtilities::GetArgOrEnvOrDefault("-T", argc, argv, "VTK_TEMP_DIR", "Testing/Temporary");
-  const std::string dir = tempDir;
-  delete[] tempDir;
+  const std::string dir = sstest::TempDir(argc, argv);
 
   struct Case
   {
@@ -83,24 +57,13 @@ int TestSpaceSkippingVolumeVsGPU(int argc, char* argv[])
     ours->SetEarlyRayTermination(c.ert);
     auto a = sstest::RenderWith(win, volume, gpu);
     auto b = sstest::RenderWith(win, volume, ours);
-    const double psnr = sstest::PSNR(a, b);
-    const int maxDiff = sstest::MaxDiff(a, b);
-    const double bg[3] = { 0, 0, 0 };
-    std::cout << "case " << c.name << ": PSNR(vtkGPUVolumeRayCastMapper, ours) = " << psnr
-              << " dB, max |diff| = " << maxDiff << "/255, drawn pixels gpu "
-              << sstest::CountNonBackground(a, bg) << " ours " << sstest::CountNonBackground(b, bg)
-              << ", sample distance " << sampleDistance << "\n";
-    for (int k = 0; k < 2; ++k)
-    {
-      vtkNew<vtkPNGWriter> w;
-      w->SetFileName((dir + "/TestSpaceSkippingVolumeVsGPU-" + c.name + (k ? "-ours" : "-gpu") +
-        ".png")
-                       .c_str());
-      w->SetInputData(k ? b : a);
-      w->Write();
-    }
+    const double psnr = sstest::PrintComparison(c.name, a, b);
+    std::cout << ", sample distance " << sampleDistance << "\n";
+    const std::string prefix = dir + "/TestSpaceSkippingVolumeVsGPU-" + c.name;
+    sstest::WritePNG(a, prefix + "-gpu.png");
+    sstest::WritePNG(b, prefix + "-ours.png");
     worst = std::min(worst, psnr);
-    SS_CHECK(sstest::CountNonBackground(b, bg) > 1000);
+    SS_CHECK(sstest::CountNonBackground(b, sstest::kBlack) > 1000);
   }
   // Camera inside the volume (perspective, near plane inside the box): rays start at the near
   // plane instead of the box entry.
@@ -116,21 +79,11 @@ int TestSpaceSkippingVolumeVsGPU(int argc, char* argv[])
     ours->SetEarlyRayTermination(0);
     auto a = sstest::RenderWith(win, volume, gpu);
     auto b = sstest::RenderWith(win, volume, ours);
-    const double psnr = sstest::PSNR(a, b);
-    const double bg[3] = { 0, 0, 0 };
-    std::cout << "case camera-inside: PSNR(vtkGPUVolumeRayCastMapper, ours) = " << psnr
-              << " dB, max |diff| = " << sstest::MaxDiff(a, b) << "/255, drawn pixels gpu "
-              << sstest::CountNonBackground(a, bg) << " ours " << sstest::CountNonBackground(b, bg)
-              << "\n";
-    for (int k = 0; k < 2; ++k)
-    {
-      vtkNew<vtkPNGWriter> w;
-      w->SetFileName(
-        (dir + "/TestSpaceSkippingVolumeVsGPU-camera-inside" + (k ? "-ours" : "-gpu") + ".png")
-          .c_str());
-      w->SetInputData(k ? b : a);
-      w->Write();
-    }
+    const double psnr = sstest::PrintComparison("camera-inside", a, b);
+    std::cout << "\n";
+    const std::string prefix = dir + "/TestSpaceSkippingVolumeVsGPU-camera-inside";
+    sstest::WritePNG(a, prefix + "-gpu.png");
+    sstest::WritePNG(b, prefix + "-ours.png");
     SS_CHECK(psnr >= kMinPSNRInside);
   }
   std::cout << "worst PSNR " << worst << " dB (threshold " << kMinPSNR << ")\n";
