@@ -188,8 +188,11 @@ BuildParams buildParams(const Options& o, const std::string& spec) {
     else if (it.rfind("brick", 0) == 0) p.brick = suffixNumber(it, "brick", spec, 1, kMaxBrick);
     else throw bad("builder suffix", it, "in '" + spec.substr(0, 60) + "' is not one of shallow deep mlsN binsN brickN");
   }
-  if (p.bins == 1)
-    throw std::invalid_argument("bad bins 1 in '" + spec.substr(0, 60) + "': 0 (sweep every brick boundary) or >= 2");
+  try {
+    validate(p);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("bad bins " + std::to_string(p.bins) + " in '" + spec.substr(0, 60) + "': " + e.what());
+  }
   return p;
 }
 

@@ -1,5 +1,6 @@
 // spaceskip: command-line renderer, generator and benchmark over Core (no VTK).
 #include "Options.h"
+#include "spaceskip/Builders.h"
 #include "spaceskip/Engine.h"
 #include "spaceskip/Generators.h"
 #include "spaceskip/ImageIO.h"
@@ -58,8 +59,7 @@ const char* kUsage = R"(usage:
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
   --builder B        auto (default: one frame with each of naive, grid, distance-grid and a
-                     k-d tree, then the fastest) naive grid lbvh lbvh-cpu kdtree-cpu kdtree-gpu
-                     kdtree-gpu-fast hybrid distance-grid
+                     k-d tree, then the fastest) or one of the builders listed at the end
   --leaf shallow|deep  --mls N  --bins N  --brick N
       --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;
       0 sweeps every brick boundary, the kdtree-cpu tree (kdtree-cpu always sweeps)
@@ -75,7 +75,16 @@ options:
   --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
   --max-volume-bytes N[K|M|G|T]  largest volume read or generated (default: the environment's
                      SPACESKIP_MAX_VOLUME_BYTES, else min(64 GiB, physical memory))
+builders:
 )";
+
+/// The usage text and the registry's builders (Builders.cpp), one per line.
+void printUsage(FILE* to) {
+  std::fputs(kUsage, to);
+  int n = 0;
+  const BuilderInfo* rows = builderRegistry(&n);
+  for (int i = 0; i < n; ++i) std::fprintf(to, "  %-18s %s\n", rows[i].cliName, rows[i].summary);
+}
 
 Volume openVolume(const std::string& spec, const Options& o) {
   const uint64_t cap = maxVolumeBytes(o);
@@ -369,7 +378,7 @@ int cmdAccuracy(const Options& o) {
 
 int main(int argc, char** argv) {
   if (argc < 2 || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "--help")) {
-    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    printUsage(argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;
   }
   try {
@@ -385,7 +394,8 @@ int main(int argc, char** argv) {
     if (cmd == "render") return cmdRender(o);
     if (cmd == "bench") return cmdBench(o);
     if (cmd == "accuracy") return cmdAccuracy(o);
-    std::fprintf(stderr, "unknown command '%s'\n%s", cmd.c_str(), kUsage);
+    std::fprintf(stderr, "unknown command '%s'\n", cmd.c_str());
+    printUsage(stderr);
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "spaceskip: error: %s\n", e.what());

@@ -1,5 +1,6 @@
 // The CUDA backend: volume upload, range grid and classification kernels, GPU builders, and a
 // one-thread-per-pixel executor of Core's shared renderPixel (exact or hardware trilinear).
+#include "BuildContext.cuh"
 #include "CudaCommon.cuh"
 #include "DistanceField.cuh"
 #include "KdTreeBuilder.cuh"
@@ -112,7 +113,7 @@ struct TextureSampler {
 constexpr int kMaxRenderThreads = 256;
 // Default launch of the hardware-filtered kernels: plain for volumes up to kLargeTextureBytes; a
 // persistent launch with kLargeTextureResident blocks of 128 threads per SM above. Measured on
-// the H100 (Testing/results/cuda-h100-round3): naive:hw at 2048^3 (8 GiB) runs fastest with 6
+// the H100 (docs/results/cuda-h100-round3): naive:hw at 2048^3 (8 GiB) runs fastest with 6
 // blocks per SM (more warps in flight thrash the texture path), at 1024^3 (1 GiB) with all 16;
 // the skipping kernels do not care either way.
 constexpr size_t kLargeTextureBytes = size_t(2) << 30;
@@ -310,7 +311,8 @@ class CudaBackend final : public Backend {
   void build(const BuildParams& p, BuildStats& s) override {
     if (!haveOcc_) throw BackendError("CUDA backend: build() before classify()");
     auto t0 = std::chrono::steady_clock::now();
-    traversal_ = traversalFor(p.builder);
+    const BuilderInfo& info = builderInfo(p.builder);
+    traversal_ = info.traversal;
     tree_.numNodes = 0;
     tree_.height = 0;
     tree_.leaves = 0;
@@ -318,40 +320,28 @@ class CudaBackend final : public Backend {
     hybridGridValid_ = false;
     d_distField_ = nullptr;
     s.builtOn = "cuda";
-    const cuda::BrickGridView g{d_occ_[cur_].get(), bdims_, brick_, cellDims_, occupied_};
-    cuda::KdParams kp;
-    kp.leaf = p.leaf;
-    kp.maxLeafSize = p.maxLeafSize;
-    kp.bins = p.bins;
-    switch (p.builder) {
-      case BuilderKind::Naive:
-      case BuilderKind::Grid: break;
-      case BuilderKind::DistanceGrid:
-        d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, kMaxSkipDistance, dist_, stream_);
-        break;
-      case BuilderKind::LBVH: cuda::buildLbvh(g, lbvh_, tree_, stream_); break;
-      case BuilderKind::KdTreeGPU: cuda::buildKdTreeGpu(g, kp, kdGpu_, tree_, stream_); break;
-      case BuilderKind::KdTreeGPUFast: cuda::buildKdTreeGpuFast(g, kp, kdFast_, tree_, stream_); break;
-      case BuilderKind::LBVHCPU:
-      case BuilderKind::KdTreeCPU:
-      case BuilderKind::Hybrid: {
-        // CPU builders on the downloaded occupancy; the tree (and Hybrid's grid) is uploaded.
-        const OccupancyGrid& occ = occupancy();
-        hostTree_ = buildTreeCPU(occ, p);
-        uploadTree(hostTree_);
-        if (p.builder == BuilderKind::Hybrid) {
-          OccupancyGrid coarse = coarsen(occ, std::max(1, 16 / occ.brick));
-          d_hybrid_.reserve(coarse.occ.size());
-          SS_CUDA_CHECK(cudaMemcpyAsync(d_hybrid_.get(), coarse.occ.data(), coarse.occ.size(), cudaMemcpyHostToDevice,
-                                        stream_));
-          hybridDims_ = coarse.dims;
-          hybridBrick_ = coarse.brick;
-          hybridGridValid_ = true;
-        }
-        SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
-        s.builtOn = "cpu";
-        break;
+    if (info.extra == BuilderExtra::DistanceField)
+      d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, kMaxSkipDistance, dist_, stream_);
+    if (info.cuda) {
+      cuda::BuildContext ctx{{d_occ_[cur_].get(), bdims_, brick_, cellDims_, occupied_}, stream_, tree_, workspaces_};
+      info.cuda(ctx, p);
+      checkTreeHeight(p.builder, tree_.height);
+    } else if (buildsTree(info)) {
+      // Host builders on the downloaded occupancy; the tree (and Hybrid's grid) is uploaded.
+      const OccupancyGrid& occ = occupancy();
+      hostTree_ = buildTreeCPU(occ, p);
+      uploadTree(hostTree_);
+      if (info.extra == BuilderExtra::CoarseGrid) {
+        OccupancyGrid coarse = coarsen(occ, std::max(1, kHybridCell / occ.brick));
+        d_hybrid_.reserve(coarse.occ.size());
+        SS_CUDA_CHECK(cudaMemcpyAsync(d_hybrid_.get(), coarse.occ.data(), coarse.occ.size(), cudaMemcpyHostToDevice,
+                                      stream_));
+        hybridDims_ = coarse.dims;
+        hybridBrick_ = coarse.brick;
+        hybridGridValid_ = true;
       }
+      SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
+      s.builtOn = "cpu";
     }
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     s.nodes = tree_.numNodes;
@@ -649,9 +639,7 @@ class CudaBackend final : public Backend {
   TraversalKind traversal_ = TraversalKind::Naive;
   cuda::DeviceTree tree_;
   Tree hostTree_;
-  cuda::LbvhWorkspace lbvh_;
-  cuda::KdTreeGpuWorkspace kdGpu_;
-  cuda::KdTreeGpuFastWorkspace kdFast_;
+  cuda::WorkspaceStore workspaces_;  ///< the device builders' workspaces (BuildContext)
   DeviceBuffer<uint8_t> d_hybrid_;
   vec3i hybridDims_{0, 0, 0};
   int hybridBrick_ = 16;

@@ -2,7 +2,7 @@
 // Every CUDA call goes through SS_CUDA_CHECK: a failure becomes a BackendError (the Engine falls
 // back to the CPU backend), never an abort.
 #pragma once
-#include "spaceskip/Engine.h"
+#include "spaceskip/Types.h"
 
 #include <cuda_runtime.h>
 

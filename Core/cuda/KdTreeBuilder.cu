@@ -2,6 +2,7 @@
 // reduction per candidate child) and KdTreeGPUFast (ours: level-parallel over a 3-D SVT).
 // Both use decideKdSplit (KdTreeSplit.cuh), so they build the same tree.
 #include "KdTreeBuilder.cuh"
+#include "BuildContext.cuh"
 #include "spaceskip/Morton.h"
 
 #include <cub/device/device_reduce.cuh>
@@ -457,6 +458,24 @@ void buildKdTreeGpuFast(const BrickGridView& g, const KdParams& p, KdTreeGpuFast
   }
   out.numNodes = levelStart;
   out.height = height;
+}
+
+namespace {
+KdParams kdParams(const BuildParams& p) {
+  KdParams kp;
+  kp.leaf = p.leaf;
+  kp.maxLeafSize = p.maxLeafSize;
+  kp.bins = p.bins;
+  return kp;
+}
+}  // namespace
+
+void buildKdTreeGpu(BuildContext& ctx, const BuildParams& p) {
+  buildKdTreeGpu(ctx.grid, kdParams(p), ctx.workspace<KdTreeGpuWorkspace>(), ctx.tree, ctx.stream);
+}
+
+void buildKdTreeGpuFast(BuildContext& ctx, const BuildParams& p) {
+  buildKdTreeGpuFast(ctx.grid, kdParams(p), ctx.workspace<KdTreeGpuFastWorkspace>(), ctx.tree, ctx.stream);
 }
 
 }  // namespace spaceskip::cuda

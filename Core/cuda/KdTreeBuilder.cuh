@@ -10,7 +10,7 @@
 #pragma once
 #include "DeviceTree.cuh"
 #include "KdTreeSplit.cuh"
-#include "spaceskip/Engine.h"
+#include "spaceskip/Types.h"
 
 namespace spaceskip::cuda {
 

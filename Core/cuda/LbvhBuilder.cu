@@ -1,6 +1,7 @@
 // LBVH over occupied bricks (paper 3.1): compaction, Morton codes, radix sort, Karras 2012
 // hierarchy, bottom-up boxes; the result uses Core's flat node layout.
 #include "LbvhBuilder.cuh"
+#include "BuildContext.cuh"
 #include "spaceskip/Morton.h"
 
 #include <cub/device/device_radix_sort.cuh>
@@ -178,6 +179,10 @@ void buildLbvh(const BrickGridView& g, LbvhWorkspace& ws, DeviceTree& out, cudaS
   out.numNodes = kNodes;
   out.height = height;
   out.leaves = n;
+}
+
+void buildLbvh(BuildContext& ctx, const BuildParams&) {
+  buildLbvh(ctx.grid, ctx.workspace<LbvhWorkspace>(), ctx.tree, ctx.stream);
 }
 
 }  // namespace spaceskip::cuda

@@ -1,7 +1,10 @@
 // The executor interface behind Engine: a oneTBB backend and a CUDA backend implement it.
 // Internal to Core (the VTK module only sees Engine).
 #pragma once
-#include "Engine.h"
+#include "Classification.h"
+#include "Tree.h"
+#include "Types.h"
+#include "Volume.h"
 #include "Integrator.h"
 
 #include <memory>

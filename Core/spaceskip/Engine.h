@@ -7,150 +7,20 @@
 #include "Classification.h"
 #include "Tree.h"
 #include "TransferFunction.h"
+#include "Types.h"
 #include "Volume.h"
 
-#include <array>
-#include <cmath>
 #include <functional>
-#include <stdexcept>
 #include <memory>
 #include <string>
-#include <vector>
 
 namespace spaceskip {
 
-enum class BuilderKind : int {
-  Naive,          ///< no skipping (the paper's baseline)
-  Grid,           ///< DDA over the macro-cell occupancy grid
-  LBVH,           ///< paper 3.1 on the render backend's device (CUDA, or the oneTBB twin)
-  LBVHCPU,        ///< paper 3.1, oneTBB
-  KdTreeCPU,      ///< paper 3.2.1 (Vidal et al. 2008), oneTBB
-  KdTreeGPU,      ///< paper 3.2.2, CUDA, host-driven recursion
-  KdTreeGPUFast,  ///< ours: level-parallel CUDA k-d tree
-  Hybrid,         ///< paper 3.3: shallow k-d tree + 16^3 grid
-  DistanceGrid,   ///< ours: the Grid DDA leaping through empty space with a distance field
-  Auto            ///< measures a few structures (Naive among them) one frame each, keeps the fastest
-};
-enum class LeafCriterion : int { Shallow, Deep };
-enum class BackendKind : int { Auto, CPU, CUDA };
-enum class FilterMode : int { Exact, Hardware };
-
-const char* builderName(BuilderKind b);
-/// Accepts CLI names (naive, grid, lbvh, lbvh-cpu, kdtree-cpu, kdtree-gpu, kdtree-gpu-fast, hybrid,
-/// distance-grid)
-/// and the VTK property names (Naive, Grid, LBVH, KdTreeCPU, ...), case-insensitively.
-bool parseBuilder(const std::string& s, BuilderKind& out);
-
-struct BuildParams {
-  BuilderKind builder = BuilderKind::Grid;
-  LeafCriterion leaf = LeafCriterion::Deep;
-  int maxLeafSize = 0;  ///< 0: none; else leaves' edge <= MLS cells (32 or 128 in the paper)
-  /// KdTreeGPU/KdTreeGPUFast split candidates: >= 2: bins - 1 planes per node at multiples of
-  /// len/bins (the paper's binned method); 0: sweep, every brick boundary along the longest axis,
-  /// which builds exactly the KdTreeCPU tree. KdTreeCPU ignores it: it always sweeps (= bins 0).
-  /// Engine::setBuildParams throws std::invalid_argument for 1 and negative values.
-  int bins = 4;
-  int brick = 8;        ///< macro-cell edge in cells (classification granularity)
-  bool operator==(const BuildParams& o) const {
-    return builder == o.builder && leaf == o.leaf && maxLeafSize == o.maxLeafSize &&
-           bins == o.bins && brick == o.brick;
-  }
-  bool operator!=(const BuildParams& o) const { return !(*this == o); }
-};
-
-struct RenderParams {
-  double sampleDistance = 0;   ///< world units; <= 0: half the smallest spacing
-  double ertThreshold = 2.0;   ///< early ray termination at this alpha; > 1 disables
-  bool jitter = false;
-  unsigned jitterSeed = 0;
-  FilterMode filter = FilterMode::Exact;
-  bool countSamples = false;   ///< statistics: FrameStats::samples (costs a per-pixel buffer)
-  /// vtkVolumeMapper cropping: six planes (xmin, xmax, ymin, ymax, zmin, zmax) in the volume's
-  /// coordinates (origin + index * spacing) cut the box into 27 regions; region
-  /// i + 3j + 9k is drawn when bit i + 3j + 9k of `croppingFlags` is set (0x2000: the
-  /// sub-volume between the planes, VTK_CROP_SUBVOLUME).
-  bool cropping = false;
-  double croppingPlanes[6] = {0, 0, 0, 0, 0, 0};
-  int croppingFlags = 0x2000;
-  /// Clipping planes in the volume's world frame: a point x is kept where
-  /// n.x + d >= 0 for every plane (nx, ny, nz, d), as vtkPlane's normal points to the kept side.
-  std::vector<std::array<double, 4>> clipPlanes;
-  /// The first sample lies this many sample distances past the ray's entry into the box (>= 0).
-  /// vtkGPUVolumeRayCastMapper starts one step in (1) and takes that first sample even where the
-  /// ray leaves the box before it (clamped to the box); > 0 does the same. 0: at the entry.
-  double firstSampleOffset = 0;
-
-  // Blend modes (vtkVolumeMapper::SetBlendMode semantics, as vtkGPUVolumeRayCastMapper does them).
-  BlendMode blend = BlendMode::Composite;
-  std::vector<double> isoValues;  ///< Isosurface: up to kMaxIsoValues (16); any order
-  /// Additive and average: scalars are normalised to [0, 1] over this range (VTK uses the scalar
-  /// array's range); lo >= hi: the transfer function's range.
-  double scalarRange[2] = {0, 0};
-  /// Average: only samples with value in this range count (vtkVolumeMapper's AverageIPScalarRange).
-  double averageRange[2] = {-HUGE_VAL, HUGE_VAL};
-
-  // Gradient shading (vtkVolumeProperty's Shade, Ambient, Diffuse, Specular, SpecularPower;
-  // VTK's defaults), composite and isosurface modes only, as in VTK.
-  bool shade = false;
-  double ambient = 0.0, diffuse = 0.7, specular = 0.2, specularPower = 10.0;
-  /// World direction from the volume towards a directional white light; (0,0,0): a headlight
-  /// (VTK's default light: at the camera, so every ray is lit along itself).
-  double lightDirection[3] = {0, 0, 0};
-};
-/// At most this many clipping planes (VTK's mappers take six).
-constexpr int kMaxClipPlanes = 6;
-
-/// Bounds on the work per ray (so a typo in Sample Distance cannot freeze ParaView's GUI).
-/// The step is at least the smallest voxel spacing / kMinStepsPerVoxel, and a ray through the
-/// whole volume box takes at most kMaxSamplesPerRay samples (which also keeps every sample
-/// index exact in float).
-constexpr double kMinStepsPerVoxel = 16;
-constexpr double kMaxSamplesPerRay = double(1 << 20);
-
 /// The sample distance the engine renders with for `requested` world units (<= 0: half the
-/// smallest spacing), after the bounds above. When a bound applied, `note` (if given) says
+/// smallest spacing), after the bounds kMinStepsPerVoxel and
+/// kMaxSamplesPerRay (Types.h). When a bound applied, `note` (if given) says
 /// what was clamped and why; otherwise it is left empty.
 double effectiveSampleDistance(const Volume& v, double requested, std::string* note = nullptr);
-
-struct BuildStats {
-  BuilderKind builder = BuilderKind::Naive;
-  std::string builtOn;       ///< "cpu" or "cuda"
-  double seconds = 0;        ///< hierarchy construction
-  double classifySeconds = 0;
-  int64_t nodes = 0;
-  int height = 0;
-  int64_t leaves = 0;
-  double occupancy = 0;      ///< fraction of occupied macro cells
-  /// Builder Auto: what it chose and why, one line ("" for the other builders, "exploring ..."
-  /// while it measures).
-  std::string choice;
-};
-
-struct FrameStats {
-  double seconds = 0;
-  int64_t samples = -1;  ///< samples taken in the frame (RenderParams::countSamples), else -1
-  double deviceSeconds = -1;  ///< render kernel time on the GPU (CUDA events), -1 on the CPU
-  std::string backend;
-};
-
-/// How often each stage ran: what tests use to check "rebuild only what a change needs".
-struct Counters {
-  int rangeGrids = 0;
-  int classifications = 0;
-  int builds = 0;
-  int colorUpdates = 0;
-  int frames = 0;
-};
-
-struct Image {
-  int width = 0, height = 0;
-  std::vector<vec4f> rgba;  ///< premultiplied, row 0 at the bottom
-};
-
-/// Raised for errors the caller can fall back from (no CUDA device, device out of memory).
-struct BackendError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 class Backend;
 

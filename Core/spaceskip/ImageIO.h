@@ -1,6 +1,6 @@
 // PNG output (libpng) and image comparison metrics.
 #pragma once
-#include "Engine.h"
+#include "Types.h"
 
 #include <string>
 

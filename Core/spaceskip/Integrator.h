@@ -4,10 +4,9 @@
 #pragma once
 #include "TransferFunction.h"
 #include "Traversal.h"
+#include "Types.h"
 
 namespace spaceskip {
-
-enum class TraversalKind : int { Naive = 0, Grid = 1, Tree = 2, Hybrid = 3 };
 
 /// Most iso values the isosurface blend mode takes (they travel in the FrameView).
 constexpr int kMaxIsoValues = 16;

@@ -2,7 +2,7 @@
 // tight node boxes from a summed volume table, built with oneTBB tasks.
 #pragma once
 #include "Classification.h"
-#include "Engine.h"
+#include "Types.h"
 #include "Tree.h"
 
 #include <cstdint>
@@ -35,5 +35,12 @@ Tree buildKdTree(const OccupancyGrid& occ, const BuildParams& p);
 
 /// The same build with no task parallelism: the reference the tests compare against.
 Tree buildKdTreeSerial(const OccupancyGrid& occ, const BuildParams& p);
+
+namespace cuda {
+struct BuildContext;
+/// The registry's device builders (cuda/KdTreeBuilder.cu): paper 3.2.2 and the level-parallel one.
+void buildKdTreeGpu(BuildContext& ctx, const BuildParams& p);
+void buildKdTreeGpuFast(BuildContext& ctx, const BuildParams& p);
+}  // namespace cuda
 
 }  // namespace spaceskip

@@ -3,6 +3,7 @@
 #pragma once
 #include "Classification.h"
 #include "Tree.h"
+#include "Types.h"
 
 #include <cstdint>
 #include <vector>
@@ -40,5 +41,11 @@ struct KarrasNode {
 };
 std::vector<KarrasNode> karrasHierarchy(const std::vector<uint64_t>& sortedCodes);
 }  // namespace detail
+
+namespace cuda {
+struct BuildContext;
+/// The registry's device builder (cuda/LbvhBuilder.cu): paper 3.1 on the GPU.
+void buildLbvh(BuildContext& ctx, const BuildParams& p);
+}  // namespace cuda
 
 }  // namespace spaceskip

@@ -45,17 +45,14 @@ class CpuBackend final : public Backend {
 
   void build(const BuildParams& p, BuildStats& s) override {
     auto t0 = std::chrono::steady_clock::now();
-    traversal_ = traversalFor(p.builder);
+    const BuilderInfo& info = builderInfo(p.builder);
+    traversal_ = info.traversal;
     tree_ = Tree{};
     hybridGrid_ = OccupancyGrid{};
     dist_.clear();
-    if (p.builder == BuilderKind::DistanceGrid) dist_ = computeDistanceField(occ_);
-    if (traversal_ == TraversalKind::Tree || traversal_ == TraversalKind::Hybrid) {
-      BuildParams q = p;
-      if (p.builder == BuilderKind::LBVH) q.builder = BuilderKind::LBVHCPU;
-      tree_ = buildTreeCPU(occ_, q);
-      if (traversal_ == TraversalKind::Hybrid) hybridGrid_ = coarsen(occ_, std::max(1, 16 / occ_.brick));
-    }
+    if (info.extra == BuilderExtra::DistanceField) dist_ = computeDistanceField(occ_);
+    if (info.extra == BuilderExtra::CoarseGrid) hybridGrid_ = coarsen(occ_, std::max(1, kHybridCell / occ_.brick));
+    if (buildsTree(info)) tree_ = buildTreeCPU(occ_, p);
     s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     s.builtOn = "cpu";
     s.nodes = int64_t(tree_.nodes.size());

@@ -2,6 +2,7 @@
 #include "spaceskip/Engine.h"
 
 #include "spaceskip/Backend.h"
+#include "spaceskip/Builders.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,48 +21,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-struct BuilderName {
-  BuilderKind kind;
-  const char* vtk;
-  const char* cli;
-};
-constexpr BuilderName kBuilders[] = {
-    {BuilderKind::Naive, "Naive", "naive"},
-    {BuilderKind::Grid, "Grid", "grid"},
-    {BuilderKind::LBVH, "LBVH", "lbvh"},
-    {BuilderKind::LBVHCPU, "LBVHCPU", "lbvh-cpu"},
-    {BuilderKind::KdTreeCPU, "KdTreeCPU", "kdtree-cpu"},
-    {BuilderKind::KdTreeGPU, "KdTreeGPU", "kdtree-gpu"},
-    {BuilderKind::KdTreeGPUFast, "KdTreeGPUFast", "kdtree-gpu-fast"},
-    {BuilderKind::Hybrid, "Hybrid", "hybrid"},
-    {BuilderKind::DistanceGrid, "DistanceGrid", "distance-grid"},
-    {BuilderKind::Auto, "Auto", "auto"},
-};
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
-}  // namespace
-
-const char* builderName(BuilderKind b) {
-  for (const auto& n : kBuilders)
-    if (n.kind == b) return n.vtk;
-  return "?";
-}
-
-bool parseBuilder(const std::string& s, BuilderKind& out) {
-  std::string l = lower(s);
-  for (const auto& n : kBuilders)
-    if (l == n.cli || l == lower(n.vtk)) {
-      out = n.kind;
-      return true;
-    }
-  if (l == "macrocellgrid") { out = BuilderKind::Grid; return true; }
-  return false;
-}
-
-namespace {
 // out[i] = in[i] * 2^exponent in float, in parallel (ldexp: exact, NaN and +-Inf kept).
 template <class T>
 void scaleToFloat(const T* in, float* out, int64_t n, int exponent) {
@@ -307,10 +266,11 @@ struct Engine::Impl {
     if (buildDirty) {
       const bool isAuto = build.builder == BuilderKind::Auto;
       BuildParams p = isAuto ? autoState.candidates[size_t(autoState.current)] : build;
-      bool gpuOnly = p.builder == BuilderKind::KdTreeGPU || p.builder == BuilderKind::KdTreeGPUFast;
-      if (gpuOnly && backend->kind() != BackendKind::CUDA) {
-        warn(std::string("builder ") + builderName(p.builder) + " needs the CUDA backend; building KdTreeCPU with the same parameters");
-        p.builder = BuilderKind::KdTreeCPU;
+      const BuilderInfo& info = builderInfo(p.builder);
+      if (!runsOnCpu(info) && backend->kind() != BackendKind::CUDA) {
+        warn(std::string("builder ") + info.name + " needs the CUDA backend; building " + builderName(info.fallback) +
+             " with the same parameters");
+        p.builder = info.fallback;
       }
       BuildStats s;
       try {
@@ -392,8 +352,7 @@ void Engine::setTransferFunction(const TransferFunction& tf) {
 void Engine::setBuildParams(const BuildParams& p) {
   // bins 1 would mean no candidate plane at all; rejected rather than silently clamped, since 0
   // (the sweep) is now a meaningful value next to it.
-  if (p.bins < 0 || p.bins == 1)
-    throw std::invalid_argument("bins must be 0 (sweep every brick boundary) or >= 2, got " + std::to_string(p.bins));
+  validate(p);
   Impl& d = *impl_;
   if (p.brick != d.build.brick) d.rangesDirty = true;
   if (p != d.build) {
