@@ -2,7 +2,7 @@
 // range-checked, so a typo gives a message naming the option instead of a crash or garbage.
 #include "Options.h"
 
-#include "spaceskip/Integrator.h"
+#include "spaceskip/render/Integrator.h"
 #include "spaceskip/Parse.h"
 #include "spaceskip/VolumeIO.h"
 

@@ -357,7 +357,7 @@ class CudaBackend final : public Backend {
     else
       f.grid = GridView{d_occ_[cur_].get(), bdims_, brick_, d_distField_};
     f.tree = TreeView{tree_.nodes.get(), tree_.numNodes};
-    // In these modes every skipping builder marches the value ranges (Integrator.h, usesValueRanges).
+    // In these modes every skipping builder marches the value ranges (render/Integrator.h, usesValueRanges).
     if (usesValueRanges(f.blend) && traversal_ != TraversalKind::Naive) {
       f.traversal = TraversalKind::Grid;
       f.grid = GridView{nullptr, bdims_, brick_, nullptr, d_vmin_.get(), d_vmax_.get()};

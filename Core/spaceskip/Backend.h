@@ -5,7 +5,7 @@
 #include "Tree.h"
 #include "Types.h"
 #include "Volume.h"
-#include "Integrator.h"
+#include "render/Integrator.h"
 
 #include <memory>
 #include <string>

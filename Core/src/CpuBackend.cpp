@@ -66,7 +66,7 @@ class CpuBackend final : public Backend {
     const OccupancyGrid& g = traversal_ == TraversalKind::Hybrid ? hybridGrid_ : occ_;
     f.grid = GridView{g.occ.data(), g.dims, g.brick, dist_.empty() ? nullptr : dist_.data()};
     f.tree = TreeView{tree_.nodes.data(), int(tree_.nodes.size())};
-    // In these modes every skipping builder marches the value ranges (Integrator.h, usesValueRanges).
+    // In these modes every skipping builder marches the value ranges (render/Integrator.h, usesValueRanges).
     if (usesValueRanges(f.blend) && traversal_ != TraversalKind::Naive) {
       f.traversal = TraversalKind::Grid;
       f.grid = GridView{nullptr, ranges_.dims, ranges_.brick, nullptr, ranges_.vmin.data(), ranges_.vmax.data()};

@@ -1,7 +1,7 @@
 // Conservative classification: value ranges include the +1 halo; a TF spike between two voxel
 // values is never classified empty; a TF edit re-classifies bricks only.
 #include "spaceskip/Classification.h"
-#include "spaceskip/Integrator.h"
+#include "spaceskip/render/Integrator.h"
 #include "TestUtil.h"
 
 #include <gtest/gtest.h>

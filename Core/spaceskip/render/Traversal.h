@@ -1,31 +1,9 @@
 // Space-skipping traversals: each yields the ray's possibly non-empty intervals front to back.
 // Written once for host and device; `visit(t0, t1)` returns false to stop (early termination).
 #pragma once
-#include "Tree.h"
+#include "FrameShared.h"
 
 namespace spaceskip {
-
-/// Occupancy grid as the integrator sees it (device pointer on the GPU).
-struct GridView {
-  const uint8_t* occ;
-  vec3i dims;  ///< bricks per axis
-  int brick;   ///< cells per brick edge
-  /// Optional (DistanceGrid): per brick 0 when occupied, else the Chebyshev distance in bricks
-  /// to the nearest occupied brick (DistanceField.h). When set, `occ` is not read.
-  const uint8_t* dist = nullptr;
-  /// Optional (value-range skipping, the MIP/MinIP/average/isosurface blend modes): per-brick
-  /// min/max of the voxels a sample inside can interpolate (RangeGrid, +1 halo). When set,
-  /// neither `occ` nor `dist` is read: a brick is visited when `visit.active(vmin, vmax)` says
-  /// its samples can still change the ray's result, which depends on what the ray has seen so
-  /// far; so every visited brick is handed over on its own, before the next one is decided.
-  const float* vmin = nullptr;
-  const float* vmax = nullptr;
-};
-
-struct TreeView {
-  const Node* nodes;
-  int numNodes;
-};
 
 /// 3-D DDA (Amanatides & Woo 1987) over the bricks of `g`, restricted to t in [tmin, tmax).
 /// Consecutive occupied bricks are merged into one interval (not with value ranges, see GridView). With a distance field, an empty

@@ -1,15 +1,13 @@
 // The per-ray integrator (absorption + emission, front to back, post-classification), written
 // once for the oneTBB and CUDA executors. Sample positions are global per ray
 // (t = t0 + k*dt from the ray's entry into the volume box), so skipping never moves a sample.
+// Ray generation is RayGen.h, the skipping traversals Traversal.h, the frame's data FrameShared.h.
 #pragma once
-#include "TransferFunction.h"
+#include "FrameShared.h"
+#include "RayGen.h"
 #include "Traversal.h"
-#include "Types.h"
 
 namespace spaceskip {
-
-/// Most iso values the isosurface blend mode takes (they travel in the FrameView).
-constexpr int kMaxIsoValues = 16;
 
 /// Blend modes whose result a brick can change although the TF gives it no opacity (MIP, MinIP:
 /// the extreme sample is mapped after the march; average: transparent samples count), or whose
@@ -18,93 +16,6 @@ constexpr int kMaxIsoValues = 16;
 SS_FUNC bool usesValueRanges(BlendMode m) {
   return m == BlendMode::MaximumIntensity || m == BlendMode::MinimumIntensity ||
          m == BlendMode::AverageIntensity || m == BlendMode::Isosurface;
-}
-
-/// Everything a pixel needs, plain data (device pointers on the GPU).
-struct FrameView {
-  float invViewProj[16];   ///< NDC -> world, column-major
-  float worldToIndex[12];  ///< world -> index space, row-major 3x4 affine
-  int width, height;
-  vec3f boxHi;             ///< index-space volume box is [0, boxHi)
-  float dt;                ///< sample distance in world units
-  float ertThreshold;      ///< early ray termination when alpha >= this; > 1 disables
-  int jitter;              ///< 1: per-pixel random start offset in [0, dt)
-  float firstSample;       ///< first sample at the box entry + firstSample * dt (see RenderParams)
-  uint32_t jitterSeed;
-  const float* depth;      ///< optional window depth in [0,1] per pixel (opaque geometry)
-  TraversalKind traversal;
-  GridView grid;           ///< Grid and Hybrid
-  TreeView tree;           ///< Tree and Hybrid
-  TransferFunctionView tf;
-  unsigned* sampleCount;   ///< optional per-pixel count of samples taken (statistics)
-  int numClipPlanes;       ///< index-space half-spaces n.p + d >= 0 kept (convex: one interval)
-  float clip[6][4];
-  int cropping;            ///< 1: only regions of cropFlags between the planes are drawn
-  int cropFlags;           ///< bit i + 3j + 9k: region (i, j, k) of the 3x3x3 split is drawn
-  float crop[6];           ///< index-space planes x0, x1, y0, y1, z0, z1
-  // Blend mode and shading (vtkVolumeMapper / vtkVolumeProperty semantics).
-  BlendMode blend;
-  float normLo, normScale;  ///< additive/average: normalised scalar = (v - normLo) * normScale
-  float avgLo, avgHi;       ///< average: only samples with value in [avgLo, avgHi] count
-  int numIso;               ///< isosurface: iso values, ascending
-  float iso[kMaxIsoValues];
-  int shade;                ///< 1: gradient shading (composite and isosurface, as VTK)
-  float ambient, diffuse, specular, specularPower;
-  vec3f lightDir;           ///< world direction towards the light; (0,0,0): headlight
-  vec3f eyeW;               ///< camera position in world space (the headlight; parallel views too)
-};
-
-/// Clips [tmin, tmax] to the convex intersection of the clipping half-spaces; false if empty.
-SS_FUNC bool clipToPlanes(const FrameView& f, const Ray& r, float& tmin, float& tmax) {
-  for (int i = 0; i < f.numClipPlanes; ++i) {
-    const float* c = f.clip[i];
-    const float num = c[0] * r.org.x + c[1] * r.org.y + c[2] * r.org.z + c[3];
-    const float den = c[0] * r.dir.x + c[1] * r.dir.y + c[2] * r.dir.z;
-    if (den == 0.f) {
-      if (num < 0.f) return false;  // parallel to the plane, on the removed side
-      continue;
-    }
-    const float t = -num / den;
-    if (den > 0.f) tmin = ss_max(tmin, t);  // entering the kept side
-    else tmax = ss_min(tmax, t);
-  }
-  return tmin < tmax;
-}
-
-/// Region index (0..2) of coordinate x between the planes lo and hi of one axis.
-SS_FUNC int cropSlab(float x, float lo, float hi) { return x < lo ? 0 : (x < hi ? 1 : 2); }
-
-/// Calls march(a, b) for each part of [tmin, tmax] that lies in a drawn cropping region, front
-/// to back: the six planes split the ray into at most seven pieces, each inside one region.
-template <class March>
-SS_FUNC void forEachCroppedInterval(const FrameView& f, const Ray& r, float tmin, float tmax, March&& march) {
-  float ts[8];
-  int n = 0;
-  ts[n++] = tmin;
-  for (int a = 0; a < 6; ++a) {
-    const float o = a < 2 ? r.org.x : (a < 4 ? r.org.y : r.org.z);
-    const float d = a < 2 ? r.dir.x : (a < 4 ? r.dir.y : r.dir.z);
-    if (d == 0.f) continue;
-    const float t = (f.crop[a] - o) / d;
-    if (t > tmin && t < tmax) ts[n++] = t;
-  }
-  ts[n++] = tmax;
-  for (int i = 1; i < n; ++i)  // insertion sort: at most 8 values
-    for (int j = i; j > 0 && ts[j] < ts[j - 1]; --j) {
-      const float x = ts[j];
-      ts[j] = ts[j - 1];
-      ts[j - 1] = x;
-    }
-  for (int i = 0; i + 1 < n; ++i) {
-    const float a = ts[i], b = ts[i + 1];
-    if (!(a < b)) continue;
-    const float tm = 0.5f * (a + b);
-    const vec3f p = r.org + r.dir * tm;
-    const int region = cropSlab(p.x, f.crop[0], f.crop[1]) + 3 * cropSlab(p.y, f.crop[2], f.crop[3]) +
-                       9 * cropSlab(p.z, f.crop[4], f.crop[5]);
-    if ((f.cropFlags >> region) & 1)
-      if (!march(a, b)) return;
-  }
 }
 
 /// A voxel as the integrator samples it. +-Inf becomes +-2^100: above every finite value (the
@@ -149,24 +60,6 @@ struct ArraySampler {
     return c0 + (c1 - c0) * fz;
   }
 };
-
-SS_FUNC uint32_t hashPixel(uint32_t x, uint32_t y, uint32_t seed) {
-  uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ seed * 0xcb1ab31fu;
-  h ^= h >> 16;
-  h *= 0x7feb352du;
-  h ^= h >> 15;
-  h *= 0x846ca68bu;
-  h ^= h >> 16;
-  return h;
-}
-
-SS_FUNC vec3f unproject(const float* m, float x, float y, float z) {
-  float X = m[0] * x + m[4] * y + m[8] * z + m[12];
-  float Y = m[1] * x + m[5] * y + m[9] * z + m[13];
-  float Z = m[2] * x + m[6] * y + m[10] * z + m[14];
-  float W = m[3] * x + m[7] * y + m[11] * z + m[15];
-  return vec3f{X / W, Y / W, Z / W};
-}
 
 /// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
 /// never before `nextK`, so adjacent intervals never take a sample twice. Sample indices are
@@ -357,29 +250,11 @@ struct TreeLeaf {
 /// -1 reads f.traversal.
 template <class Sampler, int Traversal = -1>
 SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) {
-  const float nx = (float(px) + 0.5f) / float(f.width) * 2.f - 1.f;
-  const float ny = (float(py) + 0.5f) / float(f.height) * 2.f - 1.f;
-  vec3f nearW = unproject(f.invViewProj, nx, ny, -1.f);
-  vec3f farW = unproject(f.invViewProj, nx, ny, 1.f);
-  vec3f dirW = normalize(farW - nearW);
-  float tLimit = INFINITY;
-  if (f.depth) {
-    float d = f.depth[int64_t(py) * f.width + px];
-    if (d < 1.f) tLimit = dot(unproject(f.invViewProj, nx, ny, 2.f * d - 1.f) - nearW, dirW);
-  }
-  const float* M = f.worldToIndex;
-  Ray r;
-  r.org = vec3f{M[0] * nearW.x + M[1] * nearW.y + M[2] * nearW.z + M[3],
-                M[4] * nearW.x + M[5] * nearW.y + M[6] * nearW.z + M[7],
-                M[8] * nearW.x + M[9] * nearW.y + M[10] * nearW.z + M[11]};
-  r.dir = vec3f{M[0] * dirW.x + M[1] * dirW.y + M[2] * dirW.z,
-                M[4] * dirW.x + M[5] * dirW.y + M[6] * dirW.z,
-                M[8] * dirW.x + M[9] * dirW.y + M[10] * dirW.z};
-  vec3f inv = safeInverse(r.dir);
-  float tEnter, tExit;
-  intersectBox(r, inv, vec3f{0, 0, 0}, f.boxHi, tEnter, tExit);
-  tEnter = ss_max(tEnter, 0.f);
-  tExit = ss_min(tExit, tLimit);
+  const PrimaryRay p = primaryRay(f, px, py);
+  const Ray& r = p.r;
+  const vec3f inv = p.inv;
+  const vec3f nearW = p.nearW, dirW = p.dirW;
+  const float tEnter = p.tEnter, tExit = p.tExit;
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
 

@@ -1,0 +1,72 @@
+// What both executors read per frame: plain data only (no virtuals, no STL), host pointers on
+// the oneTBB backend and device pointers on CUDA, filled once per frame by the backend.
+#pragma once
+#include "../Math.h"
+#include "../TransferFunction.h"
+#include "../Tree.h"
+#include "../Types.h"
+
+#include <cstdint>
+
+namespace spaceskip {
+
+/// Occupancy grid as the integrator sees it (device pointer on the GPU).
+struct GridView {
+  const uint8_t* occ;
+  vec3i dims;  ///< bricks per axis
+  int brick;   ///< cells per brick edge
+  /// Optional (DistanceGrid): per brick 0 when occupied, else the Chebyshev distance in bricks
+  /// to the nearest occupied brick (DistanceField.h). When set, `occ` is not read.
+  const uint8_t* dist = nullptr;
+  /// Optional (value-range skipping, the MIP/MinIP/average/isosurface blend modes): per-brick
+  /// min/max of the voxels a sample inside can interpolate (RangeGrid, +1 halo). When set,
+  /// neither `occ` nor `dist` is read: a brick is visited when `visit.active(vmin, vmax)` says
+  /// its samples can still change the ray's result, which depends on what the ray has seen so
+  /// far; so every visited brick is handed over on its own, before the next one is decided.
+  const float* vmin = nullptr;
+  const float* vmax = nullptr;
+};
+
+struct TreeView {
+  const Node* nodes;
+  int numNodes;
+};
+
+/// Most iso values the isosurface blend mode takes (they travel in the FrameView).
+constexpr int kMaxIsoValues = 16;
+
+/// Everything a pixel needs, plain data (device pointers on the GPU).
+struct FrameView {
+  float invViewProj[16];   ///< NDC -> world, column-major
+  float worldToIndex[12];  ///< world -> index space, row-major 3x4 affine
+  int width, height;
+  vec3f boxHi;             ///< index-space volume box is [0, boxHi)
+  float dt;                ///< sample distance in world units
+  float ertThreshold;      ///< early ray termination when alpha >= this; > 1 disables
+  int jitter;              ///< 1: per-pixel random start offset in [0, dt)
+  float firstSample;       ///< first sample at the box entry + firstSample * dt (see RenderParams)
+  uint32_t jitterSeed;
+  const float* depth;      ///< optional window depth in [0,1] per pixel (opaque geometry)
+  TraversalKind traversal;
+  GridView grid;           ///< Grid and Hybrid
+  TreeView tree;           ///< Tree and Hybrid
+  TransferFunctionView tf;
+  unsigned* sampleCount;   ///< optional per-pixel count of samples taken (statistics)
+  int numClipPlanes;       ///< index-space half-spaces n.p + d >= 0 kept (convex: one interval)
+  float clip[6][4];
+  int cropping;            ///< 1: only regions of cropFlags between the planes are drawn
+  int cropFlags;           ///< bit i + 3j + 9k: region (i, j, k) of the 3x3x3 split is drawn
+  float crop[6];           ///< index-space planes x0, x1, y0, y1, z0, z1
+  // Blend mode and shading (vtkVolumeMapper / vtkVolumeProperty semantics).
+  BlendMode blend;
+  float normLo, normScale;  ///< additive/average: normalised scalar = (v - normLo) * normScale
+  float avgLo, avgHi;       ///< average: only samples with value in [avgLo, avgHi] count
+  int numIso;               ///< isosurface: iso values, ascending
+  float iso[kMaxIsoValues];
+  int shade;                ///< 1: gradient shading (composite and isosurface, as VTK)
+  float ambient, diffuse, specular, specularPower;
+  vec3f lightDir;           ///< world direction towards the light; (0,0,0): headlight
+  vec3f eyeW;               ///< camera position in world space (the headlight; parallel views too)
+};
+
+}  // namespace spaceskip

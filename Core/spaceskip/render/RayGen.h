@@ -1,0 +1,117 @@
+// Ray generation: the primary ray of a pixel in the volume's index space, cut to the box, the
+// window's depth, the clipping planes and the cropping regions. Written once for both executors.
+#pragma once
+#include "FrameShared.h"
+
+namespace spaceskip {
+
+/// A pixel's ray in index space over [tEnter, tExit) (empty when !(tEnter < tExit)), with the
+/// world-space entry frame that shading needs.
+struct PrimaryRay {
+  Ray r;
+  vec3f inv;  ///< safeInverse(r.dir)
+  vec3f nearW, dirW;
+  float tEnter, tExit;
+};
+
+SS_FUNC uint32_t hashPixel(uint32_t x, uint32_t y, uint32_t seed) {
+  uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ seed * 0xcb1ab31fu;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return h;
+}
+
+SS_FUNC vec3f unproject(const float* m, float x, float y, float z) {
+  float X = m[0] * x + m[4] * y + m[8] * z + m[12];
+  float Y = m[1] * x + m[5] * y + m[9] * z + m[13];
+  float Z = m[2] * x + m[6] * y + m[10] * z + m[14];
+  float W = m[3] * x + m[7] * y + m[11] * z + m[15];
+  return vec3f{X / W, Y / W, Z / W};
+}
+
+/// The ray through the centre of pixel (px, py) (row 0 at the bottom), entering the index-space box
+/// [0, boxHi) no earlier than the near plane and leaving it no later than the window's depth.
+SS_FUNC PrimaryRay primaryRay(const FrameView& f, int px, int py) {
+  PrimaryRay p;
+  const float nx = (float(px) + 0.5f) / float(f.width) * 2.f - 1.f;
+  const float ny = (float(py) + 0.5f) / float(f.height) * 2.f - 1.f;
+  p.nearW = unproject(f.invViewProj, nx, ny, -1.f);
+  vec3f farW = unproject(f.invViewProj, nx, ny, 1.f);
+  p.dirW = normalize(farW - p.nearW);
+  float tLimit = INFINITY;
+  if (f.depth) {
+    float d = f.depth[int64_t(py) * f.width + px];
+    if (d < 1.f) tLimit = dot(unproject(f.invViewProj, nx, ny, 2.f * d - 1.f) - p.nearW, p.dirW);
+  }
+  const float* M = f.worldToIndex;
+  const vec3f nearW = p.nearW, dirW = p.dirW;
+  p.r.org = vec3f{M[0] * nearW.x + M[1] * nearW.y + M[2] * nearW.z + M[3],
+                  M[4] * nearW.x + M[5] * nearW.y + M[6] * nearW.z + M[7],
+                  M[8] * nearW.x + M[9] * nearW.y + M[10] * nearW.z + M[11]};
+  p.r.dir = vec3f{M[0] * dirW.x + M[1] * dirW.y + M[2] * dirW.z,
+                  M[4] * dirW.x + M[5] * dirW.y + M[6] * dirW.z,
+                  M[8] * dirW.x + M[9] * dirW.y + M[10] * dirW.z};
+  p.inv = safeInverse(p.r.dir);
+  intersectBox(p.r, p.inv, vec3f{0, 0, 0}, f.boxHi, p.tEnter, p.tExit);
+  p.tEnter = ss_max(p.tEnter, 0.f);
+  p.tExit = ss_min(p.tExit, tLimit);
+  return p;
+}
+
+/// Clips [tmin, tmax] to the convex intersection of the clipping half-spaces; false if empty.
+SS_FUNC bool clipToPlanes(const FrameView& f, const Ray& r, float& tmin, float& tmax) {
+  for (int i = 0; i < f.numClipPlanes; ++i) {
+    const float* c = f.clip[i];
+    const float num = c[0] * r.org.x + c[1] * r.org.y + c[2] * r.org.z + c[3];
+    const float den = c[0] * r.dir.x + c[1] * r.dir.y + c[2] * r.dir.z;
+    if (den == 0.f) {
+      if (num < 0.f) return false;  // parallel to the plane, on the removed side
+      continue;
+    }
+    const float t = -num / den;
+    if (den > 0.f) tmin = ss_max(tmin, t);  // entering the kept side
+    else tmax = ss_min(tmax, t);
+  }
+  return tmin < tmax;
+}
+
+/// Region index (0..2) of coordinate x between the planes lo and hi of one axis.
+SS_FUNC int cropSlab(float x, float lo, float hi) { return x < lo ? 0 : (x < hi ? 1 : 2); }
+
+/// Calls march(a, b) for each part of [tmin, tmax] that lies in a drawn cropping region, front
+/// to back: the six planes split the ray into at most seven pieces, each inside one region.
+template <class March>
+SS_FUNC void forEachCroppedInterval(const FrameView& f, const Ray& r, float tmin, float tmax, March&& march) {
+  float ts[8];
+  int n = 0;
+  ts[n++] = tmin;
+  for (int a = 0; a < 6; ++a) {
+    const float o = a < 2 ? r.org.x : (a < 4 ? r.org.y : r.org.z);
+    const float d = a < 2 ? r.dir.x : (a < 4 ? r.dir.y : r.dir.z);
+    if (d == 0.f) continue;
+    const float t = (f.crop[a] - o) / d;
+    if (t > tmin && t < tmax) ts[n++] = t;
+  }
+  ts[n++] = tmax;
+  for (int i = 1; i < n; ++i)  // insertion sort: at most 8 values
+    for (int j = i; j > 0 && ts[j] < ts[j - 1]; --j) {
+      const float x = ts[j];
+      ts[j] = ts[j - 1];
+      ts[j - 1] = x;
+    }
+  for (int i = 0; i + 1 < n; ++i) {
+    const float a = ts[i], b = ts[i + 1];
+    if (!(a < b)) continue;
+    const float tm = 0.5f * (a + b);
+    const vec3f p = r.org + r.dir * tm;
+    const int region = cropSlab(p.x, f.crop[0], f.crop[1]) + 3 * cropSlab(p.y, f.crop[2], f.crop[3]) +
+                       9 * cropSlab(p.z, f.crop[4], f.crop[5]);
+    if ((f.cropFlags >> region) & 1)
+      if (!march(a, b)) return;
+  }
+}
+
+}  // namespace spaceskip
