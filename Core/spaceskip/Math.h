@@ -61,9 +61,9 @@ SS_FUNC box3i unite(const box3i& a, const box3i& b) {
                vec3i{ss_maxi(a.hi.x, b.hi.x), ss_maxi(a.hi.y, b.hi.y), ss_maxi(a.hi.z, b.hi.z)}};
 }
 
-/// Cell-space box of the bricks [bricks.lo, bricks.hi) of `brick`^3 cells, clamped to the volume's
-/// `cellDims`. Its hi is also the last voxel a trilinear sample in those bricks touches (the +1
-/// halo: cellDims = voxel dims - 1), so [lo, hi] inclusive is the bricks' voxel range.
+/// Cell-space box of the bricks [bricks.lo, bricks.hi) of `brick`^3 cells, clamped to `cellDims`.
+/// Clamped to the voxel dims - 1 instead, [lo, hi] inclusive is the voxel range a trilinear sample
+/// in those bricks touches (the +1 halo of RangeGrid).
 SS_FUNC box3i brickCellBox(const box3i& bricks, int brick, vec3i cellDims) {
   return box3i{vec3i{bricks.lo.x * brick, bricks.lo.y * brick, bricks.lo.z * brick},
                vec3i{ss_mini(bricks.hi.x * brick, cellDims.x), ss_mini(bricks.hi.y * brick, cellDims.y),
