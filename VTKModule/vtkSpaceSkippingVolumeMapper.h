@@ -28,7 +28,6 @@
 #include <memory> // For std::unique_ptr
 #include <string> // For WarnOnce
 
-class vtkOpenGLRenderWindow;
 class vtkRenderer;
 class vtkVolume;
 class vtkWindow;
@@ -311,8 +310,6 @@ private:
   // Says a warning once per distinct message for the life of the mapper.
   void WarnOnce(const std::string& message);
 
-  // Reads the window depth of the viewport into the internal buffer (resolving MSAA if needed).
-  bool ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);
   /// BlendModeOverride when set, else BlendMode.
   int EffectiveBlendMode() const
   {

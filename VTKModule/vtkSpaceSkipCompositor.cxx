@@ -1,0 +1,332 @@
+// vtkSpaceSkipCompositor: depth readback, image upload (or CUDA-GL interop) and blending.
+#include "vtkSpaceSkipCompositor.h"
+
+#include "vtkLogger.h"
+#include "vtkOpenGLFramebufferObject.h"
+#include "vtkOpenGLQuadHelper.h"
+#include "vtkOpenGLRenderUtilities.h"
+#include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
+#include "vtkShaderProgram.h"
+#include "vtkTextureObject.h"
+#include "vtk_glew.h"
+
+#include "spaceskip/Engine.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#ifdef SPACESKIP_HAVE_CUDA
+// CUDA-GL interop for GPUComposite (runtime API only: no kernel here; GLEW already blocks gl.h).
+#include <cuda_gl_interop.h>
+#include <cuda_runtime_api.h>
+#endif
+
+#include <algorithm>
+#include <cstring>
+
+//------------------------------------------------------------------------------
+vtkSpaceSkipCompositor::vtkSpaceSkipCompositor() = default;
+
+//------------------------------------------------------------------------------
+vtkSpaceSkipCompositor::~vtkSpaceSkipCompositor()
+{
+  this->ReleaseInterop();
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipCompositor::ReleaseGraphicsResources(vtkWindow* win)
+{
+  if (this->Texture)
+  {
+    this->Texture->ReleaseGraphicsResources(win);
+    this->Texture = nullptr;
+  }
+  if (this->Quad)
+  {
+    this->Quad->ReleaseGraphicsResources(win);
+    this->Quad.reset();
+  }
+  if (this->Resolve)
+  {
+    this->Resolve->ReleaseGraphicsResources(win);
+    this->Resolve = nullptr;
+  }
+  this->ReleaseInterop();
+  if (this->InteropTexture)
+  {
+    this->InteropTexture->ReleaseGraphicsResources(win);
+    this->InteropTexture = nullptr;
+  }
+}
+
+//------------------------------------------------------------------------------
+const float* vtkSpaceSkipCompositor::ReadDepth(
+  vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height)
+{
+  this->Depth.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
+  vtkOpenGLState* ostate = renWin->GetState();
+  while (glGetError() != GL_NO_ERROR)
+  {
+  }
+  ostate->vtkglPixelStorei(GL_PACK_ALIGNMENT, 1);
+  GLint sampleBuffers = 0;
+  glGetIntegerv(GL_SAMPLE_BUFFERS, &sampleBuffers);
+  if (sampleBuffers <= 0)
+  {
+    glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, this->Depth.data());
+    return glGetError() == GL_NO_ERROR ? this->Depth.data() : nullptr;
+  }
+
+  // Multisampled framebuffer: resolve its depth into a single-sample framebuffer of the same
+  // depth format (what vtkOpenGLRenderWindow allocates: 32 bits, stencil when the window has
+  // one), over the same rectangle (a multisample blit cannot move pixels), then read that.
+  GLint source = 0;
+  glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &source);
+  const int needW = x0 + width, needH = y0 + height;
+  const bool stencil = renWin->GetStencilCapable() != 0;
+  ostate->PushFramebufferBindings();
+  if (!this->Resolve || this->ResolveStencil != stencil)
+  {
+    this->Resolve = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
+    this->Resolve->SetContext(renWin);
+    this->Resolve->Bind();
+    this->Resolve->PopulateFramebuffer(
+      needW, needH, true, 1, VTK_UNSIGNED_CHAR, true, 32, 0, stencil);
+    this->ResolveStencil = stencil;
+  }
+  else
+  {
+    int* size = this->Resolve->GetLastSize();
+    if (size[0] != needW || size[1] != needH)
+    {
+      this->Resolve->Bind();
+      this->Resolve->Resize(needW, needH);
+    }
+  }
+  ostate->vtkglBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<unsigned int>(source));
+  this->Resolve->Bind(GL_DRAW_FRAMEBUFFER);
+  glBlitFramebuffer(x0, y0, x0 + width, y0 + height, x0, y0, x0 + width, y0 + height,
+    GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+  this->Resolve->Bind(GL_READ_FRAMEBUFFER);
+  glReadPixels(x0, y0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, this->Depth.data());
+  const bool ok = glGetError() == GL_NO_ERROR;
+  ostate->PopFramebufferBindings();
+  return ok ? this->Depth.data() : nullptr;
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipCompositor::CopyDeviceImage(
+  vtkOpenGLRenderWindow* renWin, const void* image, int width, int height)
+{
+  if (this->CopyToInteropTexture(renWin, image, width, height))
+  {
+    this->Interop = true;
+    this->CompositePath = "gpu";
+    return true;
+  }
+  // Not this GL (Mesa, another device) or a CUDA error: the host path from now on.
+  vtkVLogF(vtkLogger::VERBOSITY_INFO,
+    "vtkSpaceSkippingVolumeMapper: CUDA-GL interop unavailable (%s); the image goes "
+    "through host memory",
+    this->InteropProblem.c_str());
+  this->InteropFailed = true;
+  this->ReleaseInterop();
+  return false;
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip::Image& image,
+  int width, int height, bool eightBit)
+{
+  vtkTextureObject* texture = this->Interop ? this->InteropTexture.GetPointer() : nullptr;
+  this->Interop = false;
+  this->UploadHostImage(renWin, texture ? nullptr : &image, width, height, eightBit);
+  if (!texture)
+  {
+    texture = this->Texture;
+    this->CompositePath = "host";
+  }
+  return this->Blend(renWin, texture);
+}
+
+//------------------------------------------------------------------------------
+// The host texture, set up every frame; `image` (when given) uploaded into it.
+void vtkSpaceSkipCompositor::UploadHostImage(vtkOpenGLRenderWindow* renWin,
+  const spaceskip::Image* image, int width, int height, bool eightBit)
+{
+  if (!this->Texture)
+  {
+    this->Texture = vtkSmartPointer<vtkTextureObject>::New();
+  }
+  this->Texture->SetContext(renWin);
+  this->Texture->SetMinificationFilter(vtkTextureObject::Nearest);
+  this->Texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+  this->Texture->SetWrapS(vtkTextureObject::ClampToEdge);
+  this->Texture->SetWrapT(vtkTextureObject::ClampToEdge);
+  if (!image)
+  {
+    return; // this frame is drawn from the interop texture
+  }
+  if (eightBit)
+  {
+    // The window holds 8 bits per channel: round the premultiplied image to 8 bits here (a
+    // quarter of the float image's upload, which cost ~5 ms per 1024^2 frame on an H100).
+    const size_t n = image->rgba.size();
+    this->Image8.resize(4 * n);
+    const float* src = &image->rgba[0].x;
+    unsigned char* dst = this->Image8.data();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, 4 * n, size_t(1) << 16),
+      [src, dst](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i < r.end(); ++i)
+        {
+          const float v = std::min(std::max(src[i], 0.f), 1.f);
+          dst[i] = static_cast<unsigned char>(v * 255.f + 0.5f);
+        }
+      });
+    this->Texture->Create2DFromRaw(static_cast<unsigned>(width), static_cast<unsigned>(height), 4,
+      VTK_UNSIGNED_CHAR, this->Image8.data());
+  }
+  else
+  {
+    this->Texture->Create2DFromRaw(static_cast<unsigned>(width), static_cast<unsigned>(height), 4,
+      VTK_FLOAT, const_cast<spaceskip::vec4f*>(image->rgba.data())); // only read
+  }
+}
+
+//------------------------------------------------------------------------------
+// A full-screen quad drawing `texture` as premultiplied RGBA over what is drawn,
+// (ONE, ONE_MINUS_SRC_ALPHA), depth untouched; false when the shader does not compile.
+bool vtkSpaceSkipCompositor::Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture)
+{
+  if (!this->Quad)
+  {
+    std::string fs = vtkOpenGLRenderUtilities::GetFullScreenQuadFragmentShaderTemplate();
+    vtkShaderProgram::Substitute(fs, "//VTK::FSQ::Decl", "uniform sampler2D ssImage;");
+    vtkShaderProgram::Substitute(
+      fs, "//VTK::FSQ::Impl", "  gl_FragData[0] = texture(ssImage, texCoord);");
+    this->Quad.reset(new vtkOpenGLQuadHelper(renWin,
+      vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), fs.c_str(), ""));
+  }
+  else
+  {
+    renWin->GetShaderCache()->ReadyShaderProgram(this->Quad->Program);
+  }
+  if (!this->Quad->Program || !this->Quad->Program->GetCompiled())
+  {
+    return false;
+  }
+
+  vtkOpenGLState* ostate = renWin->GetState();
+  vtkOpenGLState::ScopedglEnableDisable blendSaver(ostate, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable depthSaver(ostate, GL_DEPTH_TEST);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(ostate);
+  vtkOpenGLState::ScopedglDepthMask depthMaskSaver(ostate);
+  ostate->vtkglEnable(GL_BLEND);
+  ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  ostate->vtkglDisable(GL_DEPTH_TEST);
+  ostate->vtkglDepthMask(GL_FALSE);
+  texture->Activate();
+  this->Quad->Program->SetUniformi("ssImage", texture->GetTextureUnit());
+  this->Quad->Render();
+  texture->Deactivate();
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipCompositor::ReleaseInterop()
+{
+#ifdef SPACESKIP_HAVE_CUDA
+  if (this->InteropResource)
+  {
+    cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->InteropResource));
+    cudaGetLastError(); // a failure here (context gone) must not reach the engine's checks
+  }
+#endif
+  this->InteropResource = nullptr;
+  this->InteropSize[0] = this->InteropSize[1] = 0;
+}
+
+//------------------------------------------------------------------------------
+// Copies the engine's device image into InteropTexture; false (with the reason) on any failure.
+bool vtkSpaceSkipCompositor::CopyToInteropTexture(
+  vtkOpenGLRenderWindow* renWin, const void* image, int w, int h)
+{
+#ifdef SPACESKIP_HAVE_CUDA
+  auto failed = [this](const char* what, cudaError_t e) {
+    this->InteropProblem = std::string(what) + ": " + cudaGetErrorString(e);
+    cudaGetLastError();
+    return false;
+  };
+  if (!this->InteropTexture || this->InteropSize[0] != w || this->InteropSize[1] != h)
+  {
+    this->ReleaseInterop();
+    // Only NVIDIA's GL can share with CUDA: do not even ask another (the failing call would
+    // show up as an API error in compute-sanitizer).
+    const char* vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
+    if (!vendor || !std::strstr(vendor, "NVIDIA"))
+    {
+      this->InteropProblem =
+        std::string("the window's OpenGL is ") + (vendor ? vendor : "unknown") + "'s, not NVIDIA's";
+      return false;
+    }
+    if (!this->InteropTexture)
+    {
+      this->InteropTexture = vtkSmartPointer<vtkTextureObject>::New();
+    }
+    this->InteropTexture->SetContext(renWin);
+    this->InteropTexture->SetMinificationFilter(vtkTextureObject::Nearest);
+    this->InteropTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    this->InteropTexture->SetWrapS(vtkTextureObject::ClampToEdge);
+    this->InteropTexture->SetWrapT(vtkTextureObject::ClampToEdge);
+    if (!this->InteropTexture->Allocate2D(
+          static_cast<unsigned>(w), static_cast<unsigned>(h), 4, VTK_FLOAT))
+    {
+      this->InteropProblem = "could not allocate the float texture";
+      return false;
+    }
+    cudaGraphicsResource_t r = nullptr;
+    const cudaError_t e = cudaGraphicsGLRegisterImage(&r, this->InteropTexture->GetHandle(),
+      GL_TEXTURE_2D, cudaGraphicsRegisterFlagsWriteDiscard);
+    if (e != cudaSuccess)
+    {
+      return failed("cudaGraphicsGLRegisterImage", e);
+    }
+    this->InteropResource = r;
+    this->InteropSize[0] = w;
+    this->InteropSize[1] = h;
+  }
+  cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(this->InteropResource);
+  cudaError_t e = cudaGraphicsMapResources(1, &r, nullptr);
+  if (e != cudaSuccess)
+  {
+    return failed("cudaGraphicsMapResources", e);
+  }
+  cudaArray_t array = nullptr;
+  e = cudaGraphicsSubResourceGetMappedArray(&array, r, 0, 0);
+  if (e == cudaSuccess)
+  {
+    const size_t row = static_cast<size_t>(w) * 4 * sizeof(float);
+    e = cudaMemcpy2DToArray(
+      array, 0, 0, image, row, row, static_cast<size_t>(h), cudaMemcpyDeviceToDevice);
+  }
+  const cudaError_t u = cudaGraphicsUnmapResources(1, &r, nullptr);
+  if (e != cudaSuccess)
+  {
+    return failed("copy into the GL texture", e);
+  }
+  if (u != cudaSuccess)
+  {
+    return failed("cudaGraphicsUnmapResources", u);
+  }
+  return true;
+#else
+  (void)renWin;
+  (void)image;
+  (void)w;
+  (void)h;
+  this->InteropProblem = "built without CUDA";
+  return false;
+#endif
+}

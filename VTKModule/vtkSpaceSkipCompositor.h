@@ -1,0 +1,89 @@
+// vtkSpaceSkipCompositor: the window side of the mapper: reads the depth of what is drawn and
+// blends the engine's premultiplied RGBA image over it (from host memory, or from device memory
+// through CUDA-GL interop). Internal to the module (not wrapped, not installed); needs no nvcc.
+#ifndef vtkSpaceSkipCompositor_h
+#define vtkSpaceSkipCompositor_h
+
+#include "vtkSmartPointer.h" // For the textures and the framebuffer
+
+#include <memory> // For Quad
+#include <string> // For the problem and path texts
+#include <vector> // For the buffers
+
+class vtkOpenGLFramebufferObject;
+class vtkOpenGLQuadHelper;
+class vtkOpenGLRenderWindow;
+class vtkTextureObject;
+class vtkWindow;
+namespace spaceskip
+{
+struct Image;
+}
+
+class vtkSpaceSkipCompositor
+{
+public:
+  vtkSpaceSkipCompositor();
+  ~vtkSpaceSkipCompositor();
+  vtkSpaceSkipCompositor(const vtkSpaceSkipCompositor&) = delete;
+  void operator=(const vtkSpaceSkipCompositor&) = delete;
+
+  /**
+   * The window depth of the viewport's opaque geometry already drawn, in [0, 1], row 0 at the
+   * bottom (an MSAA framebuffer is resolved first), or nullptr when it could not be read.
+   */
+  const float* ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);
+
+  /// Whether the image may stay on the device for CUDA-GL interop (GPUComposite on, not failed).
+  bool CanUseDeviceImage(bool gpuComposite) const { return gpuComposite && !this->InteropFailed; }
+
+  /**
+   * Copies the engine's device image (float4 RGBA) into a GL texture registered with CUDA, the
+   * one Draw() then blends. False on any failure (not NVIDIA's GL, another device, a CUDA
+   * error): said once at INFO verbosity, and the host path is used from then on.
+   */
+  bool CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image, int width, int height);
+
+  /**
+   * Blends the image over what is drawn as premultiplied RGBA (ONE, ONE_MINUS_SRC_ALPHA): the
+   * texture CopyDeviceImage() filled this frame, else `image` uploaded from host memory (rounded
+   * to 8 bits per channel when `eightBit`). False when the compositing shader does not compile.
+   */
+  bool Draw(vtkOpenGLRenderWindow* renWin, const spaceskip::Image& image, int width, int height,
+    bool eightBit);
+
+  /// "gpu", "host" or "none": how the last image reached the window.
+  const std::string& GetCompositePath() const { return this->CompositePath; }
+  bool GetInteropFailed() const { return this->InteropFailed; }
+  const std::string& GetInteropProblem() const { return this->InteropProblem; }
+  /// Whether this frame's image is the interop texture (CopyDeviceImage succeeded).
+  bool HasDeviceImage() const { return this->Interop; }
+
+  void ReleaseGraphicsResources(vtkWindow* win);
+
+private:
+  void UploadHostImage(vtkOpenGLRenderWindow* renWin, const spaceskip::Image* image, int width,
+    int height, bool eightBit);
+  bool Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture);
+  void ReleaseInterop();
+  bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, int w, int h);
+
+  std::vector<float> Depth;
+  vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
+  bool ResolveStencil = false;
+
+  std::vector<unsigned char> Image8; // the image rounded to 8 bits for upload (EightBitComposite)
+  vtkSmartPointer<vtkTextureObject> Texture;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+
+  // GPUComposite: a float RGBA texture registered with CUDA, filled from the engine's device image.
+  vtkSmartPointer<vtkTextureObject> InteropTexture;
+  void* InteropResource = nullptr; // cudaGraphicsResource_t
+  int InteropSize[2] = { 0, 0 };
+  bool InteropFailed = false; // once failed (e.g. GL on Mesa, another GPU): host path from then on
+  bool Interop = false;       // this frame's image is InteropTexture
+  std::string InteropProblem;
+  std::string CompositePath = "none";
+};
+
+#endif

@@ -1,0 +1,70 @@
+// vtkSpaceSkipInputConverter: the mapper's vtkImageData and scalar array -> a spaceskip::Volume.
+// Internal to the module (not wrapped, not installed).
+#ifndef vtkSpaceSkipInputConverter_h
+#define vtkSpaceSkipInputConverter_h
+
+#include "vtkSmartPointer.h" // For Borrowed
+#include "vtkType.h"         // For vtkMTimeType, vtkIdType
+
+#include <functional> // For WarnFunction
+#include <string>     // For the problem and warning texts
+#include <vector>     // For Converted
+
+class vtkDataArray;
+class vtkImageData;
+namespace spaceskip
+{
+class Engine;
+}
+
+class vtkSpaceSkipInputConverter
+{
+public:
+  using WarnFunction = std::function<void(const std::string&)>;
+
+  /**
+   * Picks what this frame draws: `scalars` (vtkAbstractMapper::GetScalars of `input`) and,
+   * with several components, the one VectorMode/VectorComponent select, as vtkSmartVolumeMapper
+   * does. False, with `problem` set, when nothing can be drawn (no image, empty extent, no point
+   * scalars, wrong length, unsupported type).
+   */
+  bool Select(vtkImageData* input, vtkDataArray* scalars, int cellFlag, int vectorMode,
+    int vectorComponent, bool independentComponents, const WarnFunction& warnOnce,
+    std::string& problem);
+
+  /**
+   * Hands the selected volume to the engine when the data, the array or the component changed
+   * since the last call (borrowing native single-component arrays, converting the others to
+   * float), then recomputes the scalar range. Returns the seconds of that range pass (0 when
+   * nothing changed).
+   */
+  double Update(spaceskip::Engine& engine, const WarnFunction& warnOnce);
+
+  /// Finite range of the scalars the engine reads ({0, 1} when none is finite).
+  const double* GetScalarRange() const { return this->ScalarRange; }
+
+  /// Forgets what the engine was given (a new engine): the next Update hands the volume again.
+  void Reset();
+
+private:
+  // This frame's selection (Select).
+  vtkImageData* Input = nullptr;
+  vtkDataArray* Scalars = nullptr;
+  int NumberOfComponents = 1;
+  bool Magnitude = false;
+  int Component = 0;
+
+  // What the engine was last given; compared by identity and MTime to redo only what changed.
+  const void* InputKey = nullptr;
+  const void* ScalarsKey = nullptr;
+  vtkMTimeType InputMTime = 0;
+  vtkMTimeType ScalarsMTime = 0;
+  bool HaveVolume = false;
+  int Selection = 0; // the component the volume was made from; -1: the magnitude
+  std::vector<float> Converted; // int/long scalars (or a component, the magnitude) as float
+  // The array whose voxels the engine borrows: held so it outlives the engine's use of it.
+  vtkSmartPointer<vtkDataArray> Borrowed;
+  double ScalarRange[2] = { 0, 1 };
+};
+
+#endif

@@ -1,0 +1,282 @@
+// vtkSpaceSkipPropertyTranslator: VTK's volume property, mapper settings, lights and camera ->
+// Core's parameters, as vtkGPUVolumeRayCastMapper reads them.
+#include "vtkSpaceSkipPropertyTranslator.h"
+
+#include "vtkColorTransferFunction.h"
+#include "vtkContourValues.h"
+#include "vtkLight.h"
+#include "vtkLightCollection.h"
+#include "vtkMatrix3x3.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
+#include "vtkOpenGLCamera.h"
+#include "vtkPiecewiseFunction.h"
+#include "vtkPlane.h"
+#include "vtkPlaneCollection.h"
+#include "vtkRenderer.h"
+#include "vtkSpaceSkippingVolumeMapper.h"
+#include "vtkVolume.h"
+#include "vtkVolumeProperty.h"
+
+#include "spaceskip/Engine.h"
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+namespace
+{
+// Table resolution of the transfer function, sampled over the data's scalar range (what
+// vtkGPUVolumeRayCastMapper does by default, ColorRangeType == SCALAR).
+constexpr int kTableSize = 1024;
+// BuilderTypes are cast to spaceskip::BuilderKind: the two enums must stay in the same order.
+static_assert(static_cast<int>(spaceskip::BuilderKind::Hybrid) == vtkSpaceSkippingVolumeMapper::Hybrid &&
+    static_cast<int>(spaceskip::BuilderKind::DistanceGrid) == vtkSpaceSkippingVolumeMapper::DistanceGrid,
+  "vtkSpaceSkippingVolumeMapper::BuilderTypes out of step with spaceskip::BuilderKind");
+// Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
+constexpr double kErtThreshold = 0.99;
+
+static_assert(static_cast<int>(spaceskip::BlendMode::Isosurface) == vtkVolumeMapper::ISOSURFACE_BLEND &&
+    static_cast<int>(spaceskip::BlendMode::MaximumIntensity) == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND,
+  "spaceskip::BlendMode out of step with vtkVolumeMapper's blend modes");
+
+// Core's column-major mat4 from a row-major vtkMatrix4x4.
+spaceskip::mat4 ToCore(const vtkMatrix4x4* m)
+{
+  spaceskip::mat4 out;
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      out.m[c * 4 + r] = m->GetElement(r, c);
+    }
+  }
+  return out;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(
+  spaceskip::Engine& engine, vtkVolumeProperty* prop, const double scalarRange[2])
+{
+  const bool gray = prop->GetColorChannels(0) == 1;
+  vtkObject* color = gray ? static_cast<vtkObject*>(prop->GetGrayTransferFunction(0))
+                          : static_cast<vtkObject*>(prop->GetRGBTransferFunction(0));
+  vtkPiecewiseFunction* opacity = prop->GetScalarOpacity(0);
+  double lo = scalarRange[0], hi = scalarRange[1];
+  if (!(hi > lo))
+  {
+    hi = lo + 1.0; // constant volume: any non-empty range samples its one value
+  }
+  if (this->HaveTF && this->PropertyKey == prop && this->PropertyMTime == prop->GetMTime() &&
+    this->ColorKey == color && this->ColorMTime == color->GetMTime() &&
+    this->OpacityKey == opacity && this->OpacityMTime == opacity->GetMTime() &&
+    this->TableRange[0] == lo && this->TableRange[1] == hi)
+  {
+    return;
+  }
+  spaceskip::TransferFunction tf;
+  tf.rangeMin = lo;
+  tf.rangeMax = hi;
+  tf.unitDistance = std::max(prop->GetScalarOpacityUnitDistance(0), 1e-12);
+  std::vector<float> rgb(3 * kTableSize), alpha(kTableSize);
+  if (gray)
+  {
+    std::vector<float> g(kTableSize);
+    static_cast<vtkPiecewiseFunction*>(color)->GetTable(lo, hi, kTableSize, g.data());
+    for (int i = 0; i < kTableSize; ++i)
+    {
+      rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = g[i];
+    }
+  }
+  else
+  {
+    static_cast<vtkColorTransferFunction*>(color)->GetTable(lo, hi, kTableSize, rgb.data());
+  }
+  opacity->GetTable(lo, hi, kTableSize, alpha.data());
+  tf.table.resize(kTableSize);
+  for (int i = 0; i < kTableSize; ++i)
+  {
+    tf.table[i] = spaceskip::vec4f{ rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2],
+      std::min(std::max(alpha[i], 0.f), 1.f) };
+  }
+  engine.setTransferFunction(tf);
+  this->PropertyKey = prop;
+  this->PropertyMTime = prop->GetMTime();
+  this->ColorKey = color;
+  this->ColorMTime = color->GetMTime();
+  this->OpacityKey = opacity;
+  this->OpacityMTime = opacity->GetMTime();
+  this->TableRange[0] = lo;
+  this->TableRange[1] = hi;
+  this->HaveTF = true;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
+  vtkSpaceSkippingVolumeMapper* mapper, int blendMode, vtkRenderer* ren, vtkVolume* vol,
+  const double scalarRange[2], const WarnFunction& warnOnce)
+{
+  // Features of vtkVolumeProperty/vtkVolumeMapper the engine does not have: said once each.
+  auto unsupported = [&](bool used, bool& warned, const char* what) {
+    if (used && !warned)
+    {
+      warnOnce(what);
+    }
+    warned = warned || used;
+  };
+  unsupported(vol->GetProperty()->GetInterpolationType() == VTK_NEAREST_INTERPOLATION,
+    this->WarnedNearest,
+    "nearest interpolation is not supported; rendering with trilinear interpolation");
+  unsupported(blendMode == vtkVolumeMapper::SLICE_BLEND ||
+      blendMode < vtkVolumeMapper::COMPOSITE_BLEND || blendMode > vtkVolumeMapper::SLICE_BLEND,
+    this->WarnedBlend,
+    "the slice blend mode is not supported; rendering with composite blending");
+
+  spaceskip::BuildParams bp;
+  bp.builder = static_cast<spaceskip::BuilderKind>(mapper->GetBuilder());
+  bp.leaf = static_cast<spaceskip::LeafCriterion>(mapper->GetLeafCriterion());
+  bp.maxLeafSize = mapper->GetMaxLeafSize();
+  bp.bins = mapper->GetBinCount();
+  // A new size makes the engine recompute the value ranges, re-classify and rebuild.
+  bp.brick = mapper->GetMacroCellSize();
+  engine.setBuildParams(bp);
+  spaceskip::RenderParams rp = engine.renderParams();
+  rp.sampleDistance = mapper->GetSampleDistance();
+  rp.ertThreshold = mapper->GetEarlyRayTermination() ? kErtThreshold : 2.0;
+  rp.jitter = mapper->GetUseJittering() != 0;
+  // Cropping: the planes are in the data's coordinates, as the engine's.
+  rp.cropping = mapper->GetCropping() != 0;
+  const double* crop = mapper->GetCroppingRegionPlanes();
+  std::copy(crop, crop + 6, rp.croppingPlanes);
+  rp.croppingFlags = mapper->GetCroppingRegionFlags();
+  // Clipping planes are in world coordinates; the engine works in the data's, so each plane
+  // n.X + d >= 0 becomes (A^T n).x + (n.t + d) >= 0 for X = A x + t, A the volume's matrix.
+  rp.clipPlanes.clear();
+  if (vtkPlaneCollection* planes = mapper->GetClippingPlanes())
+  {
+    vtkMatrix4x4* A = vol->GetMatrix();
+    planes->InitTraversal();
+    while (vtkPlane* plane = planes->GetNextItem())
+    {
+      double n[3], p[3];
+      plane->GetNormal(n);
+      plane->GetOrigin(p);
+      std::array<double, 4> c{};
+      for (int k = 0; k < 3; ++k)
+      {
+        c[k] = n[0] * A->GetElement(0, k) + n[1] * A->GetElement(1, k) + n[2] * A->GetElement(2, k);
+      }
+      c[3] = n[0] * (A->GetElement(0, 3) - p[0]) + n[1] * (A->GetElement(1, 3) - p[1]) +
+        n[2] * (A->GetElement(2, 3) - p[2]);
+      rp.clipPlanes.push_back(c);
+    }
+  }
+  // Where vtkGPUVolumeRayCastMapper samples first: one step in, or the jitter alone.
+  rp.firstSampleOffset = mapper->GetUseJittering() ? 0.0 : 1.0;
+  this->SetBlendAndShading(rp, mapper, blendMode, ren, vol, scalarRange, warnOnce);
+  engine.setRenderParams(rp);
+}
+
+//------------------------------------------------------------------------------
+// Blend mode, iso values and shading from the mapper, the volume property and the renderer's
+// lights, as vtkGPUVolumeRayCastMapper reads them. Lights: a headlight (VTK's default) or one
+// directional light; anything else is lit by a headlight, said once.
+void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams& rp,
+  vtkSpaceSkippingVolumeMapper* mapper, int mode, vtkRenderer* ren, vtkVolume* vol,
+  const double scalarRange[2], const WarnFunction& warnOnce)
+{
+  rp.blend = mode >= vtkVolumeMapper::COMPOSITE_BLEND && mode <= vtkVolumeMapper::ISOSURFACE_BLEND
+    ? static_cast<spaceskip::BlendMode>(mode)
+    : spaceskip::BlendMode::Composite; // slice: warned above
+  rp.isoValues.clear();
+  vtkVolumeProperty* prop = vol->GetProperty();
+  if (rp.blend == spaceskip::BlendMode::Isosurface)
+  {
+    vtkContourValues* iso = prop->GetIsoSurfaceValues();
+    for (int i = 0; i < iso->GetNumberOfContours(); ++i)
+    {
+      rp.isoValues.push_back(iso->GetValue(i));
+    }
+  }
+  rp.scalarRange[0] = scalarRange[0];
+  rp.scalarRange[1] = scalarRange[1];
+  const double* avg = mapper->GetAverageIPScalarRange();
+  rp.averageRange[0] = avg[0];
+  rp.averageRange[1] = avg[1];
+
+  rp.shade = prop->GetShade(0) != 0;
+  rp.ambient = prop->GetAmbient(0);
+  rp.diffuse = prop->GetDiffuse(0);
+  rp.specular = prop->GetSpecular(0);
+  rp.specularPower = prop->GetSpecularPower(0);
+  rp.lightDirection[0] = rp.lightDirection[1] = rp.lightDirection[2] = 0; // headlight
+  if (!rp.shade)
+  {
+    return;
+  }
+  vtkLight* only = nullptr;
+  int on = 0;
+  vtkLightCollection* lights = ren->GetLights();
+  vtkCollectionSimpleIterator it;
+  lights->InitTraversal(it);
+  while (vtkLight* l = lights->GetNextLight(it))
+  {
+    if (l->GetSwitch())
+    {
+      ++on;
+      only = l;
+    }
+  }
+  if (on == 1 && !only->LightTypeIsHeadlight() && !only->GetPositional())
+  {
+    // A directional light, from world into the volume's physical space (its matrix's inverse).
+    double p[3], f[3];
+    only->GetTransformedPosition(p);
+    only->GetTransformedFocalPoint(f);
+    vtkNew<vtkMatrix4x4> inv;
+    vtkMatrix4x4::Invert(vol->GetMatrix(), inv);
+    const double w[4] = { p[0] - f[0], p[1] - f[1], p[2] - f[2], 0.0 };
+    double o[4];
+    inv->MultiplyPoint(w, o);
+    std::copy(o, o + 3, rp.lightDirection);
+  }
+  else if (on != 1 && !this->WarnedLight)
+  {
+    warnOnce("shading with " + std::to_string(on) + " lights: only a headlight or a single "
+      "directional light is supported; shading with a headlight");
+    this->WarnedLight = true;
+  }
+  else if (on == 1 && only->GetPositional() && !this->WarnedLight)
+  {
+    warnOnce("positional lights are not supported; shading with a headlight");
+    this->WarnedLight = true;
+  }
+}
+
+//------------------------------------------------------------------------------
+spaceskip::Camera vtkSpaceSkipPropertyTranslator::ToCamera(
+  vtkRenderer* ren, vtkOpenGLCamera* cam, vtkVolume* vol)
+{
+  vtkMatrix4x4* wcvc;
+  vtkMatrix3x3* norms;
+  vtkMatrix4x4* vcdc;
+  vtkMatrix4x4* wcdc;
+  cam->GetKeyMatrices(ren, wcvc, norms, vcdc, wcdc);
+  vtkNew<vtkMatrix4x4> view, proj, viewModel;
+  vtkMatrix4x4::Transpose(wcvc, view); // key matrices are stored transposed for OpenGL
+  vtkMatrix4x4::Transpose(vcdc, proj);
+  vtkMatrix4x4::Multiply4x4(view, vol->GetMatrix(), viewModel);
+  spaceskip::Camera camera;
+  camera.view = ToCore(viewModel);
+  camera.proj = ToCore(proj);
+  return camera;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipPropertyTranslator::Reset()
+{
+  this->PropertyKey = this->ColorKey = this->OpacityKey = nullptr;
+  this->PropertyMTime = this->ColorMTime = this->OpacityMTime = 0;
+  this->HaveTF = false;
+}
