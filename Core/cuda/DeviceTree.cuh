@@ -18,21 +18,19 @@ struct BrickGridView {
   int64_t size() const { return int64_t(dims.x) * dims.y * dims.z; }
 };
 
-/// Cell-space box of brick (x,y,z), clamped to the volume (as OccupancyGrid::brickBox).
-SS_FUNC box3i brickCellBox(vec3i b, int brick, vec3i cellDims) {
-  box3i r;
-  r.lo = vec3i{b.x * brick, b.y * brick, b.z * brick};
-  r.hi = vec3i{ss_mini((b.x + 1) * brick, cellDims.x), ss_mini((b.y + 1) * brick, cellDims.y),
-               ss_mini((b.z + 1) * brick, cellDims.z)};
-  return r;
-}
-
 /// A tree in device memory: node 0 is the root, children adjacent, leaves have child < 0.
 struct DeviceTree {
   DeviceBuffer<Node> nodes;
   int numNodes = 0;
   int height = 0;
   int64_t leaves = 0;
+
+  /// Back to the empty tree (the nodes' storage is kept for the next build).
+  void clear() {
+    numNodes = 0;
+    height = 0;
+    leaves = 0;
+  }
 };
 
 }  // namespace spaceskip::cuda

@@ -1,6 +1,6 @@
 // GPU k-d trees over the brick occupancy: KdTreeGPU (the paper's host-driven recursion with one
 // reduction per candidate child) and KdTreeGPUFast (ours: level-parallel over a 3-D SVT).
-// Both use decideKdSplit (KdTreeSplit.cuh), so they build the same tree.
+// Both use decideKdSplit (spaceskip/KdTreeSplit.h, as KdTreeCPU does), so they build the same tree.
 #include "KdTreeBuilder.cuh"
 #include "BuildContext.cuh"
 #include "spaceskip/Morton.h"
@@ -27,15 +27,8 @@ SS_FUNC box3i emptyBox() {
   return b;
 }
 
-SS_FUNC bool isEmpty(const box3i& b) { return b.hi.x <= b.lo.x || b.hi.y <= b.lo.y || b.hi.z <= b.lo.z; }
-
 struct UniteBoxes {
-  SS_FUNC box3i operator()(const box3i& a, const box3i& b) const {
-    box3i r;
-    r.lo = vec3i{ss_mini(a.lo.x, b.lo.x), ss_mini(a.lo.y, b.lo.y), ss_mini(a.lo.z, b.lo.z)};
-    r.hi = vec3i{ss_maxi(a.hi.x, b.hi.x), ss_maxi(a.hi.y, b.hi.y), ss_maxi(a.hi.z, b.hi.z)};
-    return r;
-  }
+  SS_FUNC box3i operator()(const box3i& a, const box3i& b) const { return unite(a, b); }
 };
 
 /// Keeps a brick box only when it lies inside the region (brick boxes never straddle a
@@ -43,18 +36,13 @@ struct UniteBoxes {
 struct ClipToRegion {
   box3i region;
   SS_FUNC box3i operator()(const box3i& b) const {
-    if (isEmpty(b)) return emptyBox();
+    if (b.empty()) return emptyBox();
     if (b.lo.x < region.lo.x || b.lo.y < region.lo.y || b.lo.z < region.lo.z || b.hi.x > region.hi.x ||
         b.hi.y > region.hi.y || b.hi.z > region.hi.z)
       return emptyBox();
     return b;
   }
 };
-
-SS_FUNC vec3i cellsToBricksLo(vec3i c, int brick) { return vec3i{c.x / brick, c.y / brick, c.z / brick}; }
-SS_FUNC vec3i cellsToBricksHi(vec3i c, int brick) {
-  return vec3i{(c.x + brick - 1) / brick, (c.y + brick - 1) / brick, (c.z + brick - 1) / brick};
-}
 
 // ---- KdTreeGPU (paper 3.2.2) -----------------------------------------------------------------
 
@@ -83,10 +71,10 @@ struct ReductionTight {
   int reductions = 0;
 
   box3i operator()(const box3i& region) {
-    if (isEmpty(region)) return emptyBox();
-    const vec3i blo = cellsToBricksLo(region.lo, g->brick), bhi = cellsToBricksHi(region.hi, g->brick);
-    const uint64_t mlo = mortonEncode3(blo.x, blo.y, blo.z);
-    const uint64_t mhi = mortonEncode3(bhi.x - 1, bhi.y - 1, bhi.z - 1);
+    if (region.empty()) return emptyBox();
+    const box3i b = cellBrickBox(region, g->brick);
+    const uint64_t mlo = mortonEncode3(b.lo.x, b.lo.y, b.lo.z);
+    const uint64_t mhi = mortonEncode3(b.hi.x - 1, b.hi.y - 1, b.hi.z - 1);
     auto it = thrust::make_transform_iterator(ws->mortonBoxes.get() + mlo, ClipToRegion{region});
     size_t bytes = tempBytes;
     SS_CUDA_CHECK(cub::DeviceReduce::Reduce(ws->temp.bytes.get(), bytes, it, ws->result.get(), int64_t(mhi - mlo + 1),
@@ -100,79 +88,31 @@ struct ReductionTight {
 
 // ---- KdTreeGPUFast (ours) --------------------------------------------------------------------
 
-/// 3-D summed volume table over the bricks: s[x,y,z] = occupied bricks in [0,x)x[0,y)x[0,z).
-struct SvtView {
-  const int* s;
-  vec3i dims;  ///< bricks per axis (the table is (dims+1)^3)
-  int brick;
-  vec3i cellDims;
-
-  __device__ int at(int x, int y, int z) const {
-    return s[x + int64_t(dims.x + 1) * (y + int64_t(dims.y + 1) * z)];
-  }
-  /// Occupied bricks in [lo, hi) (brick coordinates), 8 lookups.
-  __device__ int count(vec3i lo, vec3i hi) const {
-    return at(hi.x, hi.y, hi.z) - at(lo.x, hi.y, hi.z) - at(hi.x, lo.y, hi.z) - at(hi.x, hi.y, lo.z) +
-           at(lo.x, lo.y, hi.z) + at(lo.x, hi.y, lo.z) + at(hi.x, lo.y, lo.z) - at(lo.x, lo.y, lo.z);
-  }
-  /// Tight cell box of the occupied bricks in a cell region: binary search per face
-  /// (as the paper's SVT shrinking, O(log n) count queries per face).
-  __device__ box3i operator()(const box3i& region) const {
-    if (isEmpty(region)) return emptyBox();
-    vec3i lo = cellsToBricksLo(region.lo, brick), hi = cellsToBricksHi(region.hi, brick);
-    if (count(lo, hi) == 0) return emptyBox();
-    for (int a = 0; a < 3; ++a) {
-      int L = lo[a], H = hi[a] - 1;
-      while (L < H) {  // first slab (from lo) with an occupied brick
-        const int m = (L + H) / 2;
-        vec3i h2 = hi;
-        h2[a] = m + 1;
-        if (count(lo, h2) > 0) H = m;
-        else L = m + 1;
-      }
-      const int newLo = L;
-      H = hi[a] - 1;
-      while (L < H) {  // last slab (towards hi) with an occupied brick
-        const int m = (L + H + 1) / 2;
-        vec3i l2 = lo;
-        l2[a] = m;
-        if (count(l2, hi) > 0) L = m;
-        else H = m - 1;
-      }
-      lo[a] = newLo;
-      hi[a] = L + 1;
-    }
-    box3i b;
-    b.lo = vec3i{lo.x * brick, lo.y * brick, lo.z * brick};
-    b.hi = vec3i{ss_mini(hi.x * brick, cellDims.x), ss_mini(hi.y * brick, cellDims.y),
-                 ss_mini(hi.z * brick, cellDims.z)};
-    return b;
-  }
-};
+// KdTreeGPUFast's tight boxes: the shared SvtView (SummedVolumeTable.h) over a device table.
 
 // One thread per table entry: the occupancy shifted by one (the table's zero faces).
-__global__ void svtInitKernel(const uint8_t* occ, vec3i dims, int64_t count, int* s) {
+__global__ void svtInitKernel(const uint8_t* occ, vec3i dims, int64_t count, uint32_t* s) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= count) return;
   const int64_t sx = dims.x + 1, sy = dims.y + 1;
   const int x = int(i % sx), y = int((i / sx) % sy), z = int(i / (sx * sy));
-  s[i] = (x > 0 && y > 0 && z > 0) ? int(occ[(x - 1) + int64_t(dims.x) * ((y - 1) + int64_t(dims.y) * (z - 1))])
-                                   : 0;
+  s[i] = (x > 0 && y > 0 && z > 0) ? uint32_t(occ[(x - 1) + int64_t(dims.x) * ((y - 1) + int64_t(dims.y) * (z - 1))])
+                                   : 0u;
 }
 
 // One warp per x-line (coalesced): inclusive scan in chunks of 32 with a running carry.
-__global__ void svtScanXKernel(int* s, vec3i dims) {
+__global__ void svtScanXKernel(uint32_t* s, vec3i dims) {
   const int64_t line = (int64_t(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   const int lane = threadIdx.x & 31;
   const int64_t sx = dims.x + 1, lines = int64_t(dims.y + 1) * (dims.z + 1);
   if (line >= lines) return;  // whole warps leave together
-  int* row = s + line * sx;
-  int carry = 0;
+  uint32_t* row = s + line * sx;
+  uint32_t carry = 0;
   for (int64_t base = 0; base < sx; base += 32) {
     const int64_t x = base + lane;
-    int v = x < sx ? row[x] : 0;
+    uint32_t v = x < sx ? row[x] : 0u;
     for (int o = 1; o < 32; o *= 2) {
-      const int n = __shfl_up_sync(0xffffffffu, v, o);
+      const uint32_t n = __shfl_up_sync(0xffffffffu, v, o);
       if (lane >= o) v += n;
     }
     v += carry;
@@ -183,7 +123,7 @@ __global__ void svtScanXKernel(int* s, vec3i dims) {
 
 // One thread per line along y (axis 1) or z (axis 2); neighbouring threads walk neighbouring
 // x, so the accesses are coalesced.
-__global__ void svtScanYZKernel(int* s, vec3i dims, int axis) {
+__global__ void svtScanYZKernel(uint32_t* s, vec3i dims, int axis) {
   const int64_t t = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   const int64_t sx = dims.x + 1, sy = dims.y + 1, sz = dims.z + 1;
   int64_t start, stride, n;
@@ -198,7 +138,7 @@ __global__ void svtScanYZKernel(int* s, vec3i dims, int axis) {
     stride = sx * sy;
     n = sz;
   }
-  int acc = 0;
+  uint32_t acc = 0;
   for (int64_t k = 0; k < n; ++k) {
     acc += s[start + k * stride];
     s[start + k * stride] = acc;
@@ -214,7 +154,7 @@ __global__ void rootKernel(SvtView svt, box3i* out) {
 }
 
 // Stores node i of the level (its box, no children yet) and its split decision.
-__device__ void storeDecision(int64_t i, int levelStart, const box3i& box, const KdDecision& d, Node* nodes, int* flags,
+__device__ void storeDecision(int64_t i, int levelStart, const box3i& box, const detail::KdDecision& d, Node* nodes, int* flags,
                               box3i* childBoxes) {
   Node node;
   node.box = box;
@@ -227,12 +167,12 @@ __device__ void storeDecision(int64_t i, int levelStart, const box3i& box, const
 }
 
 // One thread per node of the level: writes the node's box and decides leaf or split.
-__global__ void levelDecideKernel(const box3i* boxes, int n, int levelStart, KdSplitParams p, SvtView svt,
+__global__ void levelDecideKernel(const box3i* boxes, int n, int levelStart, detail::KdSplitParams p, SvtView svt,
                                   Node* nodes, int* flags, box3i* childBoxes) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n) return;
   const box3i box = boxes[i];
-  storeDecision(i, levelStart, box, decideKdSplit(box, p, svt), nodes, flags, childBoxes);
+  storeDecision(i, levelStart, box, detail::decideKdSplit(box, p, svt), nodes, flags, childBoxes);
 }
 
 // Sweep (bins == 0): up to bricks/step - 1 candidates per node (255 for a 2048^3 root with 8^3
@@ -240,20 +180,20 @@ __global__ void levelDecideKernel(const box3i* boxes, int n, int levelStart, KdS
 // increasing order, keeping its first minimum; the warp then reduces (cost, k) to the least cost
 // and, among equal costs, the least k: decideKdSplit's serial rule (first minimum in plane order).
 // Lane 0 recomputes the winner's children (two tight boxes) or takes the MLS split.
-__global__ void levelDecideSweepKernel(const box3i* boxes, int n, int levelStart, KdSplitParams p, SvtView svt,
+__global__ void levelDecideSweepKernel(const box3i* boxes, int n, int levelStart, detail::KdSplitParams p, SvtView svt,
                                        Node* nodes, int* flags, box3i* childBoxes) {
   const int64_t i = (int64_t(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   const int lane = threadIdx.x & 31;
   if (i >= n) return;  // whole warps leave together (blockDim is a multiple of 32)
   const box3i box = boxes[i];
-  const int axis = longestAxis(box);
+  const int axis = detail::longestAxis(box);
   int64_t best = INT64_MAX;
   int bestK = INT_MAX;
-  if (!kdHalts(box, p)) {
-    const int count = kdCandidateCount(box, axis, p);
+  if (!detail::kdHalts(box, p)) {
+    const int count = detail::kdCandidateCount(box, axis, p);
     for (int k = lane + 1; k <= count; k += 32) {
       box3i l, r;
-      const int64_t c = kdPlaneCost(box, axis, kdCandidatePlane(box, axis, k, p), svt, l, r);
+      const int64_t c = detail::kdPlaneCost(box, axis, detail::kdCandidatePlane(box, axis, k, p), svt, l, r);
       if (c < best) {
         best = c;
         bestK = k;
@@ -269,12 +209,12 @@ __global__ void levelDecideSweepKernel(const box3i* boxes, int n, int levelStart
     }
   }
   if (lane != 0) return;
-  KdDecision d;
+  detail::KdDecision d;
   if (best != INT64_MAX) {
     d.split = 1;
-    kdPlaneCost(box, axis, kdCandidatePlane(box, axis, bestK, p), svt, d.left, d.right);
+    detail::kdPlaneCost(box, axis, detail::kdCandidatePlane(box, axis, bestK, p), svt, d.left, d.right);
   } else {
-    d = kdMlsSplit(box, axis, p, svt);
+    d = detail::kdMlsSplit(box, axis, p, svt);
   }
   storeDecision(i, levelStart, box, d, nodes, flags, childBoxes);
 }
@@ -293,12 +233,13 @@ __global__ void levelEmitKernel(int n, int levelStart, const int* flags, const i
   if (i == n - 1) *nextSplits = offsets[i] + flags[i];
 }
 
-KdSplitParams splitParams(const KdParams& p, int brick, int64_t rootVol) {
-  KdSplitParams s;
+detail::KdSplitParams splitParams(const KdParams& p, int brick, int64_t rootVol) {
+  detail::KdSplitParams s;
   s.deep = p.leaf == LeafCriterion::Deep ? 1 : 0;
   s.mls = p.maxLeafSize;
-  if (p.bins < 0 || p.bins == 1)
-    throw std::invalid_argument("k-d tree: bins must be 0 (sweep) or >= 2, got " + std::to_string(p.bins));
+  BuildParams checked;  // direct callers (the tests) too: the one check, Builders.cpp's validate
+  checked.bins = p.bins;
+  validate(checked);
   s.bins = p.bins;
   s.brick = brick;
   s.rootVol = rootVol;
@@ -316,9 +257,7 @@ KdTreeGpuFastWorkspace::~KdTreeGpuFastWorkspace() {
 
 void buildKdTreeGpu(const BrickGridView& g, const KdParams& p, KdTreeGpuWorkspace& ws, DeviceTree& out,
                     cudaStream_t stream) {
-  out.numNodes = 0;
-  out.height = 0;
-  out.leaves = 0;
+  out.clear();
   if (g.occupied == 0) return;
   const int maxDim = std::max(g.dims.x, std::max(g.dims.y, g.dims.z));
   const int bits = bitsFor(maxDim);
@@ -348,7 +287,7 @@ void buildKdTreeGpu(const BrickGridView& g, const KdParams& p, KdTreeGpuWorkspac
   root.pad = 0;
   nodes.push_back(root);
   depth.push_back(1);
-  const KdSplitParams sp = splitParams(p, g.brick, root.box.volume());
+  const detail::KdSplitParams sp = splitParams(p, g.brick, root.box.volume());
   // Depth-first on the host, as the paper's node_splitting recursion (explicit stack).
   std::vector<int> stack{0};
   int height = 1;
@@ -357,7 +296,7 @@ void buildKdTreeGpu(const BrickGridView& g, const KdParams& p, KdTreeGpuWorkspac
     const int idx = stack.back();
     stack.pop_back();
     const box3i box = nodes[size_t(idx)].box;
-    KdDecision d = decideKdSplit(box, sp, tight);
+    detail::KdDecision d = detail::decideKdSplit(box, sp, tight);
     if (!d.split) {
       ++leaves;
       continue;
@@ -385,9 +324,7 @@ void buildKdTreeGpu(const BrickGridView& g, const KdParams& p, KdTreeGpuWorkspac
 
 void buildKdTreeGpuFast(const BrickGridView& g, const KdParams& p, KdTreeGpuFastWorkspace& ws, DeviceTree& out,
                         cudaStream_t stream) {
-  out.numNodes = 0;
-  out.height = 0;
-  out.leaves = 0;
+  out.clear();
   if (g.occupied == 0) return;
   const int64_t svtCount = int64_t(g.dims.x + 1) * (g.dims.y + 1) * (g.dims.z + 1);
   if (svtCount > int64_t(INT32_MAX) || g.occupied > int64_t(INT32_MAX) / 2)
@@ -406,7 +343,7 @@ void buildKdTreeGpuFast(const BrickGridView& g, const KdParams& p, KdTreeGpuFast
   SS_CUDA_CHECK_LAUNCH(svtScanYZKernel);
   svtScanYZKernel<<<blocksFor(zLines, kThreads), kThreads, 0, stream>>>(ws.svt.get(), g.dims, 2);
   SS_CUDA_CHECK_LAUNCH(svtScanYZKernel);
-  const SvtView svt{ws.svt.get(), g.dims, g.brick, g.cellDims};
+  const SvtView svt{g.dims, g.brick, g.cellDims, ws.svt.get()};
 
   // 2. Root box (its volume drives the Shallow halting rule).
   const size_t maxNodes = size_t(2 * g.occupied);  // leaves <= occupied bricks (disjoint, non-empty)
@@ -421,7 +358,7 @@ void buildKdTreeGpuFast(const BrickGridView& g, const KdParams& p, KdTreeGpuFast
   box3i rootBox;
   SS_CUDA_CHECK(cudaMemcpyAsync(&rootBox, ws.levelBoxes[0].get(), sizeof(box3i), cudaMemcpyDeviceToHost, stream));
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-  const KdSplitParams sp = splitParams(p, g.brick, rootBox.volume());
+  const detail::KdSplitParams sp = splitParams(p, g.brick, rootBox.volume());
   size_t scanBytes = 0;
   SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, scanBytes, ws.splitFlags.get(), ws.splitOffsets.get(),
                                               int(maxNodes), stream));

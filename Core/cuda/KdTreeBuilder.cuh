@@ -1,4 +1,4 @@
-// GPU k-d trees over the brick occupancy (same cost, halting and MLS as KdTreeSplit.cuh):
+// GPU k-d trees over the brick occupancy (the split rule of spaceskip/KdTreeSplit.h, as KdTreeCPU):
 //  - KdTreeGPU: the paper's method (3.2.2): Morton-ordered brick boxes, one reduction per
 //    candidate child over the region's Morton range, recursion driven by the host.
 //  - KdTreeGPUFast (ours): breadth-first, one kernel pass per level for all nodes, tight boxes
@@ -9,7 +9,8 @@
 // it accepts bins 0 but is slow with it: it is there for tests, not for benchmarks.
 #pragma once
 #include "DeviceTree.cuh"
-#include "KdTreeSplit.cuh"
+#include "spaceskip/KdTreeSplit.h"
+#include "spaceskip/SummedVolumeTable.h"
 #include "spaceskip/Types.h"
 
 namespace spaceskip::cuda {
@@ -17,7 +18,7 @@ namespace spaceskip::cuda {
 struct KdParams {
   LeafCriterion leaf = LeafCriterion::Deep;
   int maxLeafSize = 0;
-  int bins = 4;  ///< >= 2: bins - 1 planes per node; 0: sweep (KdTreeSplit.cuh); 1 or < 0: std::invalid_argument
+  int bins = 4;  ///< >= 2: bins - 1 planes per node; 0: sweep (KdTreeSplit.h); 1 or < 0: std::invalid_argument
 };
 
 struct KdTreeGpuWorkspace {
@@ -29,7 +30,7 @@ struct KdTreeGpuWorkspace {
 };
 
 struct KdTreeGpuFastWorkspace {
-  DeviceBuffer<int> svt;  ///< (dims+1)^3 inclusive prefix counts
+  DeviceBuffer<uint32_t> svt;  ///< (dims+1)^3 inclusive prefix counts (read through SvtView)
   DeviceBuffer<box3i> levelBoxes[2];
   DeviceBuffer<box3i> childBoxes;
   DeviceBuffer<int> splitFlags, splitOffsets;

@@ -1,7 +1,9 @@
 // LBVH over occupied bricks (paper 3.1): compaction, Morton codes, radix sort, Karras 2012
-// hierarchy, bottom-up boxes; the result uses Core's flat node layout.
+// hierarchy (karrasNode, shared with the CPU twin), bottom-up boxes; the result uses Core's flat
+// node layout.
 #include "LbvhBuilder.cuh"
 #include "BuildContext.cuh"
+#include "spaceskip/LbvhBuilder.h"
 #include "spaceskip/Morton.h"
 
 #include <cub/device/device_radix_sort.cuh>
@@ -31,46 +33,18 @@ __global__ void mortonKernel(const int* ids, const int* numSelected, vec3i dims,
   codes[i] = mortonEncode3(uint32_t(b.x), uint32_t(b.y), uint32_t(b.z));
 }
 
-// Karras 2012, sec. 4: length of the common prefix of keys i and j (-1 outside [0, n)).
-__device__ int delta(const uint64_t* k, int n, int i, int j) {
-  if (j < 0 || j >= n) return -1;
-  return __clzll(k[i] ^ k[j]);  // keys are unique (one per brick)
-}
-
 // One thread per internal node i in [0, n-1). Karras node ids: internal i -> i, leaf j -> n-1+j.
 // Writes the children's parent and their output slots (children of internal i go to 1+2i, 2+2i).
 __global__ void karrasKernel(const uint64_t* keys, int n, int* parent, int* outIndex) {
   const int i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i >= n - 1) return;
-  const int d = delta(keys, n, i, i + 1) - delta(keys, n, i, i - 1) >= 0 ? 1 : -1;
-  const int dmin = delta(keys, n, i, i - d);
-  int lmax = 2;
-  while (delta(keys, n, i, i + lmax * d) > dmin) lmax *= 2;
-  int l = 0;
-  for (int t = lmax / 2; t >= 1; t /= 2)
-    if (delta(keys, n, i, i + (l + t) * d) > dmin) l += t;
-  const int j = i + l * d;
-  const int dnode = delta(keys, n, i, j);
-  int s = 0;
-  for (int div = 2;; div *= 2) {
-    const int t = (l + div - 1) / div;
-    if (delta(keys, n, i, i + (s + t) * d) > dnode) s += t;
-    if (t <= 1) break;
-  }
-  const int gamma = i + s * d + (d < 0 ? -1 : 0);
-  const int left = (i < j ? i : j) == gamma ? (n - 1) + gamma : gamma;
-  const int right = (i > j ? i : j) == gamma + 1 ? (n - 1) + gamma + 1 : gamma + 1;
+  const detail::KarrasNode k = detail::karrasNode(keys, n, i);
+  const int left = k.leftLeaf ? (n - 1) + k.left : k.left;
+  const int right = k.rightLeaf ? (n - 1) + k.right : k.right;
   parent[left] = i;
   parent[right] = i;
   outIndex[left] = 1 + 2 * i;
   outIndex[right] = 2 + 2 * i;
-}
-
-__device__ box3i unite(const box3i& a, const box3i& b) {
-  box3i r;
-  r.lo = vec3i{min(a.lo.x, b.lo.x), min(a.lo.y, b.lo.y), min(a.lo.z, b.lo.z)};
-  r.hi = vec3i{max(a.hi.x, b.hi.x), max(a.hi.y, b.hi.y), max(a.hi.z, b.hi.z)};
-  return r;
 }
 
 __device__ box3i loadBoxCG(const Node* n) {
@@ -124,9 +98,7 @@ void buildLbvh(const BrickGridView& g, LbvhWorkspace& ws, DeviceTree& out, cudaS
   if (g.dims.x > (1 << 21) || g.dims.y > (1 << 21) || g.dims.z > (1 << 21))
     throw BackendError("LBVH: more than 2^21 bricks along an axis");
   const int n = int(g.occupied);
-  out.numNodes = 0;
-  out.height = 0;
-  out.leaves = 0;
+  out.clear();
   if (n == 0) return;
 
   // 1. Compaction: indices of occupied bricks.

@@ -1,5 +1,6 @@
 // KdTreeCPU (paper 3.2.1; Vidal et al. 2008): top-down k-d tree over the brick occupancy with
-// tight node boxes from a summed volume table, built with oneTBB tasks.
+// tight node boxes from a summed volume table, built with oneTBB tasks over the split rule the GPU
+// builders share (KdTreeSplit.h).
 #pragma once
 #include "Classification.h"
 #include "Types.h"
@@ -18,8 +19,8 @@ constexpr int64_t kKdTreeSerialCutoffBricks = 4096;
 ///  - candidate planes run along the node's longest axis at every brick boundary for bricks of
 ///    8 cells or more, else every ceil(8/brick) bricks (every 8 cells for brick 1, 2, 4), placed
 ///    relative to the node's low face as in Vidal's code. KdTreeCPU always sweeps and ignores
-///    BuildParams::bins: it is the GPU builders' bins = 0, which give this very tree
-///    (Core/cuda/KdTreeSplit.cuh; TestKdSweep.cpp checks it);
+///    BuildParams::bins: it runs the GPU builders' rule with bins = 0 (KdTreeSplit.h), so those
+///    give this very tree (TestKdSweep.cpp, TestCuda.cpp check it);
 ///  - cost = volume of the tight left box + volume of the tight right box (cells); a plane is
 ///    rejected when it removes <= 1/1000 of the node volume as empty space; least cost wins;
 ///  - halting: Shallow = node volume < 10% of the root volume, Deep = node volume <= 8^3 cells,

@@ -1,7 +1,9 @@
 // LBVH on the CPU (paper 3.1; Karras 2012): occupied bricks, Morton order, radix-tree hierarchy,
-// bottom-up boxes. The oneTBB reference twin of the CUDA LBVH: both must emit this exact tree.
+// bottom-up boxes. The oneTBB twin of the CUDA LBVH (cuda/LbvhBuilder.cu): both run karrasNode and
+// emit this exact tree.
 #pragma once
 #include "Classification.h"
+#include "Macros.h"
 #include "Tree.h"
 #include "Types.h"
 
@@ -34,11 +36,55 @@ Tree buildLbvh(const OccupancyGrid& occ);
 
 namespace detail {
 /// Karras 2012 for sorted unique codes: per internal node i the children in Karras' numbering
-/// (leaf indices flagged by isLeaf). Exposed for tests and the CUDA twin's cross-check.
+/// (leaf indices flagged by isLeaf).
 struct KarrasNode {
   int left, right;
   bool leftLeaf, rightLeaf;
 };
+
+/// Leading zeros of a 64-bit word (64 for 0).
+SS_FUNC int clz64(uint64_t v) {
+#if defined(__CUDA_ARCH__)
+  return __clzll(static_cast<long long>(v));
+#else
+  return v ? __builtin_clzll(v) : 64;
+#endif
+}
+
+/// Karras 2012, sec. 4: length of the common prefix of keys i and j; -1 outside [0, n).
+SS_FUNC int karrasDelta(const uint64_t* keys, int n, int i, int j) {
+  if (j < 0 || j >= n) return -1;
+  return clz64(keys[i] ^ keys[j]);  // keys are unique (one per brick)
+}
+
+/// Karras 2012, sec. 4 (Fig. 4): internal node i (0 <= i < n-1) of the radix tree over n sorted
+/// unique keys: its range [i, j] (or [j, i]) and split gamma, the last position sharing more than
+/// the range's common prefix with i. One call per node on both twins (oneTBB loop, CUDA thread).
+/// 32-bit positions: n <= 2^30 keeps i + lmax * d in range.
+SS_FUNC KarrasNode karrasNode(const uint64_t* keys, int n, int i) {
+  // Direction of the range: towards the neighbour sharing the longer prefix (never equal for
+  // unique keys).
+  const int d = karrasDelta(keys, n, i, i + 1) - karrasDelta(keys, n, i, i - 1) > 0 ? 1 : -1;
+  // Upper bound on the range's length, then its other end j by binary search.
+  const int dmin = karrasDelta(keys, n, i, i - d);
+  int lmax = 2;
+  while (karrasDelta(keys, n, i, i + lmax * d) > dmin) lmax *= 2;
+  int l = 0;
+  for (int t = lmax / 2; t >= 1; t /= 2)
+    if (karrasDelta(keys, n, i, i + (l + t) * d) > dmin) l += t;
+  const int j = i + l * d;
+  // Split: binary search with t = ceil(l / 2), ceil(l / 4), ... down to 1.
+  const int dnode = karrasDelta(keys, n, i, j);
+  int s = 0, t = l;
+  do {
+    t = (t + 1) >> 1;
+    if (karrasDelta(keys, n, i, i + (s + t) * d) > dnode) s += t;
+  } while (t > 1);
+  const int gamma = i + s * d + (d < 0 ? -1 : 0);
+  return KarrasNode{gamma, gamma + 1, (i < j ? i : j) == gamma, (i > j ? i : j) == gamma + 1};
+}
+
+/// karrasNode for every internal node (oneTBB). Exposed for tests.
 std::vector<KarrasNode> karrasHierarchy(const std::vector<uint64_t>& sortedCodes);
 }  // namespace detail
 

@@ -54,6 +54,34 @@ struct box3i {
   }
 };
 
+/// Union of two boxes (the smallest box holding both; used by the LBVH's bottom-up pass and
+/// KdTreeGPU's reductions, where the empty box is the one with lo = INT_MAX, hi = INT_MIN).
+SS_FUNC box3i unite(const box3i& a, const box3i& b) {
+  return box3i{vec3i{ss_mini(a.lo.x, b.lo.x), ss_mini(a.lo.y, b.lo.y), ss_mini(a.lo.z, b.lo.z)},
+               vec3i{ss_maxi(a.hi.x, b.hi.x), ss_maxi(a.hi.y, b.hi.y), ss_maxi(a.hi.z, b.hi.z)}};
+}
+
+/// Cell-space box of the bricks [bricks.lo, bricks.hi) of `brick`^3 cells, clamped to `cellDims`.
+/// Clamped to the voxel dims - 1 instead, [lo, hi] inclusive is the voxel range a trilinear sample
+/// in those bricks touches (the +1 halo of RangeGrid).
+SS_FUNC box3i brickCellBox(const box3i& bricks, int brick, vec3i cellDims) {
+  return box3i{vec3i{bricks.lo.x * brick, bricks.lo.y * brick, bricks.lo.z * brick},
+               vec3i{ss_mini(bricks.hi.x * brick, cellDims.x), ss_mini(bricks.hi.y * brick, cellDims.y),
+                     ss_mini(bricks.hi.z * brick, cellDims.z)}};
+}
+
+/// Cell-space box of brick `b` (clamped to the volume, as OccupancyGrid::brickBox).
+SS_FUNC box3i brickCellBox(vec3i b, int brick, vec3i cellDims) {
+  return brickCellBox(box3i{b, vec3i{b.x + 1, b.y + 1, b.z + 1}}, brick, cellDims);
+}
+
+/// The bricks a cell region covers: [floor(lo / brick), ceil(hi / brick)) per axis.
+SS_FUNC box3i cellBrickBox(const box3i& cells, int brick) {
+  return box3i{vec3i{cells.lo.x / brick, cells.lo.y / brick, cells.lo.z / brick},
+               vec3i{(cells.hi.x + brick - 1) / brick, (cells.hi.y + brick - 1) / brick,
+                     (cells.hi.z + brick - 1) / brick}};
+}
+
 /// Ray in the volume's index space; t is shared with world space (the map is affine).
 struct Ray {
   vec3f org, dir;

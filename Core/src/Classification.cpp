@@ -12,13 +12,7 @@
 namespace spaceskip {
 
 namespace {
-box3i brickBoxOf(vec3i cellDims, int brick, int x, int y, int z) {
-  box3i b;
-  b.lo = vec3i{x * brick, y * brick, z * brick};
-  b.hi = vec3i{std::min((x + 1) * brick, cellDims.x), std::min((y + 1) * brick, cellDims.y),
-               std::min((z + 1) * brick, cellDims.z)};
-  return b;
-}
+box3i brickBoxOf(vec3i cellDims, int brick, int x, int y, int z) { return brickCellBox(vec3i{x, y, z}, brick, cellDims); }
 
 template <class T>
 void rangesOf(const Volume& v, RangeGrid& g) {

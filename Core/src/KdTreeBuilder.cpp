@@ -1,41 +1,46 @@
-// KdTreeCPU: Vidal-style plane sweep over a summed volume table, oneTBB task parallel.
+// KdTreeCPU: a oneTBB task_group recursion over the shared split rule (KdTreeSplit.h, the sweep),
+// tight boxes from the summed volume table's shared queries (SvtView).
 #include "spaceskip/KdTreeBuilder.h"
 
+#include "spaceskip/KdTreeSplit.h"
 #include "spaceskip/SummedVolumeTable.h"
 
 #include <tbb/concurrent_vector.h>
 #include <tbb/task_group.h>
 
-#include <algorithm>
 #include <atomic>
-#include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace spaceskip {
 
-namespace detail {
+namespace {
 
-/// A node while building: box in brick coordinates, children by index into the pool.
+/// A node while building: tight cell box, children by index into the pool.
 struct KdBuildNode {
-  box3i bricks;
+  box3i box;
   int left = -1, right = -1;
 };
 
 class KdTreeBuild {
  public:
   KdTreeBuild(const OccupancyGrid& occ, const BuildParams& p, bool parallel)
-      : occ_(occ), p_(p), parallel_(parallel), svt_(occ) {
-    planeStep_ = std::max(1, (8 + occ.brick - 1) / occ.brick);
+      : occ_(occ), parallel_(parallel), svt_(occ) {
+    // KdTreeCPU always sweeps (bins 0) and ignores p.bins.
+    sp_.deep = p.leaf == LeafCriterion::Deep ? 1 : 0;
+    sp_.mls = p.maxLeafSize;
+    sp_.bins = 0;
+    sp_.brick = occ.brick;
+    sp_.rootVol = 0;
   }
 
   Tree run() {
     Tree t;
-    box3i all{vec3i{0, 0, 0}, occ_.dims};
-    box3i root = svt_.shrink(all);
+    const box3i root = svt_.view()(box3i{vec3i{0, 0, 0}, occ_.cellDims});
     if (root.empty()) return t;
-    rootVolume_ = cellBox(root).volume();
+    sp_.rootVol = root.volume();
     pool_.push_back(KdBuildNode{root, -1, -1});
     if (parallel_) {
       tbb::task_group g;
@@ -50,57 +55,6 @@ class KdTreeBuild {
   }
 
  private:
-  box3i cellBox(const box3i& b) const {
-    const int B = occ_.brick;
-    return box3i{vec3i{b.lo.x * B, b.lo.y * B, b.lo.z * B},
-                 vec3i{std::min(b.hi.x * B, occ_.cellDims.x), std::min(b.hi.y * B, occ_.cellDims.y),
-                       std::min(b.hi.z * B, occ_.cellDims.z)}};
-  }
-
-  /// Decides the split of a node: false for a leaf, else the two tight child boxes.
-  bool chooseSplit(const box3i& node, box3i& lbox, box3i& rbox) const {
-    const box3i cb = cellBox(node);
-    const int64_t vol = cb.volume();
-    vec3i len{cb.hi.x - cb.lo.x, cb.hi.y - cb.lo.y, cb.hi.z - cb.lo.z};
-    int axis = 0;  // longest axis, the first one on ties
-    if (len.y > len[axis]) axis = 1;
-    if (len.z > len[axis]) axis = 2;
-    const bool halt = p_.leaf == LeafCriterion::Shallow ? vol < rootVolume_ / 10 : vol <= 8 * 8 * 8;
-    if (!halt) {
-      // Plane sweep: candidates first + step*k, 0 < k < nb/step (Vidal's raster of 8 voxels).
-      const int first = node.lo[axis], nb = node.hi[axis] - node.lo[axis];
-      const int planes = nb / planeStep_;
-      int64_t best = std::numeric_limits<int64_t>::max();
-      for (int k = 1; k < planes; ++k) {
-        box3i l = node, r = node;
-        l.hi[axis] = r.lo[axis] = first + planeStep_ * k;
-        l = svt_.shrink(l);
-        r = svt_.shrink(r);
-        const int64_t c = cellBox(l).volume() + cellBox(r).volume();
-        if (vol - c <= vol / 1000) continue;  // removes (almost) no empty space
-        if (c < best) {
-          best = c;
-          lbox = l;
-          rbox = r;
-        }
-      }
-      if (best != std::numeric_limits<int64_t>::max()) return true;
-    }
-    // Max leaf size: a would-be leaf with an edge above MLS is split in the middle of its
-    // longest axis. The node box is tight, so both halves hold occupied bricks.
-    if (p_.maxLeafSize > 0 && len[axis] > p_.maxLeafSize) {
-      const int nb = node.hi[axis] - node.lo[axis];
-      if (nb >= 2) {
-        box3i l = node, r = node;
-        l.hi[axis] = r.lo[axis] = node.lo[axis] + nb / 2;
-        lbox = svt_.shrink(l);
-        rbox = svt_.shrink(r);
-        return true;
-      }
-    }
-    return false;
-  }
-
   // Serial recursion (the reference, and the tail of every parallel task).
   void split(int index, int depth) {
     int li, ri;
@@ -109,26 +63,9 @@ class KdTreeBuild {
     split(ri, depth + 1);
   }
 
-  // Splits node `index` if the cost function (or MLS) asks for it: appends both children and
-  // links them; false for a leaf (or when the height bound would be exceeded).
-  bool splitNode(int index, int depth, int& li, int& ri) {
-    box3i l, r;
-    if (!chooseSplit(pool_[size_t(index)].bricks, l, r)) return false;
-    if (depth + 1 >= kMaxTreeHeight) {
-      tooDeep_ = true;
-      return false;
-    }
-    li = append(l);
-    ri = append(r);
-    pool_[size_t(index)].left = li;
-    pool_[size_t(index)].right = ri;
-    return true;
-  }
-
-  // Task-parallel recursion above the cutoff.
+  // Task-parallel recursion above the serial cutoff.
   void split(tbb::task_group& g, int index, int depth) {
-    const box3i node = pool_[size_t(index)].bricks;
-    if (node.volume() < kKdTreeSerialCutoffBricks) {
+    if (cellBrickBox(pool_[size_t(index)].box, occ_.brick).volume() < kKdTreeSerialCutoffBricks) {
       split(index, depth);
       return;
     }
@@ -136,6 +73,22 @@ class KdTreeBuild {
     if (!splitNode(index, depth, li, ri)) return;
     g.run([this, &g, li, depth] { split(g, li, depth + 1); });
     split(g, ri, depth + 1);
+  }
+
+  // Splits node `index` when the shared rule asks for it: appends both children and links them;
+  // false for a leaf (or when the height bound would be exceeded).
+  bool splitNode(int index, int depth, int& li, int& ri) {
+    const detail::KdDecision d = detail::decideKdSplit(pool_[size_t(index)].box, sp_, svt_.view());
+    if (!d.split) return false;
+    if (depth + 1 >= kMaxTreeHeight) {
+      tooDeep_ = true;
+      return false;
+    }
+    li = append(d.left);
+    ri = append(d.right);
+    pool_[size_t(index)].left = li;
+    pool_[size_t(index)].right = ri;
+    return true;
   }
 
   int append(const box3i& b) {
@@ -148,7 +101,7 @@ class KdTreeBuild {
   void flatten(Tree& t) const {
     t.nodes.clear();
     t.nodes.reserve(pool_.size());
-    t.nodes.push_back(Node{cellBox(pool_[0].bricks), -1, 0});
+    t.nodes.push_back(Node{pool_[0].box, -1, 0});
     std::vector<std::pair<int, int>> stack{{0, 0}};  // (pool index, output index)
     while (!stack.empty()) {
       auto [pi, oi] = stack.back();
@@ -157,8 +110,8 @@ class KdTreeBuild {
       if (n.left < 0) continue;
       const int c = int(t.nodes.size());
       t.nodes[size_t(oi)].child = c;
-      t.nodes.push_back(Node{cellBox(pool_[size_t(n.left)].bricks), -1, 0});
-      t.nodes.push_back(Node{cellBox(pool_[size_t(n.right)].bricks), -1, 0});
+      t.nodes.push_back(Node{pool_[size_t(n.left)].box, -1, 0});
+      t.nodes.push_back(Node{pool_[size_t(n.right)].box, -1, 0});
       stack.push_back({n.right, c + 1});
       stack.push_back({n.left, c});
     }
@@ -166,21 +119,17 @@ class KdTreeBuild {
   }
 
   const OccupancyGrid& occ_;
-  BuildParams p_;
   bool parallel_;
   SummedVolumeTable svt_;
-  int planeStep_ = 1;
-  int64_t rootVolume_ = 0;
+  detail::KdSplitParams sp_{};
   tbb::concurrent_vector<KdBuildNode> pool_;
   std::atomic<bool> tooDeep_{false};  // set by any task; read after all joined
 };
 
-}  // namespace detail
+}  // namespace
 
-Tree buildKdTree(const OccupancyGrid& occ, const BuildParams& p) { return detail::KdTreeBuild(occ, p, true).run(); }
+Tree buildKdTree(const OccupancyGrid& occ, const BuildParams& p) { return KdTreeBuild(occ, p, true).run(); }
 
-Tree buildKdTreeSerial(const OccupancyGrid& occ, const BuildParams& p) {
-  return detail::KdTreeBuild(occ, p, false).run();
-}
+Tree buildKdTreeSerial(const OccupancyGrid& occ, const BuildParams& p) { return KdTreeBuild(occ, p, false).run(); }
 
 }  // namespace spaceskip

@@ -1,4 +1,5 @@
-// LBVH CPU twin: compaction, Morton codes, parallel sort, Karras 2012 hierarchy, bottom-up boxes.
+// LBVH CPU twin: compaction, Morton codes, parallel sort, Karras 2012 hierarchy (karrasNode, shared
+// with the CUDA twin), bottom-up boxes.
 #include "spaceskip/LbvhBuilder.h"
 
 #include "spaceskip/Morton.h"
@@ -15,12 +16,6 @@
 
 namespace spaceskip {
 
-namespace {
-
-int clz64(uint64_t v) { return v ? __builtin_clzll(v) : 64; }
-
-}  // namespace
-
 uint64_t mortonCode3(uint32_t x, uint32_t y, uint32_t z) { return mortonEncode3(x, y, z); }
 
 namespace detail {
@@ -28,32 +23,8 @@ namespace detail {
 std::vector<KarrasNode> karrasHierarchy(const std::vector<uint64_t>& codes) {
   const int n = int(codes.size());
   std::vector<KarrasNode> nodes(size_t(std::max(n - 1, 0)));
-  // Length of the common prefix of codes i and j; -1 outside the array (Karras 2012, sec. 4).
-  auto delta = [&](int64_t i, int64_t j) -> int {
-    if (j < 0 || j >= n) return -1;
-    return clz64(codes[size_t(i)] ^ codes[size_t(j)]);
-  };
   tbb::parallel_for(tbb::blocked_range<int>(0, n - 1, 1024), [&](const tbb::blocked_range<int>& r) {
-    for (int i = r.begin(); i != r.end(); ++i) {
-      // Direction of the range: towards the neighbour sharing the longer prefix.
-      const int d = delta(i, i + 1) - delta(i, i - 1) > 0 ? 1 : -1;
-      const int dmin = delta(i, i - d);
-      int64_t lmax = 2;
-      while (delta(i, i + lmax * d) > dmin) lmax *= 2;
-      int64_t l = 0;
-      for (int64_t t = lmax / 2; t >= 1; t /= 2)
-        if (delta(i, i + (l + t) * d) > dmin) l += t;
-      const int j = int(i + l * d);
-      // Split: the last position sharing more than the node's common prefix with i.
-      const int dnode = delta(i, j);
-      int64_t s = 0, t = l;
-      do {
-        t = (t + 1) >> 1;
-        if (delta(i, i + (s + t) * d) > dnode) s += t;
-      } while (t > 1);
-      const int gamma = int(i + s * d + std::min(d, 0));
-      nodes[size_t(i)] = KarrasNode{gamma, gamma + 1, std::min(i, j) == gamma, std::max(i, j) == gamma + 1};
-    }
+    for (int i = r.begin(); i != r.end(); ++i) nodes[size_t(i)] = karrasNode(codes.data(), n, i);
   });
   return nodes;
 }
@@ -124,11 +95,7 @@ Tree buildLbvh(const OccupancyGrid& occ) {
         const box3i& b = t.nodes[size_t(2 * p + 2)].box;
         o = internalOut[size_t(p)];
         height[size_t(o)] = 1 + std::max(height[size_t(2 * p + 1)], height[size_t(2 * p + 2)]);
-        box3i& u = t.nodes[size_t(o)].box;
-        for (int ax = 0; ax < 3; ++ax) {
-          u.lo[ax] = std::min(a.lo[ax], b.lo[ax]);
-          u.hi[ax] = std::max(a.hi[ax], b.hi[ax]);
-        }
+        t.nodes[size_t(o)].box = unite(a, b);
       }
     }
   });

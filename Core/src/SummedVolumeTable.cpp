@@ -1,4 +1,5 @@
-// Summed volume table: parallel construction (per-slice 2-D sums, then along z) and box queries.
+// Summed volume table: parallel construction (per-slice 2-D sums, then along z); the box queries
+// are the shared SvtView's.
 #include "spaceskip/SummedVolumeTable.h"
 
 #include <tbb/blocked_range.h>
@@ -9,14 +10,14 @@
 
 namespace spaceskip {
 
-SummedVolumeTable::SummedVolumeTable(const OccupancyGrid& occ) : dims_(occ.dims) {
+SummedVolumeTable::SummedVolumeTable(const OccupancyGrid& occ) {
   if (occ.size() >= (int64_t(1) << 32)) throw std::length_error("summed volume table: 2^32 or more bricks");
-  const int nx = dims_.x, ny = dims_.y, nz = dims_.z;
-  stride_ = vec3i{nx + 1, ny + 1, nz + 1};
-  const size_t sx = size_t(stride_.x), sxy = sx * size_t(stride_.y);
+  const int nx = occ.dims.x, ny = occ.dims.y, nz = occ.dims.z;
+  const size_t sx = size_t(nx) + 1, sxy = sx * (size_t(ny) + 1);
   // No serial zero fill: the zero borders are written by the parallel passes (first touch in
   // parallel too), every other entry by pass 1.
-  sums_.reset(new uint32_t[sxy * size_t(stride_.z)]);  // default-initialised: no zero fill
+  sums_.reset(new uint32_t[sxy * (size_t(nz) + 1)]);  // default-initialised: no zero fill
+  view_ = SvtView{occ.dims, occ.brick, occ.cellDims, sums_.get()};
   // Pass 1: a 2-D summed area table per z slice (x running sum plus the row below); slices are
   // independent and a slice stays in cache while it is summed. Slice 0 is the zero border.
   tbb::parallel_for(tbb::blocked_range<int>(-1, nz), [&](const tbb::blocked_range<int>& r) {
@@ -51,51 +52,25 @@ SummedVolumeTable::SummedVolumeTable(const OccupancyGrid& occ) : dims_(occ.dims)
   });
 }
 
-int64_t SummedVolumeTable::count(const box3i& in) const {
-  const int x0 = std::max(in.lo.x, 0), y0 = std::max(in.lo.y, 0), z0 = std::max(in.lo.z, 0);
-  const int x1 = std::min(in.hi.x, dims_.x), y1 = std::min(in.hi.y, dims_.y), z1 = std::min(in.hi.z, dims_.z);
-  if (x1 <= x0 || y1 <= y0 || z1 <= z0) return 0;
-  // Inclusion-exclusion over the 8 corners; unsigned wrap-around cancels exactly.
-  uint32_t c = at(x1, y1, z1) - at(x0, y1, z1) - at(x1, y0, z1) - at(x1, y1, z0) + at(x0, y0, z1) +
-               at(x0, y1, z0) + at(x1, y0, z0) - at(x0, y0, z0);
-  return int64_t(c);
-}
-
-box3i SummedVolumeTable::shrink(const box3i& in) const {
+box3i SummedVolumeTable::clip(const box3i& in) const {
   box3i b;
   for (int a = 0; a < 3; ++a) {
     b.lo[a] = std::max(in.lo[a], 0);
-    b.hi[a] = std::min(in.hi[a], dims_[a]);
+    b.hi[a] = std::min(in.hi[a], view_.dims[a]);
   }
-  const int64_t total = count(b);
-  if (total == 0) return box3i{b.lo, b.lo};
-  box3i out = b;
-  // Each axis independently against the full extent of the others: the tight box is the
-  // product of the occupied bricks' extents per axis. count() is monotone in each face.
-  for (int a = 0; a < 3; ++a) {
-    // Largest lo with count([lo, hi)) == total.
-    int l = b.lo[a], h = b.hi[a] - 1;
-    while (l < h) {
-      int m = l + (h - l + 1) / 2;
-      box3i t = b;
-      t.lo[a] = m;
-      if (count(t) == total) l = m;
-      else h = m - 1;
-    }
-    out.lo[a] = l;
-    // Smallest hi with count([lo, hi)) == total.
-    l = b.lo[a] + 1;
-    h = b.hi[a];
-    while (l < h) {
-      int m = l + (h - l) / 2;
-      box3i t = b;
-      t.hi[a] = m;
-      if (count(t) == total) h = m;
-      else l = m + 1;
-    }
-    out.hi[a] = l;
-  }
-  return out;
+  return b;
+}
+
+int64_t SummedVolumeTable::count(const box3i& in) const {
+  const box3i b = clip(in);
+  return b.empty() ? 0 : int64_t(view_.count(b.lo, b.hi));
+}
+
+box3i SummedVolumeTable::shrink(const box3i& in) const {
+  box3i b = clip(in);
+  if (b.empty() || view_.count(b.lo, b.hi) == 0) return box3i{b.lo, b.lo};
+  view_.shrink(b.lo, b.hi);
+  return b;
 }
 
 }  // namespace spaceskip

@@ -1,15 +1,15 @@
-// The GPU k-d split decision's sweep mode (bins = 0, Core/cuda/KdTreeSplit.cuh) against KdTreeCPU:
-// a host recursion over decideKdSplit, with a brute-force (or SVT) tight box over the occupancy,
-// must build the KdTreeCPU tree node for node, for procedural volumes, random TFs, several brick
-// sizes, volumes that are not a multiple of the brick (clamped boxes), and every leaf criterion.
-// KdTreeGPU and KdTreeGPUFast run that same decision (TestCuda.cpp checks them on a device).
+// The shared k-d split rule's sweep mode (bins = 0, spaceskip/KdTreeSplit.h) against KdTreeCPU: a
+// serial host recursion over decideKdSplit with a brute-force (or SVT) tight box must build the
+// KdTreeCPU tree (task-parallel, SvtView tight boxes) node for node, for procedural volumes, random
+// TFs, several brick sizes, volumes that are not a multiple of the brick (clamped boxes), and every
+// leaf criterion. KdTreeGPU and KdTreeGPUFast run that same rule (TestCuda.cpp checks them on a device).
 #include "TestUtil.h"
 #include "TreeInvariants.h"
 
-#include "cuda/KdTreeSplit.cuh"
 #include "spaceskip/Builders.h"
 #include "spaceskip/Generators.h"
 #include "spaceskip/KdTreeBuilder.h"
+#include "spaceskip/KdTreeSplit.h"
 #include "spaceskip/SummedVolumeTable.h"
 
 #include <gtest/gtest.h>
@@ -34,14 +34,10 @@ struct HostTight {
 
   box3i operator()(const box3i& region) {
     ++calls;
-    const int B = g.brick;
-    box3i b{vec3i{region.lo.x / B, region.lo.y / B, region.lo.z / B},
-            vec3i{(region.hi.x + B - 1) / B, (region.hi.y + B - 1) / B, (region.hi.z + B - 1) / B}};
-    box3i t = svt ? svt->shrink(b) : test::bruteTightBox(g, b);
+    const box3i b = cellBrickBox(region, g.brick);
+    const box3i t = svt ? svt->shrink(b) : test::bruteTightBox(g, b);
     if (t.empty()) return box3i{region.lo, region.lo};
-    return box3i{vec3i{t.lo.x * B, t.lo.y * B, t.lo.z * B},
-                 vec3i{std::min(t.hi.x * B, g.cellDims.x), std::min(t.hi.y * B, g.cellDims.y),
-                       std::min(t.hi.z * B, g.cellDims.z)}};
+    return brickCellBox(t, g.brick, g.cellDims);
   }
 };
 
@@ -51,12 +47,12 @@ struct SharedDecisionTree {
   const OccupancyGrid& g;
   BuildParams p;
   HostTight tight;
-  cuda::KdSplitParams sp{};
+  detail::KdSplitParams sp{};
   Tree t;
 
   void node(int index, int depth) {
     ASSERT_LT(depth, kMaxTreeHeight);
-    const cuda::KdDecision d = cuda::decideKdSplit(t.nodes[size_t(index)].box, sp, tight);
+    const detail::KdDecision d = detail::decideKdSplit(t.nodes[size_t(index)].box, sp, tight);
     if (!d.split) return;
     const int c = int(t.nodes.size());
     t.nodes[size_t(index)].child = c;
@@ -142,10 +138,11 @@ TEST(KdSweep, CandidatesAreKdTreeCpuBrickBoundaries) {
     for (int nb = 1; nb <= 40; ++nb) {
       for (int clamp : {0, 1}) {
         box3i box{vec3i{3 * brick, 0, 0}, vec3i{(3 + nb) * brick - (clamp && brick > 1 ? brick / 2 : 0), 1, 1}};
-        cuda::KdSplitParams p{1, 0, 0, brick, 1};
+        detail::KdSplitParams p{1, 0, 0, brick, 1};
         std::vector<int> planes;
-        for (int k = 1; k <= cuda::kdCandidateCount(box, 0, p); ++k) planes.push_back(cuda::kdCandidatePlane(box, 0, k, p));
-        std::vector<int> expected;  // KdTreeBuilder.cpp: first + step * k, 0 < k < nb / step (bricks)
+        for (int k = 1; k <= detail::kdCandidateCount(box, 0, p); ++k)
+          planes.push_back(detail::kdCandidatePlane(box, 0, k, p));
+        std::vector<int> expected;  // Vidal's sweep: first + step * k, 0 < k < nb / step (bricks)
         for (int k = 1; k < nb / step; ++k) expected.push_back((3 + step * k) * brick);
         EXPECT_EQ(planes, expected) << "brick " << brick << " bricks " << nb << " clamped " << clamp;
       }

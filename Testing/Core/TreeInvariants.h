@@ -88,7 +88,7 @@ inline void checkTreeInvariants(const Tree& t, const OccupancyGrid& occ, const s
     bool separated = false;
     for (int k = 0; k < 3; ++k) separated |= a.hi[k] <= b.lo[k] || b.hi[k] <= a.lo[k];
     EXPECT_TRUE(separated) << "children of node " << i << " not separated by a plane";
-    EXPECT_TRUE(sameBox(nd.box, unite(a, b))) << "inner node " << i << " is not the union of its children";
+    EXPECT_TRUE(sameBox(nd.box, test::unite(a, b))) << "inner node " << i << " is not the union of its children";
   }
   EXPECT_EQ(parentCount[0], 0);
   for (int i = 1; i < n; ++i) ASSERT_EQ(parentCount[size_t(i)], 1) << "node " << i << " not referenced once";
@@ -128,7 +128,7 @@ inline void checkTreeInvariants(const Tree& t, const OccupancyGrid& occ, const s
           if (!overlaps(bb, lb)) continue;
           EXPECT_TRUE(contains(lb, bb)) << "leaf " << leaves[li] << " cuts an occupied brick";
           ++hits[size_t(occ.index(x, y, z))];
-          u = unite(u, bb);
+          u = test::unite(u, bb);
         }
     EXPECT_TRUE(sameBox(u, lb)) << "leaf " << leaves[li] << " is not tight";
   }

@@ -1,21 +1,21 @@
-// The k-d split decision shared by KdTreeGPU (host-driven, paper 3.2.2) and KdTreeGPUFast
-// (level-parallel, on the device), so both build the same tree. Cost and halting follow the
-// paper's code (deskvox virvo/spaceskip/cudakdtree.cu, node_splitting): candidate planes along
-// the longest axis at multiples of len/bins, snapped down to the brick raster; cost = sum of the
-// children's tight volumes; a split removing <= 1/1000 of the node volume is rejected. Halting:
-// Shallow = node volume < 10% of the root's, Deep = node volume <= 8^3 cells. MLS (paper 4.3):
-// a leaf longer than MLS cells along its longest axis is split in the middle of that axis.
+// The k-d split rule, written once for KdTreeCPU (oneTBB tasks, src/KdTreeBuilder.cpp), KdTreeGPU
+// (host-driven, paper 3.2.2) and KdTreeGPUFast (level-parallel, cuda/KdTreeBuilder.cu), so all
+// three build the same tree. Cost and halting follow the paper's code (deskvox
+// virvo/spaceskip/cudakdtree.cu, node_splitting): candidate planes along the longest axis at
+// multiples of len/bins, snapped down to the brick raster; cost = sum of the children's tight
+// volumes; a split removing <= 1/1000 of the node volume is rejected. Halting: Shallow = node
+// volume < 10% of the root's, Deep = node volume <= 8^3 cells. MLS (paper 4.3): a leaf longer
+// than MLS cells along its longest axis is split in the middle of that axis.
 //
-// bins == 0 is the sweep: the candidates, cost, halting, tie-breaking and MLS split of KdTreeCPU
-// (Core/src/KdTreeBuilder.cpp, Vidal's plane sweep), so a GPU tree with bins 0 is the KdTreeCPU
-// tree of the same leaf criterion and MLS, node for node (the layout order aside).
-// Header-only and host+device (SS_FUNC): the host tests include it to check exactly that.
+// bins == 0 is the sweep (Vidal's plane sweep, every step-th brick boundary): KdTreeCPU always
+// runs it, so a GPU tree with bins 0 is the KdTreeCPU tree of the same leaf criterion and MLS,
+// node for node (the layout order aside). Header-only and host+device (SS_FUNC).
 #pragma once
-#include "spaceskip/Math.h"
+#include "Math.h"
 
 #include <cstdint>
 
-namespace spaceskip::cuda {
+namespace spaceskip::detail {
 
 struct KdSplitParams {
   int deep;         ///< 1: Deep halting, 0: Shallow
@@ -30,14 +30,14 @@ struct KdDecision {
   box3i left, right;  ///< tight child boxes when split
 };
 
-/// The longest axis, the first one on ties (as KdTreeCPU).
+/// The longest axis, the first one on ties.
 SS_FUNC int longestAxis(const box3i& b) {
   int lx = b.hi.x - b.lo.x, ly = b.hi.y - b.lo.y, lz = b.hi.z - b.lo.z;
   return lx >= ly ? (lx >= lz ? 0 : 2) : (ly >= lz ? 1 : 2);
 }
 
-/// KdTreeCPU's sweep step in bricks: every brick boundary for bricks of 8 cells or more, else
-/// every ceil(8/brick) bricks (Vidal's raster of 8 voxels).
+/// The sweep's step in bricks: every brick boundary for bricks of 8 cells or more, else every
+/// ceil(8/brick) bricks (Vidal's raster of 8 voxels).
 SS_FUNC int kdSweepStep(int brick) { return ss_maxi(1, (8 + brick - 1) / brick); }
 
 SS_FUNC bool kdHalts(const box3i& box, const KdSplitParams& p) {
@@ -113,9 +113,10 @@ SS_FUNC KdDecision kdMlsSplit(const box3i& box, int axis, const KdSplitParams& p
 }
 
 /// `box` is the node's tight box (cells); `tight(region)` returns the tight box of the
-/// occupied bricks inside `region` (empty box when none). The least cost wins; on ties the
-/// first plane in increasing order (KdTreeCPU's rule). KdTreeGPUFast evaluates the sweep's
-/// candidates in parallel with the same pieces (KdTreeBuilder.cu, levelDecideSweepKernel).
+/// occupied bricks inside `region` (empty box when none; SvtView in SummedVolumeTable.h). The
+/// least cost wins; on ties the first plane in increasing order. KdTreeGPUFast evaluates the
+/// sweep's candidates in parallel with the same pieces (cuda/KdTreeBuilder.cu,
+/// levelDecideSweepKernel).
 #ifdef __CUDACC__
 #pragma nv_exec_check_disable
 #endif
@@ -143,4 +144,4 @@ SS_FUNC KdDecision decideKdSplit(const box3i& box, const KdSplitParams& p, Tight
   return kdMlsSplit(box, axis, p, tight);
 }
 
-}  // namespace spaceskip::cuda
+}  // namespace spaceskip::detail
