@@ -193,6 +193,7 @@ int cmdBench(const Options& o) {
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
   const int frames = int(o.getInt("--frames", 8, 1, 1000000));
   const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
+  const LaunchParams launch = launchParams(o);
   int w = 1024, h = 1024;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   std::ostringstream json;
@@ -217,7 +218,6 @@ int cmdBench(const Options& o) {
     engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
     engine.setVolume(v);
     engine.setTransferFunction(tf);
-    const LaunchParams launch = launchParams(o);
     for (const std::string& b : builders) {
       const BenchItem item = benchItem(b);
       const BuildParams bp = buildParams(o, item.spec);
