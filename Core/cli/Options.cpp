@@ -25,7 +25,7 @@ const std::set<std::string>& valueOptions() {
       "-o", "--dims", "--seed", "--builder", "--builders", "--leaf", "--mls", "--bins", "--brick", "--backend",
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
-      "--shade"};
+      "--shade", "--cuda-block", "--cuda-carveout"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
@@ -248,6 +248,20 @@ BackendKind backendKind(const Options& o) {
   throw bad("--backend", b, "is not auto, cpu or cuda");
 }
 
+LaunchParams launchParams(const Options& o) {
+  LaunchParams p;
+  if (o.has("--cuda-block")) {
+    const std::string b = o.get("--cuda-block", "");
+    const size_t x = b.find('x');
+    if (x == std::string::npos) throw bad("--cuda-block", b, "is not WxH");
+    p.blockX = int(parseIntArg(b.substr(0, x), "--cuda-block (width)", 1, 256));
+    p.blockY = int(parseIntArg(b.substr(x + 1), "--cuda-block (height)", 1, 256));
+    if (p.blockX * p.blockY < 32 || p.blockX * p.blockY > 256) throw bad("--cuda-block", b, "is not 32..256 threads");
+  }
+  p.carveout = int(o.getInt("--cuda-carveout", -1, 0, 100));
+  return p;
+}
+
 BenchItem benchItem(const std::string& item) {
   BenchItem it;
   for (const std::string& part : split(item, ':')) {
@@ -255,7 +269,7 @@ BenchItem benchItem(const std::string& item) {
     else if (part == "exact") it.filter = int(FilterMode::Exact);
     else if (part == "cold") it.cold = true;
     else if (part.size() > 3 && part.rfind("res", 0) == 0 && part.find_first_not_of("0123456789", 3) == std::string::npos)
-      it.resident = std::to_string(parseIntArg(part.substr(3), "bench suffix 'res'", 0, 1024));
+      it.resident = int(parseIntArg(part.substr(3), "bench suffix 'res'", 0, 1024));
     else it.spec += (it.spec.empty() ? "" : ":") + part;
   }
   return it;

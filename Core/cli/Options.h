@@ -2,6 +2,7 @@
 // Separate from main.cpp so the option fuzzer (Testing/Fuzz) and the tests can call it.
 #pragma once
 #include "spaceskip/Engine.h"
+#include "spaceskip/LaunchParams.h"
 
 #include <cstdint>
 #include <map>
@@ -56,6 +57,8 @@ uint64_t maxVolumeBytes(const Options& o);
 BuildParams buildParams(const Options& o, const std::string& spec);
 RenderParams renderParams(const Options& o);
 BackendKind backendKind(const Options& o);
+/// --cuda-block WxH (32..256 threads) and --cuda-carveout N (0..100): the CUDA launch shape.
+LaunchParams launchParams(const Options& o);
 
 /// Bench-only suffixes of a --builders item, stripped before buildParams sees it:
 /// `hw`/`exact` pick the filter for this item, `cold` times the first build only (no rebuilds:
@@ -64,7 +67,7 @@ struct BenchItem {
   std::string spec;      ///< the item without bench-only suffixes
   int filter = -1;       ///< -1: --filter, else a FilterMode
   bool cold = false;
-  std::string resident;  ///< `resN`: SPACESKIP_CUDA_RESIDENT=N for this item (CUDA launch shape)
+  int resident = -1;  ///< `resN`: LaunchParams::resident = N for this item (CUDA launch shape)
 };
 BenchItem benchItem(const std::string& item);
 

@@ -54,7 +54,7 @@ const char* kUsage = R"(usage:
       or kdtree-gpu-fast:deep:mls32:bins0 (the sweep: the kdtree-cpu:deep:mls32 tree)
       --build-reps N: report the fastest of N rebuilds (default 1)
       bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only),
-      :resN (CUDA: persistent launch with N blocks per SM, SPACESKIP_CUDA_RESIDENT; res0 = plain)
+      :resN (CUDA: persistent launch with N blocks per SM; res0 = plain)
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
@@ -64,6 +64,8 @@ options:
       --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;
       0 sweeps every brick boundary, the kdtree-cpu tree (kdtree-cpu always sweeps)
   --backend auto|cpu|cuda     --threads N (oneTBB worker limit)
+  --cuda-block WxH   --cuda-carveout N   CUDA launch shape: threads per block (32..256; default
+                     16x8), percent of L1 given to shared memory (0..100; default: the driver's)
   --tf PRESET|FILE   presets: ramp grayscale coolwarm band spike opaque zero
   --size WxH         (render default 512x512, bench default 1024x1024)
   --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective
@@ -152,6 +154,7 @@ int cmdRender(const Options& o) {
   engine.setTransferFunction(makeTF(o, v));
   engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
   engine.setRenderParams(renderParams(o));
+  engine.setLaunchParams(launchParams(o));
   auto t1 = Clock::now();
   engine.update();
   double prep = since(t1);
@@ -190,6 +193,7 @@ int cmdBench(const Options& o) {
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
   const int frames = int(o.getInt("--frames", 8, 1, 1000000));
   const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
+  const LaunchParams launch = launchParams(o);
   int w = 1024, h = 1024;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   std::ostringstream json;
@@ -236,9 +240,9 @@ int cmdBench(const Options& o) {
         engine.update();
         if (rep == 0 || engine.buildStats().seconds < s.seconds) s = engine.buildStats();
       }
-      const char* residentBefore = std::getenv("SPACESKIP_CUDA_RESIDENT");
-      const std::string residentSaved = residentBefore ? residentBefore : "";
-      if (!item.resident.empty()) setenv("SPACESKIP_CUDA_RESIDENT", item.resident.c_str(), 1);
+      LaunchParams itemLaunch = launch;
+      if (item.resident >= 0) itemLaunch.resident = item.resident;
+      engine.setLaunchParams(itemLaunch);
       double b6[6];
       v.worldBounds(b6);
       Image img;
@@ -268,10 +272,6 @@ int cmdBench(const Options& o) {
       counted.countSamples = true;
       engine.setRenderParams(counted);
       engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
-      if (!item.resident.empty()) {
-        if (residentBefore) setenv("SPACESKIP_CUDA_RESIDENT", residentSaved.c_str(), 1);
-        else unsetenv("SPACESKIP_CUDA_RESIDENT");
-      }
       const double samples = double(engine.frameStats().samples);
       const double gsps = samples * kernelFps * 1e-9;
       // Logical voxel traffic of trilinear sampling: 8 voxels per sample (mostly cache hits).
@@ -332,6 +332,7 @@ int cmdAccuracy(const Options& o) {
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
   engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
+  engine.setLaunchParams(launchParams(o));
   Camera cam = makeCamera(o, v, w, h);
   RenderParams ref;
   ref.sampleDistance = minSpacing / 8;

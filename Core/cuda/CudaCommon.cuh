@@ -56,7 +56,8 @@ inline int64_t deviceMemoryLimit() {
 
 /// Testing aid: SPACESKIP_CUDA_FAIL_RENDER=1 makes every render launch report
 /// cudaErrorLaunchFailure, a CUDA error in the middle of a frame, so that the fallback to the CPU
-/// backend's image can be tested on any GPU. Read at every render launch; anything else: off.
+/// backend's image can be tested on any GPU (TestCuda.cpp sets it). Read at every render launch;
+/// anything else: off. Unlike the launch shape (LaunchParams), no caller sets this in earnest.
 inline cudaError_t injectedRenderError() {
   const char* s = std::getenv("SPACESKIP_CUDA_FAIL_RENDER");
   return s && s[0] == '1' && s[1] == '\0' ? cudaErrorLaunchFailure : cudaSuccess;
@@ -146,6 +147,69 @@ struct TempStorage {
     bytes.reserve(n < 1 ? 1 : n);
     return bytes.get();
   }
+};
+
+/// Owned handles: created by the constructor (SS_CUDA_CHECKed), destroyed unchecked.
+class Stream {
+ public:
+  Stream() { SS_CUDA_CHECK(cudaStreamCreateWithFlags(&s_, cudaStreamNonBlocking)); }
+  ~Stream() {
+    if (s_) cudaStreamDestroy(s_);
+  }
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+  operator cudaStream_t() const { return s_; }
+
+ private:
+  cudaStream_t s_ = nullptr;
+};
+
+class Event {
+ public:
+  Event() { SS_CUDA_CHECK(cudaEventCreate(&e_)); }
+  ~Event() {
+    if (e_) cudaEventDestroy(e_);
+  }
+  Event(const Event&) = delete;
+  Event& operator=(const Event&) = delete;
+  operator cudaEvent_t() const { return e_; }
+
+ private:
+  cudaEvent_t e_ = nullptr;
+};
+
+/// Pinned host memory (cudaMallocHost): fast DMA to and from the device.
+class PinnedBuffer {
+ public:
+  PinnedBuffer() = default;
+  ~PinnedBuffer() { release(); }
+  PinnedBuffer(const PinnedBuffer&) = delete;
+  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+  /// Ensures room for `bytes` (old contents are not kept); throws BackendError when it cannot.
+  void reserve(size_t bytes) { SS_CUDA_CHECK(tryReserve(bytes)); }
+  /// As reserve(), but reports a failure (cleared, the buffer left empty) instead of throwing.
+  cudaError_t tryReserve(size_t bytes) {
+    if (bytes_ >= bytes && p_) return cudaSuccess;
+    release();
+    const cudaError_t e = cudaMallocHost(&p_, bytes);
+    if (e != cudaSuccess) {
+      (void)cudaGetLastError();
+      p_ = nullptr;
+      return e;
+    }
+    bytes_ = bytes;
+    return cudaSuccess;
+  }
+  void release() {
+    if (p_) cudaFreeHost(p_);
+    p_ = nullptr;
+    bytes_ = 0;
+  }
+  void* get() const { return p_; }
+
+ private:
+  void* p_ = nullptr;
+  size_t bytes_ = 0;
 };
 
 inline unsigned blocksFor(int64_t n, int threads) { return unsigned((n + threads - 1) / threads); }

@@ -2,6 +2,7 @@
 // Internal to Core (the VTK module only sees Engine).
 #pragma once
 #include "Classification.h"
+#include "LaunchParams.h"
 #include "Tree.h"
 #include "Types.h"
 #include "Volume.h"
@@ -33,6 +34,8 @@ class Backend {
   /// The last frame's premultiplied RGBA (one float4 per pixel, row 0 at the bottom) in device
   /// memory while setImageOnDevice(true) is in effect, else nullptr.
   virtual const void* deviceImage() const { return nullptr; }
+  /// The launch shape of the render kernels (the CUDA backend; others ignore it).
+  virtual void setLaunchParams(const LaunchParams& /*p*/) {}
   /// Seconds the last render() spent in device work (CUDA events), -1 when not measured.
   virtual double lastFrameDeviceSeconds() const { return -1; }
   virtual const OccupancyGrid& occupancy() = 0;

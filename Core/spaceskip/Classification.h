@@ -24,6 +24,43 @@ struct RangeGrid {
   box3i brickBox(int x, int y, int z) const;
 };
 
+/// Voxels [v0, v1] along an axis of n voxels that brick b's cells [b*B, (b+1)*B) read: the +1
+/// halo of trilinear sampling, clamped.
+SS_FUNC void brickVoxelSpan(int64_t b, int brick, int64_t n, int64_t& v0, int64_t& v1) {
+  v0 = b * brick;
+  v1 = v0 + brick < n - 1 ? v0 + brick : n - 1;
+}
+
+/// Folds voxels line[x0..x1] into [lo, hi], skipping NaN.
+template <class T>
+SS_FUNC void foldRange(const T* line, int64_t x0, int64_t x1, float& lo, float& hi) {
+  float l = lo, h = hi;
+  for (int64_t x = x0; x <= x1; ++x) {
+    const float v = float(line[x]);
+    if (v != v) continue;  // NaN
+    l = v < l ? v : l;
+    h = v > h ? v : h;
+  }
+  lo = l;
+  hi = h;
+}
+
+/// RangeGrid's rule for brick (bx, by, bz) of a volume of `dims` voxels at `data`: min/max over
+/// its voxels with the +1 halo, NaN skipped; (+inf, -inf) when all are NaN. One CUDA thread per
+/// brick runs it as it is; the oneTBB twin folds the same spans in line order, one pass per row.
+template <class T>
+SS_FUNC void brickRange(const T* data, vec3l dims, int brick, int64_t bx, int64_t by, int64_t bz, float& lo,
+                        float& hi) {
+  int64_t x0, x1, y0, y1, z0, z1;
+  brickVoxelSpan(bx, brick, dims.x, x0, x1);
+  brickVoxelSpan(by, brick, dims.y, y0, y1);
+  brickVoxelSpan(bz, brick, dims.z, z0, z1);
+  lo = INFINITY;
+  hi = -INFINITY;
+  for (int64_t z = z0; z <= z1; ++z)
+    for (int64_t y = y0; y <= y1; ++y) foldRange(data + dims.x * (y + dims.y * z), x0, x1, lo, hi);
+}
+
 /// Parallel (oneTBB) computation of the range grid.
 RangeGrid computeRangeGrid(const Volume& v, int brick = 8);
 

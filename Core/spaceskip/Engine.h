@@ -23,6 +23,7 @@ namespace spaceskip {
 double effectiveSampleDistance(const Volume& v, double requested, std::string* note = nullptr);
 
 class Backend;
+struct LaunchParams;  // LaunchParams.h
 
 class Engine {
  public:
@@ -61,6 +62,8 @@ class Engine {
   /// The last frame's premultiplied RGBA, float4 per pixel, row 0 at the bottom, in device memory
   /// (valid until the next render), or nullptr when the image went to the host.
   const void* deviceImage() const;
+  /// CUDA: the launch shape of the render kernels (LaunchParams.h); other backends ignore it.
+  void setLaunchParams(const LaunchParams& p);
 
   const BuildStats& buildStats() const;
   /// Builder Auto: true while it still measures its candidates (one frame each).

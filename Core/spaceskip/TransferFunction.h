@@ -76,17 +76,51 @@ SS_FUNC vec4f lookup(const TransferFunctionView& tf, float v) {
                a.w + (b.w - a.w) * f};
 }
 
-/// O(1) max-opacity query over entry ranges (sparse table), for classification.
+/// O(1) max-opacity query over entry ranges of a TF table: a sparse table whose level k holds the
+/// max over 2^k consecutive entries, flat in `levels`. Plain data, read as it is by the CPU
+/// classification (host pointer) and the CUDA kernel (device pointer), so both classify alike.
+struct OpacityRangeMaxView {
+  static constexpr int kMaxLevels = 32;  ///< any int-sized table has at most 31 levels
+  const float* levels;                   ///< level k at levels + offset[k]: size - 2^k + 1 entries
+  int offset[kMaxLevels];
+  int size;         ///< table entries (level 0)
+  double lo, scale; ///< entry x = (v - lo) * scale
+
+  /// Max opacity any sample with value in [vmin, vmax] can get (0 for an empty/NaN range).
+  SS_FUNC float query(double vmin, double vmax) const {
+    if (!(vmin <= vmax)) return 0.f;  // empty or NaN range
+    // A sample's value lies in [vmin, vmax]; the lookup blends entries floor(x) and floor(x)+1.
+    double x0 = (vmin - lo) * scale, x1 = (vmax - lo) * scale;
+    x0 = fmin(fmax(x0, 0.0), double(size - 1));
+    x1 = fmin(fmax(x1, 0.0), double(size - 1));
+    // One extra entry on each side absorbs float-vs-double rounding of the integrator's lookup.
+    int i0 = int(floor(x0)) - 1, i1 = int(ceil(x1)) + 1;
+    i0 = i0 < 0 ? 0 : (i0 > size - 1 ? size - 1 : i0);
+    i1 = i1 < i0 ? i0 : (i1 > size - 1 ? size - 1 : i1);
+    const int len = i1 - i0 + 1;
+    int k = 0;
+    while ((2 << k) <= len) ++k;
+    const float* L = levels + offset[k];
+    return fmaxf(L[i0], L[i1 - (1 << k) + 1]);
+  }
+};
+
+/// Builds the sparse table over a TF's (uncorrected) opacity on the host. The CPU queries it in
+/// place; the CUDA backend copies levels() to the device and points a copy of view() there.
+/// Throws std::invalid_argument for an empty table.
 class OpacityRangeMax {
  public:
   explicit OpacityRangeMax(const TransferFunction& tf);
+  OpacityRangeMax(const OpacityRangeMax&) = delete;  // view_ points into levels_
+  OpacityRangeMax& operator=(const OpacityRangeMax&) = delete;
   /// Max opacity any sample with value in [vmin, vmax] can get (0 for an empty/NaN range).
-  float query(double vmin, double vmax) const;
+  float query(double vmin, double vmax) const { return view_.query(vmin, vmax); }
+  const OpacityRangeMaxView& view() const { return view_; }
+  const std::vector<float>& levels() const { return levels_; }
 
  private:
-  std::vector<std::vector<float>> levels_;
-  double lo_, scale_;
-  int size_;
+  std::vector<float> levels_;
+  OpacityRangeMaxView view_{};
 };
 
 }  // namespace spaceskip

@@ -17,6 +17,21 @@ const char* voxelTypeName(VoxelType t);
 /// Parses "uint8", "int16", "float", "float32", "double", ... ; returns false if unknown.
 bool parseVoxelType(const std::string& s, VoxelType& out);
 
+/// The one switch over voxel types: calls f(T()) with T the C++ type of `t` (uint8_t, int8_t,
+/// uint16_t, int16_t, float, double) and returns what it returns.
+template <class F>
+decltype(auto) dispatchVoxelType(VoxelType t, F&& f) {
+  switch (t) {
+    case VoxelType::UInt8: break;
+    case VoxelType::Int8: return f(int8_t());
+    case VoxelType::UInt16: return f(uint16_t());
+    case VoxelType::Int16: return f(int16_t());
+    case VoxelType::Float32: return f(float());
+    case VoxelType::Float64: return f(double());
+  }
+  return f(uint8_t());
+}
+
 /// Host volume. Either owns its voxels (`storage`) or borrows a caller's buffer (`data`).
 /// Voxel (i,j,k) lives at i + dims.x*(j + dims.y*k) with 64-bit arithmetic.
 struct Volume {

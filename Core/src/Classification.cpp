@@ -18,7 +18,8 @@ template <class T>
 void rangesOf(const Volume& v, RangeGrid& g) {
   const T* data = static_cast<const T*>(v.data);
   const int64_t nx = v.dims.x, ny = v.dims.y, nz = v.dims.z;
-  // Parallel over brick rows (y,z): each task writes its own bricks.
+  // Parallel over brick rows (y,z): each task writes its own bricks. brickRange's spans, in line
+  // order: each voxel line of the row is read once and folded into the bricks it crosses.
   tbb::parallel_for(tbb::blocked_range<int64_t>(0, int64_t(g.dims.y) * g.dims.z),
                     [&](const tbb::blocked_range<int64_t>& r) {
     std::vector<float> lo(size_t(g.dims.x)), hi(size_t(g.dims.x));
@@ -26,23 +27,16 @@ void rangesOf(const Volume& v, RangeGrid& g) {
       const int by = int(row % g.dims.y), bz = int(row / g.dims.y);
       std::fill(lo.begin(), lo.end(), std::numeric_limits<float>::infinity());
       std::fill(hi.begin(), hi.end(), -std::numeric_limits<float>::infinity());
-      // Voxels [b*B, (b+1)*B] inclusive (the +1 halo), clamped.
-      const int64_t y0 = int64_t(by) * g.brick, y1 = std::min<int64_t>(y0 + g.brick, ny - 1);
-      const int64_t z0 = int64_t(bz) * g.brick, z1 = std::min<int64_t>(z0 + g.brick, nz - 1);
+      int64_t y0, y1, z0, z1;
+      brickVoxelSpan(by, g.brick, ny, y0, y1);
+      brickVoxelSpan(bz, g.brick, nz, z0, z1);
       for (int64_t z = z0; z <= z1; ++z)
         for (int64_t y = y0; y <= y1; ++y) {
           const T* line = data + nx * (y + ny * z);
           for (int bx = 0; bx < g.dims.x; ++bx) {
-            const int64_t x0 = int64_t(bx) * g.brick, x1 = std::min<int64_t>(x0 + g.brick, nx - 1);
-            float l = lo[size_t(bx)], h = hi[size_t(bx)];
-            for (int64_t x = x0; x <= x1; ++x) {
-              float val = float(line[x]);
-              if (val != val) continue;  // NaN
-              l = val < l ? val : l;
-              h = val > h ? val : h;
-            }
-            lo[size_t(bx)] = l;
-            hi[size_t(bx)] = h;
+            int64_t x0, x1;
+            brickVoxelSpan(bx, g.brick, nx, x0, x1);
+            foldRange(line, x0, x1, lo[size_t(bx)], hi[size_t(bx)]);
           }
         }
       for (int bx = 0; bx < g.dims.x; ++bx) {
@@ -66,14 +60,7 @@ RangeGrid computeRangeGrid(const Volume& v, int brick) {
                  (g.cellDims.z + g.brick - 1) / g.brick};
   g.vmin.resize(size_t(g.size()));
   g.vmax.resize(size_t(g.size()));
-  switch (v.type) {
-    case VoxelType::UInt8: rangesOf<uint8_t>(v, g); break;
-    case VoxelType::Int8: rangesOf<int8_t>(v, g); break;
-    case VoxelType::UInt16: rangesOf<uint16_t>(v, g); break;
-    case VoxelType::Int16: rangesOf<int16_t>(v, g); break;
-    case VoxelType::Float32: rangesOf<float>(v, g); break;
-    case VoxelType::Float64: rangesOf<double>(v, g); break;
-  }
+  dispatchVoxelType(v.type, [&](auto t) { rangesOf<decltype(t)>(v, g); });
   return g;
 }
 

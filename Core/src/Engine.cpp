@@ -511,6 +511,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
 
 bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }
 const void* Engine::deviceImage() const { return impl_->backend->deviceImage(); }
+void Engine::setLaunchParams(const LaunchParams& p) { impl_->backend->setLaunchParams(p); }
 
 const BuildStats& Engine::buildStats() const { return impl_->stats; }
 bool Engine::exploring() const {

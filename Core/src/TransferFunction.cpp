@@ -106,32 +106,27 @@ std::vector<vec4f> tableForBlend(const TransferFunction& tf, float dt, BlendMode
   return out;
 }
 
-OpacityRangeMax::OpacityRangeMax(const TransferFunction& tf)
-    : lo_(tf.rangeMin), size_(int(tf.table.size())) {
-  scale_ = tf.rangeMax > tf.rangeMin ? double(size_ - 1) / (tf.rangeMax - tf.rangeMin) : 0.0;
-  levels_.emplace_back(size_t(size_));
-  for (int i = 0; i < size_; ++i) levels_[0][size_t(i)] = tf.table[size_t(i)].w;
-  for (int len = 2; len <= size_; len *= 2) {
-    const auto& prev = levels_.back();
-    std::vector<float> cur(size_t(size_ - len + 1));
-    for (int i = 0; i + len <= size_; ++i) cur[size_t(i)] = std::max(prev[size_t(i)], prev[size_t(i + len / 2)]);
-    levels_.push_back(std::move(cur));
+OpacityRangeMax::OpacityRangeMax(const TransferFunction& tf) {
+  if (tf.table.empty()) throw std::invalid_argument("empty transfer-function table");
+  const int size = int(tf.table.size());
+  view_.size = size;
+  view_.lo = tf.rangeMin;
+  view_.scale = tf.rangeMax > tf.rangeMin ? double(size - 1) / (tf.rangeMax - tf.rangeMin) : 0.0;
+  // Level k (entries i..i+2^k-1) at offset[k]: the max of two entries of level k-1.
+  size_t total = 0;
+  int levels = 0;
+  for (int64_t len = 1; len <= size && levels < OpacityRangeMaxView::kMaxLevels; len *= 2, ++levels) {
+    view_.offset[levels] = int(total);
+    total += size_t(size - len + 1);
   }
-}
-
-float OpacityRangeMax::query(double vmin, double vmax) const {
-  if (!(vmin <= vmax)) return 0.f;  // empty or NaN range
-  // A sample's value lies in [vmin, vmax]; the lookup blends entries floor(x) and floor(x)+1.
-  double x0 = (vmin - lo_) * scale_, x1 = (vmax - lo_) * scale_;
-  x0 = std::clamp(x0, 0.0, double(size_ - 1));
-  x1 = std::clamp(x1, 0.0, double(size_ - 1));
-  // One extra entry on each side absorbs float-vs-double rounding of the integrator's lookup.
-  int i0 = int(std::floor(x0)) - 1, i1 = int(std::ceil(x1)) + 1;
-  i0 = std::clamp(i0, 0, size_ - 1);
-  i1 = std::clamp(i1, i0, size_ - 1);
-  int len = i1 - i0 + 1, k = 0;
-  while ((2 << k) <= len) ++k;
-  return std::max(levels_[size_t(k)][size_t(i0)], levels_[size_t(k)][size_t(i1 - (1 << k) + 1)]);
+  levels_.resize(total);
+  for (int i = 0; i < size; ++i) levels_[size_t(i)] = tf.table[size_t(i)].w;
+  for (int k = 1, len = 2; k < levels; ++k, len *= 2) {
+    const float* prev = levels_.data() + view_.offset[k - 1];
+    float* cur = levels_.data() + view_.offset[k];
+    for (int i = 0; i + len <= size; ++i) cur[i] = std::max(prev[i], prev[i + len / 2]);
+  }
+  view_.levels = levels_.data();
 }
 
 }  // namespace spaceskip

@@ -1,0 +1,123 @@
+// Brick value ranges and classification against the TF on the device (thin drivers over the
+// shared brickRange and OpacityRangeMaxView).
+#include "Classification.cuh"
+
+#include <algorithm>
+
+namespace spaceskip::cuda {
+
+namespace {
+
+constexpr int kThreads = 256;
+
+// Launch shape: one thread per brick, 256 per block. brickRange over the brick's voxels.
+template <class T>
+__global__ void rangeKernel(const T* data, vec3l dims, vec3i bdims, int brick, float* vmin, float* vmax) {
+  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  const int64_t nb = int64_t(bdims.x) * bdims.y * bdims.z;
+  if (i >= nb) return;
+  const int64_t bx = i % bdims.x, by = (i / bdims.x) % bdims.y, bz = i / (int64_t(bdims.x) * bdims.y);
+  float lo, hi;
+  brickRange(data, dims, brick, bx, by, bz, lo, hi);
+  vmin[i] = lo;
+  vmax[i] = hi;
+}
+
+// Launch shape: one thread per brick, 256 per block. Occupancy against the TF; counts occupied
+// bricks (one atomic per block) and flags any difference from the previous occupancy.
+__global__ void classifyKernel(const float* vmin, const float* vmax, int64_t n, OpacityRangeMaxView rmq,
+                               const uint8_t* prev, uint8_t* occ, unsigned long long* occupied, int* changed) {
+  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  int o = 0, diff = 0;
+  if (i < n) {
+    o = rmq.query(double(vmin[i]), double(vmax[i])) > 0.f ? 1 : 0;
+    occ[i] = uint8_t(o);
+    diff = prev ? (prev[i] != o) : 1;
+  }
+  const int blockCount = __syncthreads_count(o);
+  const int blockDiff = __syncthreads_or(diff);
+  if (threadIdx.x == 0) {
+    if (blockCount) atomicAdd(occupied, (unsigned long long)blockCount);
+    if (blockDiff) atomicOr(changed, 1);
+  }
+}
+
+}  // namespace
+
+cudaError_t brickRanges(const void* d_voxels, VoxelType type, vec3l dims, vec3i bdims, int brick, float* d_vmin,
+                        float* d_vmax, cudaStream_t stream) {
+  const int64_t nb = int64_t(bdims.x) * bdims.y * bdims.z;
+  dispatchVoxelType(type, [&](auto t) {
+    using T = decltype(t);
+    rangeKernel<T><<<blocksFor(nb, kThreads), kThreads, 0, stream>>>(
+        static_cast<const T*>(d_voxels), dims, bdims, brick, d_vmin, d_vmax);
+  });
+  return cudaPeekAtLastError();
+}
+
+cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, int64_t n, const OpacityRangeMaxView& rmq,
+                           const uint8_t* d_prev, uint8_t* d_occ, ClassifyFlags* d_flags, cudaStream_t stream) {
+  classifyKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_vmin, d_vmax, n, rmq, d_prev, d_occ,
+                                                                  &d_flags->occupied, &d_flags->changed);
+  return cudaPeekAtLastError();
+}
+
+void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t stream) {
+  const Volume& vol = v.volume();
+  haveOcc = false;
+  brick = std::max(1, b);
+  cellDims = vol.cellDims();
+  bdims = vec3i{(cellDims.x + brick - 1) / brick, (cellDims.y + brick - 1) / brick, (cellDims.z + brick - 1) / brick};
+  const size_t nb = size_t(numBricks());
+  d_vmin.reserve(nb);
+  d_vmax.reserve(nb);
+  d_occ[0].reserve(nb);
+  d_occ[1].reserve(nb);
+  SS_CUDA_CHECK(brickRanges(v.d_voxels<unsigned char>(), vol.type, vol.dims, bdims, brick, d_vmin.get(), d_vmax.get(),
+                            stream));
+}
+
+bool BrickClassification::classify(const TransferFunction& tf, cudaStream_t stream) {
+  // The sparse table over the TF's (uncorrected) opacity, built as on the CPU, queried on the device.
+  const OpacityRangeMax table(tf);
+  d_levels_.reserve(table.levels().size());
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_levels_.get(), table.levels().data(), table.levels().size() * sizeof(float),
+                                cudaMemcpyHostToDevice, stream));
+  OpacityRangeMaxView rmq = table.view();
+  rmq.levels = d_levels_.get();
+
+  const uint8_t* prev = haveOcc ? d_occ[cur].get() : nullptr;
+  uint8_t* next = d_occ[1 - cur].get();
+  d_flags_.reserve(1);
+  SS_CUDA_CHECK(cudaMemsetAsync(d_flags_.get(), 0, sizeof(ClassifyFlags), stream));
+  SS_CUDA_CHECK(classifyBricks(d_vmin.get(), d_vmax.get(), numBricks(), rmq, prev, next, d_flags_.get(), stream));
+  auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
+  SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  cur = 1 - cur;
+  const bool changed = !haveOcc || flags->changed != 0;
+  haveOcc = true;
+  occupied = int64_t(flags->occupied);
+  hostOccValid_ = false;
+  return changed;
+}
+
+const OccupancyGrid& BrickClassification::occupancy(cudaStream_t stream) {
+  if (!hostOccValid_) {
+    hostOcc_ = OccupancyGrid{};
+    hostOcc_.brick = brick;
+    hostOcc_.cellDims = cellDims;
+    hostOcc_.dims = bdims;
+    if (haveOcc) {
+      hostOcc_.occ.resize(size_t(numBricks()));
+      SS_CUDA_CHECK(cudaMemcpyAsync(hostOcc_.occ.data(), d_occ[cur].get(), hostOcc_.occ.size(), cudaMemcpyDeviceToHost,
+                                    stream));
+      SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+      hostOcc_.occupied = occupied;
+    }
+    hostOccValid_ = true;
+  }
+  return hostOcc_;
+}
+
+}  // namespace spaceskip::cuda

@@ -1,0 +1,57 @@
+// Per-brick value ranges and occupancy on the device: the twins of Core/src/Classification.cpp,
+// sharing its rules (brickRange, OpacityRangeMaxView in spaceskip/Classification.h).
+#pragma once
+#include "DeviceVolume.cuh"
+#include "spaceskip/Classification.h"
+
+namespace spaceskip::cuda {
+
+/// What classifyBricks counts, in device memory (zeroed by the caller).
+struct ClassifyFlags {
+  unsigned long long occupied;  ///< occupied bricks
+  int changed;                  ///< 1 when some brick differs from the previous occupancy
+};
+
+/// d_vmin/d_vmax[i] = brickRange of brick i (x fastest) of the `bdims` bricks of `brick` cells
+/// over the `type` voxels at d_voxels.
+cudaError_t brickRanges(const void* d_voxels, VoxelType type, vec3l dims, vec3i bdims, int brick, float* d_vmin,
+                        float* d_vmax, cudaStream_t stream);
+
+/// d_occ[i] = 1 when brick i's range can have opacity > 0 (rmq.levels on the device); counts
+/// into d_flags and flags any difference from d_prev (nullptr: everything changed).
+cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, int64_t n, const OpacityRangeMaxView& rmq,
+                           const uint8_t* d_prev, uint8_t* d_occ, ClassifyFlags* d_flags, cudaStream_t stream);
+
+/// The brick grid of the current volume: value ranges (once per volume) and a double-buffered
+/// occupancy (once per opacity edit), with a host copy of the occupancy made on demand.
+class BrickClassification {
+ public:
+  BrickClassification() { h_flags_.reserve(sizeof(ClassifyFlags)); }
+
+  /// Sizes the grid for `v` and launches the range kernel on `stream` (no synchronization).
+  void setVolume(const DeviceVolume& v, int brick, cudaStream_t stream);
+  /// Classifies against `tf`'s opacity; true when the occupancy changed (or is the first).
+  bool classify(const TransferFunction& tf, cudaStream_t stream);
+  /// The occupancy on the host (downloaded once per classification).
+  const OccupancyGrid& occupancy(cudaStream_t stream);
+
+  int64_t numBricks() const { return int64_t(bdims.x) * bdims.y * bdims.z; }
+
+  // Plain state, read by the builders and the render launch.
+  int brick = 8;
+  vec3i cellDims{0, 0, 0}, bdims{0, 0, 0};
+  DeviceBuffer<float> d_vmin, d_vmax;
+  DeviceBuffer<uint8_t> d_occ[2];  ///< d_occ[cur]: the current occupancy
+  int cur = 0;
+  bool haveOcc = false;  ///< classify() ran for this volume
+  int64_t occupied = 0;
+
+ private:
+  DeviceBuffer<float> d_levels_;  ///< OpacityRangeMax's levels
+  DeviceBuffer<ClassifyFlags> d_flags_;
+  PinnedBuffer h_flags_;
+  OccupancyGrid hostOcc_;
+  bool hostOccValid_ = false;
+};
+
+}  // namespace spaceskip::cuda

@@ -1,0 +1,207 @@
+// Render kernels (one per traversal and sampler), the tile scheduler, and the frame's way from
+// FrameView to the caller's image.
+#include "CudaExecutor.cuh"
+#include "spaceskip/Backend.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <type_traits>
+
+namespace spaceskip::cuda {
+
+namespace {
+
+// Launch shape: 2-D grid of 16x8 blocks (LaunchParams::blockX/Y override), one thread per pixel.
+// One kernel per traversal: a kernel holding every traversal is allocated the registers of the
+// tree traversal (64 per thread, half occupancy), which the naive and grid marches do not need.
+// SPACESKIP_CUDA_HW_MIN_BLOCKS > 1 asks the hardware-filtered kernels to fit that many blocks of
+// 256 threads per SM (a register cap). Measured on the H100 (round 3): 6 (40 registers) made
+// every ESS kernel 4-11% slower than no cap, so the default is 1 (no cap).
+constexpr int kMaxRenderThreads = 256;
+// Default launch of the hardware-filtered kernels: plain for volumes up to kLargeTextureBytes; a
+// persistent launch with kLargeTextureResident blocks of 128 threads per SM above. Measured on
+// the H100 (docs/results/cuda-h100-round3): naive:hw at 2048^3 (8 GiB) runs fastest with 6
+// blocks per SM (more warps in flight thrash the texture path), at 1024^3 (1 GiB) with all 16;
+// the skipping kernels do not care either way.
+constexpr size_t kLargeTextureBytes = size_t(2) << 30;
+constexpr int kLargeTextureResident = 6;
+template <class Sampler>
+struct RenderMinBlocks {
+  static constexpr int value = 1;
+};
+#ifndef SPACESKIP_CUDA_HW_MIN_BLOCKS
+#define SPACESKIP_CUDA_HW_MIN_BLOCKS 1  // CMake: SPACESKIP_CUDA_HW_MIN_BLOCKS (1 = no register cap)
+#endif
+template <>
+struct RenderMinBlocks<TextureSampler> {
+  static constexpr int value = SPACESKIP_CUDA_HW_MIN_BLOCKS;
+};
+
+// Tiles of blockDim pixels. Without `tileCounter` block (i, j) renders tile (i, j). With it the
+// launch is persistent: a fixed number of resident blocks take tiles in row-major order from the
+// counter until none are left, which bounds the warps in flight (the volume's cache working set)
+// and balances blocks whose rays cost very different amounts.
+template <class Sampler, int Traversal>
+__global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::value)
+    renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out,
+                 unsigned* tileCounter) {
+  const unsigned tilesX = (unsigned(f.width) + blockDim.x - 1) / blockDim.x;
+  auto tile = [&](unsigned tx, unsigned ty) {
+    const int x = int(tx * blockDim.x + threadIdx.x), y = int(ty * blockDim.y + threadIdx.y);
+    if (x < f.width && y < f.height) out[int64_t(y) * f.width + x] = renderPixel<Sampler, Traversal>(f, s, x, y);
+  };
+  if (!tileCounter) {
+    tile(blockIdx.x, blockIdx.y);
+    return;
+  }
+  const unsigned numTiles = tilesX * ((unsigned(f.height) + blockDim.y - 1) / blockDim.y);
+  __shared__ unsigned next;
+  for (;;) {
+    if (threadIdx.x == 0 && threadIdx.y == 0) next = atomicAdd(tileCounter, 1u);
+    __syncthreads();
+    const unsigned t = next;
+    __syncthreads();  // everyone has read `next` before thread 0 overwrites it
+    if (t >= numTiles) return;
+    tile(t % tilesX, t / tilesX);
+  }
+}
+
+template <class Sampler>
+using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*);
+
+template <class Sampler>
+RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
+  switch (t) {
+    case TraversalKind::Naive: return renderKernel<Sampler, int(TraversalKind::Naive)>;
+    case TraversalKind::Grid: return renderKernel<Sampler, int(TraversalKind::Grid)>;
+    case TraversalKind::Tree: return renderKernel<Sampler, int(TraversalKind::Tree)>;
+    case TraversalKind::Hybrid: return renderKernel<Sampler, int(TraversalKind::Hybrid)>;
+  }
+  return renderKernel<Sampler, int(TraversalKind::Naive)>;
+}
+
+bool validBlock(const LaunchParams& p) {
+  return p.blockX > 0 && p.blockY > 0 && p.blockX * p.blockY >= 32 && p.blockX * p.blockY <= kMaxRenderThreads;
+}
+
+}  // namespace
+
+CudaExecutor::CudaExecutor() {
+  // Measurement overrides from the environment (LaunchParams.h): SPACESKIP_CUDA_BLOCK=WxH,
+  // SPACESKIP_CUDA_CARVEOUT=0..100.
+  if (const char* b = std::getenv("SPACESKIP_CUDA_BLOCK")) {
+    unsigned w = 0, h = 0;
+    if (std::sscanf(b, "%ux%u", &w, &h) == 2 && w * h >= 32 && w * h <= unsigned(kMaxRenderThreads)) {
+      env_.blockX = int(w);
+      env_.blockY = int(h);
+    }
+  }
+  int dev = 0;
+  if (cudaGetDevice(&dev) != cudaSuccess ||
+      cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
+    (void)cudaGetLastError();
+    numSMs_ = 1;
+  }
+  if (const char* c = std::getenv("SPACESKIP_CUDA_CARVEOUT")) {
+    const int v = std::atoi(c);
+    if (v >= 0 && v <= 100) env_.carveout = v;
+  }
+}
+
+void CudaExecutor::setTransferTable(const std::vector<vec4f>& t, float lo, float scale, cudaStream_t stream) {
+  d_table_.reserve(t.size());
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_table_.get(), t.data(), t.size() * sizeof(vec4f), cudaMemcpyHostToDevice, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  table_ = TransferFunctionView{d_table_.get(), int(t.size()), lo, scale};
+}
+
+void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol, Image& out,
+                          cudaStream_t stream) {
+  const size_t pixels = size_t(f.width) * size_t(f.height);
+  f.tf = table_;
+  f.depth = nullptr;
+  if (depth) {
+    d_depth_.reserve(pixels);
+    SS_CUDA_CHECK(cudaMemcpyAsync(d_depth_.get(), depth, pixels * sizeof(float), cudaMemcpyHostToDevice, stream));
+    f.depth = d_depth_.get();
+  }
+  unsigned* hostCounts = f.sampleCount;
+  f.sampleCount = nullptr;
+  if (hostCounts) {
+    d_counts_.reserve(pixels);
+    f.sampleCount = d_counts_.get();
+  }
+  d_image_.reserve(pixels);
+  const LaunchParams& shape = validBlock(launch_) ? launch_ : env_;
+  const unsigned bx = validBlock(shape) ? unsigned(shape.blockX) : 16u, by = validBlock(shape) ? unsigned(shape.blockY) : 8u;
+  const dim3 block(bx, by);
+  const dim3 grid(unsigned((f.width + bx - 1) / bx), unsigned((f.height + by - 1) / by));
+  SS_CUDA_CHECK(cudaEventRecord(ev0_, stream));
+  if (filter == FilterMode::Hardware) {
+    const TextureSampler s = vol.texture(stream);
+    launch(f, s, grid, block, vol.textureBytes(), stream);
+  } else {
+    const Volume& v = vol.volume();
+    dispatchVoxelType(v.type, [&](auto t) {
+      using T = decltype(t);
+      launch(f, ArraySampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z}, grid, block, 0, stream);
+    });
+  }
+  SS_CUDA_CHECK_LAUNCH(renderKernel);
+  SS_CUDA_CHECK(injectedRenderError());
+  SS_CUDA_CHECK(cudaEventRecord(ev1_, stream));
+  out.width = f.width;
+  out.height = f.height;
+  float ms = 0;
+  if (imageOnDevice_ && !hostCounts) {
+    // The caller draws d_image_ itself (CUDA-GL interop): no download.
+    out.rgba.clear();
+    SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+    SS_CUDA_CHECK(cudaEventElapsedTime(&ms, ev0_, ev1_));
+    lastDeviceSeconds_ = double(ms) * 1e-3;
+    deviceImageValid_ = true;
+    return;
+  }
+  deviceImageValid_ = false;
+  out.rgba.resize(pixels);
+  // Through a pinned staging buffer (DMA at full link speed, then a parallel host copy): about
+  // twice as fast as a copy into the caller's pageable vector. Without pinned memory, direct.
+  const size_t imageBytes = pixels * sizeof(vec4f);
+  const bool staged = h_stage_.tryReserve(imageBytes) == cudaSuccess;
+  SS_CUDA_CHECK(cudaMemcpyAsync(staged ? h_stage_.get() : static_cast<void*>(out.rgba.data()), d_image_.get(),
+                                imageBytes, cudaMemcpyDeviceToHost, stream));
+  if (hostCounts)
+    SS_CUDA_CHECK(
+        cudaMemcpyAsync(hostCounts, d_counts_.get(), pixels * sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  if (staged) parallelCopy(out.rgba.data(), h_stage_.get(), imageBytes);
+  SS_CUDA_CHECK(cudaEventElapsedTime(&ms, ev0_, ev1_));
+  lastDeviceSeconds_ = double(ms) * 1e-3;
+}
+
+template <class Sampler>
+void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes,
+                          cudaStream_t stream) {
+  // Persistent launch with N blocks per SM taking tiles from a counter (0: one block per tile, the
+  // plain launch): LaunchParams::resident, else SPACESKIP_CUDA_RESIDENT (read per frame), else automatic.
+  int residentBlocks = std::is_same<Sampler, TextureSampler>::value && textureBytes > kLargeTextureBytes
+                           ? std::max(1, kLargeTextureResident * 128 / int(block.x * block.y))
+                           : 0;
+  if (launch_.resident >= 0) residentBlocks = launch_.resident;
+  else if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks = std::max(0, std::atoi(r));
+  RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f.traversal);
+  const int carveout = launch_.carveout >= 0 && launch_.carveout <= 100 ? launch_.carveout : env_.carveout;
+  if (carveout >= 0) SS_CUDA_CHECK(cudaFuncSetAttribute(k, cudaFuncAttributePreferredSharedMemoryCarveout, carveout));
+  if (residentBlocks <= 0) {
+    k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr);
+    return;
+  }
+  d_tileCounter_.reserve(1);
+  SS_CUDA_CHECK(cudaMemsetAsync(d_tileCounter_.get(), 0, sizeof(unsigned), stream));
+  const unsigned tiles = grid.x * grid.y;
+  const unsigned blocks = std::min(tiles, unsigned(residentBlocks) * unsigned(numSMs_));
+  k<<<blocks, block, 0, stream>>>(f, s, d_image_.get(), d_tileCounter_.get());
+}
+
+}  // namespace spaceskip::cuda

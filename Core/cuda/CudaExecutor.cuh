@@ -1,0 +1,54 @@
+// The CUDA executor of Core's shared renderPixel: one thread per pixel over tiles (plain or
+// persistent launch), exact or hardware-filtered sampling, the frame's device buffers and the
+// image's way back (a pinned staging copy, or left on the device for CUDA-GL interop).
+#pragma once
+#include "DeviceVolume.cuh"
+#include "spaceskip/LaunchParams.h"
+#include "spaceskip/Types.h"
+#include "spaceskip/render/Integrator.h"
+
+#include <vector>
+
+namespace spaceskip::cuda {
+
+class CudaExecutor {
+ public:
+  /// Reads the SM count and the environment's launch overrides (LaunchParams.h).
+  CudaExecutor();
+
+  void setLaunchParams(const LaunchParams& p) { launch_ = p; }
+  /// The (opacity-corrected) table the integrator samples; synchronizes `stream`.
+  void setTransferTable(const std::vector<vec4f>& table, float lo, float scale, cudaStream_t stream);
+  /// Renders `f` (grid and tree pointing at device memory; the table and depth filled here) from
+  /// `vol` into `out`, or only sizes `out` and leaves the image in deviceImage() (setImageOnDevice).
+  void render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol, Image& out, cudaStream_t stream);
+
+  bool setImageOnDevice(bool on) {
+    imageOnDevice_ = on;
+    deviceImageValid_ = false;
+    return true;
+  }
+  const void* deviceImage() const { return deviceImageValid_ ? d_image_.get() : nullptr; }
+  double lastFrameDeviceSeconds() const { return lastDeviceSeconds_; }
+
+ private:
+  template <class Sampler>
+  void launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes, cudaStream_t stream);
+
+  Event ev0_, ev1_;
+  LaunchParams launch_;
+  LaunchParams env_;  ///< SPACESKIP_CUDA_BLOCK / _CARVEOUT as read at construction
+  int numSMs_ = 1;
+  DeviceBuffer<vec4f> d_table_;
+  TransferFunctionView table_{nullptr, 0, 0.f, 1.f};
+  DeviceBuffer<float> d_depth_;
+  DeviceBuffer<unsigned> d_counts_;
+  DeviceBuffer<vec4f> d_image_;
+  DeviceBuffer<unsigned> d_tileCounter_;
+  PinnedBuffer h_stage_;           ///< pinned copy of the last frame's image on its way to the caller
+  bool imageOnDevice_ = false;     ///< setImageOnDevice(): leave the image in d_image_
+  bool deviceImageValid_ = false;  ///< the last render() left its image in d_image_
+  double lastDeviceSeconds_ = -1;
+};
+
+}  // namespace spaceskip::cuda

@@ -1,0 +1,89 @@
+// Volume upload and the hardware-filtered texture made from the device copy.
+#include "DeviceVolume.cuh"
+
+#include <limits>
+#include <type_traits>
+
+namespace spaceskip::cuda {
+
+namespace {
+
+constexpr int kThreads = 256;
+
+// Launch shape: one thread per voxel, 256 per block. double -> float (textures have no double channel).
+__global__ void toFloatKernel(const double* in, float* out, int64_t n) {
+  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < n) out[i] = float(in[i]);
+}
+
+}  // namespace
+
+void DeviceVolume::upload(const Volume& v, cudaStream_t stream) {
+  destroyTexture();
+  volume_ = v;
+  volume_.storage.reset();  // the Engine keeps the voxels alive; we keep the device copy
+  const size_t bytes = v.byteSize();
+  d_voxels_.release();
+  d_voxels_.reserve(bytes);
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_voxels_.get(), v.data, bytes, cudaMemcpyHostToDevice, stream));
+}
+
+TextureSampler DeviceVolume::texture(cudaStream_t stream) {
+  if (tex_) return TextureSampler{tex_, texScale_};
+  destroyTexture();  // an array left by an earlier attempt that failed after allocating it
+  cudaChannelFormatDesc desc{};
+  cudaTextureReadMode mode = cudaReadModeNormalizedFloat;
+  const void* src = d_voxels_.get();
+  size_t elem = voxelSize(volume_.type);
+  DeviceBuffer<float> converted;
+  dispatchVoxelType(volume_.type, [&](auto t) {
+    using T = decltype(t);
+    if constexpr (std::is_integral_v<T>) {
+      // Normalized reads, scaled back by the type's max (255, 127, 65535, 32767).
+      desc = cudaCreateChannelDesc<T>();
+      texScale_ = float(std::numeric_limits<T>::max());
+    } else {
+      desc = cudaCreateChannelDesc<float>();
+      mode = cudaReadModeElementType;
+      texScale_ = 1.f;
+      if constexpr (std::is_same_v<T, double>) {
+        const int64_t n = volume_.voxelCount();
+        converted.reserve(size_t(n));
+        toFloatKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_voxels<double>(), converted.get(), n);
+        SS_CUDA_CHECK_LAUNCH(toFloatKernel);
+        src = converted.get();
+        elem = sizeof(float);
+      }
+    }
+  });
+  const cudaExtent extent = make_cudaExtent(size_t(volume_.dims.x), size_t(volume_.dims.y), size_t(volume_.dims.z));
+  SS_CUDA_CHECK(deviceMalloc3DArray(&array_, &desc, extent, arrayBytes_));
+  cudaMemcpy3DParms copy{};
+  copy.srcPtr = make_cudaPitchedPtr(const_cast<void*>(src), size_t(volume_.dims.x) * elem, size_t(volume_.dims.x),
+                                    size_t(volume_.dims.y));
+  copy.dstArray = array_;
+  copy.extent = extent;
+  copy.kind = cudaMemcpyDeviceToDevice;
+  SS_CUDA_CHECK(cudaMemcpy3DAsync(&copy, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  cudaResourceDesc res{};
+  res.resType = cudaResourceTypeArray;
+  res.res.array.array = array_;
+  cudaTextureDesc td{};
+  td.addressMode[0] = td.addressMode[1] = td.addressMode[2] = cudaAddressModeClamp;
+  td.filterMode = cudaFilterModeLinear;
+  td.readMode = mode;
+  td.normalizedCoords = 0;
+  SS_CUDA_CHECK(cudaCreateTextureObject(&tex_, &res, &td, nullptr));
+  return TextureSampler{tex_, texScale_};
+}
+
+void DeviceVolume::destroyTexture() {
+  if (tex_) cudaDestroyTextureObject(tex_);
+  deviceFreeArray(array_, arrayBytes_);
+  tex_ = 0;
+  array_ = nullptr;
+  arrayBytes_ = 0;
+}
+
+}  // namespace spaceskip::cuda
