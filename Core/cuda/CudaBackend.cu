@@ -105,6 +105,9 @@ class CudaBackend final : public Backend {
   double lastFrameDeviceSeconds() const override { return exec_.lastFrameDeviceSeconds(); }
 
   const OccupancyGrid& occupancy() override { return cls_.occupancy(stream_); }
+  double occupiedFraction() override {
+    return cls_.numBricks() ? double(cls_.occupied) / double(cls_.numBricks()) : 0.0;
+  }
 
   Tree tree() override {
     Tree t;

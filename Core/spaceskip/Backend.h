@@ -39,6 +39,8 @@ class Backend {
   /// Seconds the last render() spent in device work (CUDA events), -1 when not measured.
   virtual double lastFrameDeviceSeconds() const { return -1; }
   virtual const OccupancyGrid& occupancy() = 0;
+  /// Fraction of occupied bricks after the last classify(), without a host copy of the grid.
+  virtual double occupiedFraction() { return occupancy().occupancy(); }
   virtual Tree tree() = 0;
 };
 

@@ -171,7 +171,7 @@ struct Engine::Impl {
     for (size_t i = 1; i < a.seconds.size(); ++i)
       if (a.seconds[i] < a.seconds[size_t(best)]) best = int(i);
     a.exploring = false;
-    a.occupancy = backend->occupancy().occupancy();
+    a.occupancy = backend->occupiedFraction();
     if (best != a.current) buildDirty = true;
     a.current = best;
     describeAutoChoice();
@@ -249,7 +249,7 @@ struct Engine::Impl {
       tableDirty = true;
       if (changed) buildDirty = true;
       if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
-          std::fabs(backend->occupancy().occupancy() - autoState.occupancy) > kAutoReexplore)
+          std::fabs(backend->occupiedFraction() - autoState.occupancy) > kAutoReexplore)
         startAutoExploration();
     }
     if (build.builder == BuilderKind::Auto && autoState.candidates.empty()) startAutoExploration();
@@ -283,7 +283,7 @@ struct Engine::Impl {
       }
       s.builder = p.builder;
       s.classifySeconds = stats.classifySeconds;
-      s.occupancy = backend->occupancy().occupancy();
+      s.occupancy = backend->occupiedFraction();
       s.choice = isAuto ? autoState.choice : std::string();
       stats = s;
       ++counters.builds;

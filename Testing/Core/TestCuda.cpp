@@ -661,7 +661,7 @@ TEST(CudaBackend, ErrorMidFrameFallsBackToTheCpuImage) {
 }
 
 TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
-  // SPACESKIP_CUDA_RESIDENT switches the render kernels to a persistent launch (blocks taking
+  // LaunchParams::resident switches the render kernels to a persistent launch (blocks taking
   // tiles from a counter); every pixel must still be rendered once, with the same result. A
   // 100x70 image leaves partial tiles, and 1 block per SM leaves each block many tiles.
   REQUIRE_CUDA();
@@ -673,9 +673,10 @@ TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
     for (FilterMode filter : {FilterMode::Exact, FilterMode::Hardware}) {
       Image img[2];
       for (int i = 0; i < 2; ++i) {
-        if (i == 1) setenv("SPACESKIP_CUDA_RESIDENT", "1", 1);
         Engine e(BackendKind::CUDA);
-        unsetenv("SPACESKIP_CUDA_RESIDENT");
+        LaunchParams lp;
+        lp.resident = i == 1 ? 1 : 0;  // plain launch vs 1 resident block per SM
+        e.setLaunchParams(lp);
         e.setVolume(v);
         e.setTransferFunction(tf);
         e.setBuildParams(params(k));
