@@ -6,6 +6,7 @@
 #
 #   Testing/gpu/bench-compare.sh OUTDIR BEFORE_CLI AFTER_CLI
 #   env: ROUNDS (3), FRAMES (16), VOLUMES ("gen:nbody:1024 gen:menger:1024"), BUILDERS (below),
+#        EXTRA (more bench options, e.g. "--build-reps 20": the fastest of 20 rebuilds),
 #        TBB_DIR/LD_LIBRARY_PATH as for run-gpu.sh (set from ./.deps when present)
 # Writes OUTDIR/compare.csv (every run), OUTDIR/compare.txt (medians and ratios), OUTDIR/env.txt.
 set -uo pipefail
@@ -30,6 +31,7 @@ builders=${BUILDERS:-naive,grid,distance-grid,lbvh,kdtree-gpu-fast:deep:mls128,k
   echo "after:  $after ($(sha256sum "$after" | cut -c1-12))"
   echo "rounds: $rounds frames: $frames volumes: $volumes"
   echo "builders: $builders"
+  echo "extra: ${EXTRA:-}"
 } > "$out/env.txt"
 echo "which,round,dataset,variant,kernel_fps,build_s" > "$out/compare.csv"
 for vol in $volumes; do
@@ -38,7 +40,7 @@ for vol in $volumes; do
       cli=$before
       [ $which = after ] && cli=$after
       tmp=$(mktemp)
-      "$cli" bench "$vol" --backend cuda --builders "$builders" --size 1024x1024 --frames "$frames" --csv "$tmp" \
+      "$cli" bench "$vol" --backend cuda --builders "$builders" --size 1024x1024 --frames "$frames" --csv "$tmp" ${EXTRA:-} \
         > "$out/log-$which.txt" 2>&1 || echo "$which $vol round $r failed: $(tail -3 "$out/log-$which.txt")" >> "$out/env.txt"
       # columns: dataset(1) variant(3) build_s(10) kernel_fps(18)
       awk -F, -v w=$which -v r=$r 'NR > 1 { print w "," r "," $1 "," $3 "," $18 "," $10 }' "$tmp" >> "$out/compare.csv"
