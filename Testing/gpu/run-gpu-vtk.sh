@@ -9,7 +9,8 @@
 #
 #   Testing/gpu/run-gpu-vtk.sh OUTDIR [PHASE...]
 #   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
-#          bench-ert core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
+#          bench-ert bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
+#          shading, window and CLI, N-body and Menger 1024^3: modes.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
 #          its CUDA tests: core.log) auto (the CLI's Builder Auto against fixed builders, dense and
 #          sparse 1024^3: cli-bench.log)
 #          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024
@@ -194,7 +195,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
 # vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -221,6 +222,24 @@ has bench-float && ITEMS=Grid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[
 if has bench-ert; then
   ITEMS=Naive,Grid,KdTreeGPUFast:mls32,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --ert
   ITEMS=Naive,Grid,KdTreeGPUFast:mls32,Hybrid window_bench menger 1024 "${v2[@]}" --ert
+fi
+
+# MIP: Naive takes every sample; every skipping builder marches the per-brick value ranges
+# (render/Integrator.h, usesValueRanges). Shading: composite with and without --shade.
+if has bench-modes; then
+  for shape in nbody menger; do
+    for mode in "--blend composite" "--blend composite --shade" "--blend mip"; do
+      late && break
+      ITEMS=Naive,Grid,KdTreeGPUFast:mls32,DistanceGrid window_bench $shape 1024 "${vg[@]}" $mode
+      cmode=${mode/--shade/--shade on}
+      log "CLI bench gen:$shape:1024 $cmode"
+      { echo "==== CLI gen:$shape:1024 $cmode"; timeout 300 "$cli" bench "gen:$shape:1024" --backend cuda \
+          --builders naive,grid,kdtree-gpu-fast:mls32,distance-grid --size 1024x1024 --frames "$frames" $cmode; } \
+        >> "$work/modes-cli.log" 2>&1
+      log "CLI bench rc=$?"
+    done
+  done
+  { grep -E "^blend|^item|^Naive|^Grid|^KdTree|^Distance|^vtkGPU|volume " "$work/bench.log"; echo; cat "$work/modes-cli.log"; } > "$out/modes.log"
 fi
 
 # --- Core's tests (CUDA included) and compute-sanitizer on its CUDA tests ------------------------

@@ -229,7 +229,8 @@ if has bench-sweep; then
   bench sweep-menger1024 gen:menger:1024 "$sw"
 fi
 if has blocks; then
-  # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK), recorded for the notes.
+  # Launch-shape sweep on one data set (SPACESKIP_CUDA_BLOCK: an override of LaunchParams, which
+  # the CLI also takes as --cuda-block WxH), recorded for the notes.
   for bs in 8x8 32x4 16x16 16x8; do
     SPACESKIP_CUDA_BLOCK=$bs bench "block$bs" gen:nbody:1024 "naive,grid,lbvh,kdtree-gpu-fast:deep:mls32,naive:hw,kdtree-gpu-fast:deep:mls32:hw"
   done

@@ -8,7 +8,8 @@
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
 //       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN]] [--vtk-gpu] [--csv FILE]
 //       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
-//       [--host-composite (GPUComposite off)]
+//       [--host-composite (GPUComposite off)] [--blend composite|mip|minip|average|additive]
+//       [--shade (gradient shading, VTK's default headlight and material)]
 // --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
 // headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
 // config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
@@ -321,6 +322,8 @@ int main(int argc, char* argv[])
     "Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4";
   int n = 256, frames = 16, size = 1024, edits = 4;
   bool vtkGpu = false, egl = false, floatComposite = false, ert = false, hostComposite = false;
+  bool shade = false;
+  int blend = vtkVolumeMapper::COMPOSITE_BLEND;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -347,6 +350,27 @@ int main(int argc, char* argv[])
       ert = true;
     else if (a == "--host-composite")
       hostComposite = true;
+    else if (a == "--shade")
+      shade = true;
+    else if (a == "--blend")
+    {
+      const std::string m = next();
+      if (m == "composite")
+        blend = vtkVolumeMapper::COMPOSITE_BLEND;
+      else if (m == "mip")
+        blend = vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND;
+      else if (m == "minip")
+        blend = vtkVolumeMapper::MINIMUM_INTENSITY_BLEND;
+      else if (m == "average")
+        blend = vtkVolumeMapper::AVERAGE_INTENSITY_BLEND;
+      else if (m == "additive")
+        blend = vtkVolumeMapper::ADDITIVE_BLEND;
+      else
+      {
+        std::cerr << "unknown blend mode " << m << "\n";
+        return 2;
+      }
+    }
     else if (a == "--csv")
       csvPath = next();
     else if (a == "--png")
@@ -407,8 +431,9 @@ int main(int argc, char* argv[])
   prop->SetColor(ctf);
   prop->SetScalarOpacity(pwf);
   prop->SetInterpolationTypeToLinear();
-  prop->ShadeOff();
+  prop->SetShade(shade ? 1 : 0);
   prop->SetScalarOpacityUnitDistance(1.0);
+  std::printf("blend mode %d, shading %s\n", blend, shade ? "on" : "off");
 
   vtkNew<vtkRenderer> ren;
   ren->SetBackground(0, 0, 0);
@@ -500,6 +525,7 @@ int main(int argc, char* argv[])
   mapper->SetEarlyRayTermination(ert);
   mapper->SetEightBitComposite(!floatComposite);
   mapper->SetGPUComposite(!hostComposite);
+  mapper->SetBlendMode(blend);
   std::printf("composite: %s image upload\n", floatComposite ? "32-bit float" : "8-bit");
   volume->SetMapper(mapper);
   bool firstOfAll = true;
@@ -602,6 +628,7 @@ int main(int argc, char* argv[])
     gpu->SetInputData(image);
     gpu->AutoAdjustSampleDistancesOff();
     gpu->SetSampleDistance(0.5);
+    gpu->SetBlendMode(blend);
     volume->SetMapper(gpu);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
