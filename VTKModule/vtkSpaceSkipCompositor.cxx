@@ -1,6 +1,7 @@
 // vtkSpaceSkipCompositor: depth readback, image upload (or CUDA-GL interop) and blending.
 #include "vtkSpaceSkipCompositor.h"
 
+#include "vtkActor2D.h"
 #include "vtkLogger.h"
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
@@ -8,8 +9,12 @@
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
+#include "vtkProp.h"
+#include "vtkPropCollection.h"
+#include "vtkRenderer.h"
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
+#include "vtkVolume.h"
 #include "vtk_glew.h"
 
 #include "spaceskip/Engine.h"
@@ -59,6 +64,26 @@ void vtkSpaceSkipCompositor::ReleaseGraphicsResources(vtkWindow* win)
     this->InteropTexture->ReleaseGraphicsResources(win);
     this->InteropTexture = nullptr;
   }
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipCompositor::SceneHasDepth(vtkRenderer* ren)
+{
+  if (!ren || ren->GetPreserveDepthBuffer())
+  {
+    return true;
+  }
+  vtkPropCollection* props = ren->GetViewProps();
+  vtkCollectionSimpleIterator it;
+  props->InitTraversal(it);
+  while (vtkProp* p = props->GetNextProp(it))
+  {
+    if (p->GetVisibility() && !vtkVolume::SafeDownCast(p) && !vtkActor2D::SafeDownCast(p))
+    {
+      return true;
+    }
+  }
+  return false;
 }
 
 //------------------------------------------------------------------------------

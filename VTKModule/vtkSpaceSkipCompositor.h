@@ -13,6 +13,7 @@
 class vtkOpenGLFramebufferObject;
 class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
+class vtkRenderer;
 class vtkTextureObject;
 class vtkWindow;
 namespace spaceskip
@@ -33,6 +34,14 @@ public:
    * bottom (an MSAA framebuffer is resolved first), or nullptr when it could not be read.
    */
   const float* ReadDepth(vtkOpenGLRenderWindow* renWin, int x0, int y0, int width, int height);
+
+  /**
+   * False when nothing in `ren` can have written depth before the volumes: every visible view
+   * prop is a volume or a 2D actor and the renderer does not keep an earlier layer's depth. The
+   * depth buffer then holds the cleared far plane only, and its readback (1.2-1.5 ms at 1024^2 on
+   * the H100) is skipped: the rays run to the box's far side either way.
+   */
+  static bool SceneHasDepth(vtkRenderer* ren);
 
   /// Whether the image may stay on the device for CUDA-GL interop (GPUComposite on, not failed).
   bool CanUseDeviceImage(bool gpuComposite) const { return gpuComposite && !this->InteropFailed; }

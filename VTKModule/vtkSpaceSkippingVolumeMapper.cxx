@@ -93,6 +93,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   double RangeSeconds = 0;
   double UpdateSeconds = 0;
   double DepthSeconds = 0;
+  bool DepthRead = false; // the last frame read the window's depth (SceneHasDepth)
   double EngineSeconds = 0;
   double CompositeSeconds = 0;
   double MapperSeconds = 0;
@@ -114,7 +115,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
 
   bool SelectInput(vtkVolume* vol);
   bool UpdateEngine();
-  void RenderFrame(vtkOpenGLRenderWindow* renWin, const spaceskip::Camera& camera, int x0, int y0,
+  void RenderFrame(vtkOpenGLRenderWindow* renWin, bool sceneHasDepth, const spaceskip::Camera& camera, int x0, int y0,
     int width, int height);
   bool Composite(vtkOpenGLRenderWindow* renWin, const spaceskip::Camera& camera, int width,
     int height);
@@ -202,17 +203,19 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::UpdateEngine()
 // The engine's work: whatever the changes left to do (ranges, upload, classification, build),
 // the depth of what is drawn, the frame; then the statistics of the frame.
 void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWindow* renWin,
-  const spaceskip::Camera& camera, int x0, int y0, int width, int height)
+  bool sceneHasDepth, const spaceskip::Camera& camera, int x0, int y0, int width, int height)
 {
   spaceskip::Engine& engine = *this->Engine;
   auto t0 = std::chrono::steady_clock::now();
   engine.update();
   this->UpdateSeconds = SecondsSince(t0);
 
-  // Depth of the opaque geometry already drawn, read from the framebuffer being rendered.
+  // Depth of the opaque geometry already drawn, read from the framebuffer being rendered (not
+  // when the scene has nothing but volumes: the buffer holds the far plane only).
   t0 = std::chrono::steady_clock::now();
-  this->FrameDepth = this->Compositor.ReadDepth(renWin, x0, y0, width, height);
-  if (!this->FrameDepth)
+  this->DepthRead = sceneHasDepth;
+  this->FrameDepth = sceneHasDepth ? this->Compositor.ReadDepth(renWin, x0, y0, width, height) : nullptr;
+  if (sceneHasDepth && !this->FrameDepth)
   {
     this->Warn("could not read the depth buffer: the volume ignores opaque geometry");
   }
@@ -341,6 +344,10 @@ double vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds()
 {
   return this->Internals->DepthSeconds;
 }
+bool vtkSpaceSkippingVolumeMapper::GetLastFrameReadDepth()
+{
+  return this->Internals->DepthRead;
+}
 double vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds()
 {
   return this->Internals->EngineSeconds;
@@ -463,7 +470,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     {
       return;
     }
-    d.RenderFrame(renWin, camera, x0, y0, width, height);
+    d.RenderFrame(renWin, vtkSpaceSkipCompositor::SceneHasDepth(ren), camera, x0, y0, width, height);
     if (!d.Composite(renWin, camera, width, height))
     {
       return;

@@ -250,6 +250,12 @@ public:
   double GetLastEngineRenderSeconds();
   double GetLastKernelSeconds();
   double GetLastCompositeSeconds();
+  /**
+   * Whether the last frame read the window's depth buffer: only when something besides volumes
+   * and 2D actors is visible in the renderer (or it preserves an earlier layer's depth); a scene
+   * of volumes alone skips the readback.
+   */
+  bool GetLastFrameReadDepth();
   double GetLastMapperSeconds();
   ///@}
 

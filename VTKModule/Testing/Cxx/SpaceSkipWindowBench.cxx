@@ -10,6 +10,8 @@
 //       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
 //       [--host-composite (GPUComposite off)] [--blend composite|mip|minip|average|additive]
 //       [--shade (gradient shading, VTK's default headlight and material)]
+//       [--depth-actor (an opaque point actor outside the volume: the mapper reads the window's
+//        depth as with geometry in the scene; without it a volume-only scene skips the readback)]
 // --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
 // headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
 // config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
@@ -32,6 +34,11 @@
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 #include "vtkWindowToImageFilter.h"
+#include "vtkActor.h"
+#include "vtkCellArray.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkPolyDataMapper.h"
 #include "vtk_glew.h"
 
 #include "spaceskip/Generators.h"
@@ -322,7 +329,7 @@ int main(int argc, char* argv[])
     "Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4";
   int n = 256, frames = 16, size = 1024, edits = 4;
   bool vtkGpu = false, egl = false, floatComposite = false, ert = false, hostComposite = false;
-  bool shade = false;
+  bool shade = false, depthActor = false;
   int blend = vtkVolumeMapper::COMPOSITE_BLEND;
   for (int i = 1; i < argc; ++i)
   {
@@ -352,6 +359,8 @@ int main(int argc, char* argv[])
       hostComposite = true;
     else if (a == "--shade")
       shade = true;
+    else if (a == "--depth-actor")
+      depthActor = true;
     else if (a == "--blend")
     {
       const std::string m = next();
@@ -518,6 +527,25 @@ int main(int argc, char* argv[])
   vtkNew<vtkVolume> volume;
   volume->SetProperty(prop);
   ren->AddVolume(volume);
+  if (depthActor)
+  {
+    // One opaque point at a corner of the volume's bounds: a visible non-volume prop, so the
+    // mapper reads the depth buffer (vtkSpaceSkipCompositor::SceneHasDepth).
+    vtkNew<vtkPoints> pts;
+    pts->InsertNextPoint(b[0], b[2], b[4]);
+    vtkNew<vtkCellArray> verts;
+    const vtkIdType id = 0;
+    verts->InsertNextCell(1, &id);
+    vtkNew<vtkPolyData> pd;
+    pd->SetPoints(pts);
+    pd->SetVerts(verts);
+    vtkNew<vtkPolyDataMapper> pm;
+    pm->SetInputData(pd);
+    vtkNew<vtkActor> actor;
+    actor->SetMapper(pm);
+    ren->AddActor(actor);
+    std::printf("depth actor: one opaque point (the mapper reads the window's depth)\n");
+  }
   vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
   mapper->SetInputData(image);
   // The paper's protocol has no early ray termination; --ert turns it on (at 0.99, as VTK's

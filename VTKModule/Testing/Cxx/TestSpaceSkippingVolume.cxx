@@ -17,6 +17,8 @@ int TestSpaceSkippingVolume(int argc, char* argv[])
             << "\n";
   SS_CHECK(mapper->GetBuildCount() == 1 && mapper->GetClassifyCount() == 1);
   SS_CHECK(mapper->GetOccupancy() > 0.0 && mapper->GetOccupancy() < 1.0);
+  // A volume alone: nothing wrote depth before it, so the readback is skipped.
+  SS_CHECK(!mapper->GetLastFrameReadDepth());
   // SPACESKIP_BACKEND=cuda (Testing/gpu/run-gpu-vtk.sh) overrides SetBackendToCPU().
   const char* forced = std::getenv("SPACESKIP_BACKEND");
   const std::string expected = forced && std::string(forced) == "cuda" ? "cuda" : "cpu";
