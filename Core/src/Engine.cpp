@@ -239,10 +239,8 @@ struct Engine::Impl {
   /// with cropping off the cropping planes are left out, so moving them changes nothing.
   CropClip cropClipFor() {
     CropClip c;
-    Volume atOrigin = volume;
-    for (int i = 0; i < 3; ++i) atOrigin.origin[i] = 0;
-    const mat4 indexToWorldRel = atOrigin.indexToWorld();
-    const double* L = indexToWorldRel.m;  // column-major: index axis k is column k
+    const mat4 indexToWorld = volume.indexToWorld();
+    const double* L = indexToWorld.m;  // column-major: index axis k is column k (the origin is column 3)
     if (int(render.clipPlanes.size()) > kMaxClipPlanes)
       warn("more than " + std::to_string(kMaxClipPlanes) + " clipping planes: using the first " +
            std::to_string(kMaxClipPlanes));
