@@ -23,14 +23,17 @@ __global__ void rangeKernel(const T* data, vec3l dims, vec3i bdims, int brick, f
   vmax[i] = hi;
 }
 
-// Launch shape: one thread per brick, 256 per block. Occupancy against the TF; counts occupied
-// bricks (one atomic per block) and flags any difference from the previous occupancy.
-__global__ void classifyKernel(const float* vmin, const float* vmax, int64_t n, OpacityRangeMaxView rmq,
-                               const uint8_t* prev, uint8_t* occ, unsigned long long* occupied, int* changed) {
+// Launch shape: one thread per brick, 256 per block. Occupancy against the TF and the cropping
+// and clipping planes (brickOccupied, as on the CPU); counts occupied bricks (one atomic per
+// block) and flags any difference from the previous occupancy.
+__global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims, int brick, vec3i cellDims,
+                               OpacityRangeMaxView rmq, CropClip cc, const uint8_t* prev, uint8_t* occ,
+                               unsigned long long* occupied, int* changed) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
   int o = 0, diff = 0;
   if (i < n) {
-    o = rmq.query(double(vmin[i]), double(vmax[i])) > 0.f ? 1 : 0;
+    o = brickOccupied(i, vmin[i], vmax[i], rmq, bdims, brick, cellDims, cc) ? 1 : 0;
     occ[i] = uint8_t(o);
     diff = prev ? (prev[i] != o) : 1;
   }
@@ -55,10 +58,13 @@ cudaError_t brickRanges(const void* d_voxels, VoxelType type, vec3l dims, vec3i 
   return cudaPeekAtLastError();
 }
 
-cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, int64_t n, const OpacityRangeMaxView& rmq,
-                           const uint8_t* d_prev, uint8_t* d_occ, ClassifyFlags* d_flags, cudaStream_t stream) {
-  classifyKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_vmin, d_vmax, n, rmq, d_prev, d_occ,
-                                                                  &d_flags->occupied, &d_flags->changed);
+cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims, int brick, vec3i cellDims,
+                           const OpacityRangeMaxView& rmq, const CropClip& cc, const uint8_t* d_prev, uint8_t* d_occ,
+                           ClassifyFlags* d_flags, cudaStream_t stream) {
+  const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
+  classifyKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_vmin, d_vmax, bdims, brick, cellDims, rmq, cc,
+                                                                  d_prev, d_occ, &d_flags->occupied,
+                                                                  &d_flags->changed);
   return cudaPeekAtLastError();
 }
 
@@ -77,7 +83,7 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
                             stream));
 }
 
-bool BrickClassification::classify(const TransferFunction& tf, cudaStream_t stream) {
+bool BrickClassification::classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream) {
   // The sparse table over the TF's (uncorrected) opacity, built as on the CPU, queried on the device.
   const OpacityRangeMax table(tf);
   d_levels_.reserve(table.levels().size());
@@ -90,7 +96,8 @@ bool BrickClassification::classify(const TransferFunction& tf, cudaStream_t stre
   uint8_t* next = d_occ[1 - cur].get();
   d_flags_.reserve(1);
   SS_CUDA_CHECK(cudaMemsetAsync(d_flags_.get(), 0, sizeof(ClassifyFlags), stream));
-  SS_CUDA_CHECK(classifyBricks(d_vmin.get(), d_vmax.get(), numBricks(), rmq, prev, next, d_flags_.get(), stream));
+  SS_CUDA_CHECK(
+      classifyBricks(d_vmin.get(), d_vmax.get(), bdims, brick, cellDims, rmq, cc, prev, next, d_flags_.get(), stream));
   auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
   SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));

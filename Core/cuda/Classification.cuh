@@ -17,10 +17,13 @@ struct ClassifyFlags {
 cudaError_t brickRanges(const void* d_voxels, VoxelType type, vec3l dims, vec3i bdims, int brick, float* d_vmin,
                         float* d_vmax, cudaStream_t stream);
 
-/// d_occ[i] = 1 when brick i's range can have opacity > 0 (rmq.levels on the device); counts
-/// into d_flags and flags any difference from d_prev (nullptr: everything changed).
-cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, int64_t n, const OpacityRangeMaxView& rmq,
-                           const uint8_t* d_prev, uint8_t* d_occ, ClassifyFlags* d_flags, cudaStream_t stream);
+/// d_occ[i] = 1 when brick i of the `bdims` bricks of `brick` cells (of `cellDims`) is occupied
+/// by brickOccupied: its range can have opacity > 0 (rmq.levels on the device) and `cc` leaves
+/// some of it drawn; counts into d_flags and flags any difference from d_prev (nullptr:
+/// everything changed).
+cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims, int brick, vec3i cellDims,
+                           const OpacityRangeMaxView& rmq, const CropClip& cc, const uint8_t* d_prev, uint8_t* d_occ,
+                           ClassifyFlags* d_flags, cudaStream_t stream);
 
 /// The brick grid of the current volume: value ranges (once per volume) and a double-buffered
 /// occupancy (once per opacity edit), with a host copy of the occupancy made on demand.
@@ -30,8 +33,8 @@ class BrickClassification {
 
   /// Sizes the grid for `v` and launches the range kernel on `stream` (no synchronization).
   void setVolume(const DeviceVolume& v, int brick, cudaStream_t stream);
-  /// Classifies against `tf`'s opacity; true when the occupancy changed (or is the first).
-  bool classify(const TransferFunction& tf, cudaStream_t stream);
+  /// Classifies against `tf`'s opacity and `cc`; true when the occupancy changed (or is the first).
+  bool classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream);
   /// The occupancy on the host (downloaded once per classification).
   const OccupancyGrid& occupancy(cudaStream_t stream);
 

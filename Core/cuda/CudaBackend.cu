@@ -37,7 +37,7 @@ class CudaBackend final : public Backend {
     SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
   }
 
-  bool classify(const TransferFunction& tf) override { return cls_.classify(tf, stream_); }
+  bool classify(const TransferFunction& tf, const CropClip& cc) override { return cls_.classify(tf, cc, stream_); }
 
   void setTransferTable(const std::vector<vec4f>& t, float lo, float scale) override {
     exec_.setTransferTable(t, lo, scale, stream_);

@@ -20,8 +20,9 @@ class Backend {
   virtual const char* name() const = 0;
   /// Takes the volume (uploads it on the GPU) and computes the per-brick value ranges.
   virtual void setVolume(const Volume& v, int brick) = 0;
-  /// Re-classifies bricks against the TF opacity; returns true when the occupancy changed.
-  virtual bool classify(const TransferFunction& tf) = 0;
+  /// Re-classifies bricks against the TF opacity and what `cc` leaves drawn (bricks no drawn
+  /// sample can reach are empty); returns true when the occupancy changed.
+  virtual bool classify(const TransferFunction& tf, const CropClip& cc) = 0;
   /// The opacity-corrected table the integrator samples.
   virtual void setTransferTable(const std::vector<vec4f>& corrected, float lo, float scale) = 0;
   /// Builds the hierarchy `p.builder` asks for; throws BackendError when this backend cannot.

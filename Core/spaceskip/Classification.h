@@ -1,6 +1,7 @@
 // Conservative classification: per-brick value ranges (once per volume) and per-brick
 // occupancy (once per opacity edit). See DESIGN.md "Conservative classification".
 #pragma once
+#include "CropClip.h"
 #include "TransferFunction.h"
 #include "Volume.h"
 
@@ -64,7 +65,7 @@ SS_FUNC void brickRange(const T* data, vec3l dims, int brick, int64_t bx, int64_
 /// Parallel (oneTBB) computation of the range grid.
 RangeGrid computeRangeGrid(const Volume& v, int brick = 8);
 
-/// One byte per brick: 1 when some sample inside can have opacity > 0.
+/// One byte per brick: 1 when some sample inside can have opacity > 0 and be drawn.
 struct OccupancyGrid {
   int brick = 8;
   vec3i cellDims{0, 0, 0};
@@ -79,7 +80,19 @@ struct OccupancyGrid {
   double occupancy() const { return size() ? double(occupied) / double(size()) : 0.0; }
 };
 
-/// Re-classifies bricks (never voxels) against the TF's opacity (oneTBB).
-OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf);
+/// Brick `i` (x fastest) of the grid: occupied when its value range can have opacity > 0 under
+/// `rmq` and a drawn sample can lie in it (brickMayBeDrawn). Both backends classify with this.
+template <class RangeMax>
+SS_FUNC bool brickOccupied(int64_t i, float vmin, float vmax, const RangeMax& rmq, vec3i dims, int brick,
+                           vec3i cellDims, const CropClip& cc) {
+  if (!(rmq.query(vmin, vmax) > 0.f)) return false;
+  if (!cc.active()) return true;
+  const vec3i b{int(i % dims.x), int((i / dims.x) % dims.y), int(i / (int64_t(dims.x) * dims.y))};
+  return brickMayBeDrawn(brickCellBox(b, brick, cellDims), cc);
+}
+
+/// Re-classifies bricks (never voxels) against the TF's opacity and what cropping and clipping
+/// leave drawn (oneTBB).
+OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, const CropClip& cc = CropClip{});
 
 }  // namespace spaceskip

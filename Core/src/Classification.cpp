@@ -64,7 +64,7 @@ RangeGrid computeRangeGrid(const Volume& v, int brick) {
   return g;
 }
 
-OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf) {
+OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, const CropClip& cc) {
   OccupancyGrid o;
   o.brick = ranges.brick;
   o.cellDims = ranges.cellDims;
@@ -75,7 +75,8 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf) {
       tbb::blocked_range<int64_t>(0, ranges.size(), 4096), int64_t(0),
       [&](const tbb::blocked_range<int64_t>& r, int64_t acc) {
         for (int64_t i = r.begin(); i != r.end(); ++i) {
-          uint8_t occ = rmq.query(ranges.vmin[size_t(i)], ranges.vmax[size_t(i)]) > 0.f ? 1 : 0;
+          const uint8_t occ = brickOccupied(i, ranges.vmin[size_t(i)], ranges.vmax[size_t(i)], rmq, ranges.dims,
+                                            ranges.brick, ranges.cellDims, cc) ? 1 : 0;
           o.occ[size_t(i)] = occ;
           acc += occ;
         }

@@ -29,8 +29,8 @@ class CpuBackend final : public Backend {
     tree_ = Tree{};
   }
 
-  bool classify(const TransferFunction& tf) override {
-    OccupancyGrid o = spaceskip::classify(ranges_, tf);
+  bool classify(const TransferFunction& tf, const CropClip& cc) override {
+    OccupancyGrid o = spaceskip::classify(ranges_, tf, cc);
     bool changed = o.occ != occ_.occ || o.dims.x != occ_.dims.x || o.dims.y != occ_.dims.y ||
                    o.dims.z != occ_.dims.z;
     occ_ = std::move(o);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <iostream>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <set>
 
@@ -88,6 +89,10 @@ struct Engine::Impl {
   RenderParams render;
 
   bool rangesDirty = true, opacityDirty = true, colorDirty = true, buildDirty = true, tableDirty = true;
+  /// What cropping and clipping leave drawn, in index space: the FrameView's planes and what the
+  /// occupancy was last classified against (a change re-classifies; a camera change does not).
+  CropClip cropClip;
+  bool cropClipDirty = false;
   BuildStats stats;
   FrameStats frame;
   Counters counters;
@@ -230,9 +235,47 @@ struct Engine::Impl {
 
   double dt() const { return effectiveSampleDistance(volume, render.sampleDistance); }
 
+  /// The clipping and cropping planes of `render` in the integrator's index space (in double);
+  /// with cropping off the cropping planes are left out, so moving them changes nothing.
+  CropClip cropClipFor() {
+    CropClip c;
+    const mat4 indexToWorld = volume.indexToWorld();
+    const double* L = indexToWorld.m;  // column-major: index axis k is column k (the origin is column 3)
+    if (int(render.clipPlanes.size()) > kMaxClipPlanes)
+      warn("more than " + std::to_string(kMaxClipPlanes) + " clipping planes: using the first " +
+           std::to_string(kMaxClipPlanes));
+    for (const auto& pl : render.clipPlanes) {
+      if (c.numClipPlanes == kMaxClipPlanes) break;
+      if (!(std::isfinite(pl[0]) && std::isfinite(pl[1]) && std::isfinite(pl[2]) && std::isfinite(pl[3]))) {
+        warn("a clipping plane with a non-finite normal or offset is ignored");
+        continue;
+      }
+      float* p = c.clip[c.numClipPlanes++];
+      for (int k = 0; k < 3; ++k) p[k] = float(pl[0] * L[k * 4] + pl[1] * L[k * 4 + 1] + pl[2] * L[k * 4 + 2]);
+      p[3] = float(pl[0] * volume.origin[0] + pl[1] * volume.origin[1] + pl[2] * volume.origin[2] + pl[3]);
+    }
+    if (render.cropping) {
+      c.cropping = 1;
+      c.cropFlags = render.croppingFlags & 0x7ffffff;
+      for (int a = 0; a < 3; ++a) {
+        double lo = render.croppingPlanes[2 * a], hi = render.croppingPlanes[2 * a + 1];
+        if (lo > hi) std::swap(lo, hi);
+        const double o = volume.origin[a], sp = volume.spacing[a];
+        c.crop[2 * a] = float(std::clamp((lo - o) / sp, -1e30, 1e30));
+        c.crop[2 * a + 1] = float(std::clamp((hi - o) / sp, -1e30, 1e30));
+      }
+    }
+    return c;
+  }
+
   void update() {
     if (!haveVolume) throw std::runtime_error("no volume set");
     if (!haveTF) throw std::runtime_error("no transfer function set");
+    const CropClip cc = cropClipFor();
+    if (cc != cropClip) {
+      cropClip = cc;
+      cropClipDirty = true;
+    }
     if (rangesDirty) {
       backend->setVolume(volume, build.brick);
       ++counters.rangeGrids;
@@ -240,13 +283,13 @@ struct Engine::Impl {
       opacityDirty = true;
       buildDirty = true;
     }
-    if (opacityDirty) {
+    if (opacityDirty || cropClipDirty) {
       auto t0 = Clock::now();
-      bool changed = backend->classify(scaledTF());
+      bool changed = backend->classify(scaledTF(), cropClip);
       stats.classifySeconds = since(t0);
       ++counters.classifications;
-      opacityDirty = false;
-      tableDirty = true;
+      if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
+      opacityDirty = cropClipDirty = false;
       if (changed) buildDirty = true;
       if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
           std::fabs(backend->occupiedFraction() - autoState.occupancy) > kAutoReexplore)
@@ -448,31 +491,13 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.boxHi = vec3f{float(cd.x), float(cd.y), float(cd.z)};
   f.dt = float(d.dt());
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
-  // Clipping planes and cropping planes into the index space of the integrator (in double).
-  const double* L = indexToWorldRel.m;  // column-major: index axis c is column c
-  f.numClipPlanes = 0;
-  if (int(d.render.clipPlanes.size()) > kMaxClipPlanes)
-    d.warn("more than " + std::to_string(kMaxClipPlanes) + " clipping planes: using the first " +
-           std::to_string(kMaxClipPlanes));
-  for (const auto& pl : d.render.clipPlanes) {
-    if (f.numClipPlanes == kMaxClipPlanes) break;
-    if (!(std::isfinite(pl[0]) && std::isfinite(pl[1]) && std::isfinite(pl[2]) && std::isfinite(pl[3]))) {
-      d.warn("a clipping plane with a non-finite normal or offset is ignored");
-      continue;
-    }
-    float* c = f.clip[f.numClipPlanes++];
-    for (int k = 0; k < 3; ++k) c[k] = float(pl[0] * L[k * 4] + pl[1] * L[k * 4 + 1] + pl[2] * L[k * 4 + 2]);
-    c[3] = float(pl[0] * d.volume.origin[0] + pl[1] * d.volume.origin[1] + pl[2] * d.volume.origin[2] + pl[3]);
-  }
-  f.cropping = d.render.cropping ? 1 : 0;
-  f.cropFlags = d.render.croppingFlags & 0x7ffffff;
-  for (int a = 0; a < 3; ++a) {
-    double lo = d.render.croppingPlanes[2 * a], hi = d.render.croppingPlanes[2 * a + 1];
-    if (lo > hi) std::swap(lo, hi);
-    const double o = d.volume.origin[a], sp = d.volume.spacing[a];
-    f.crop[2 * a] = float(std::clamp((lo - o) / sp, -1e30, 1e30));
-    f.crop[2 * a + 1] = float(std::clamp((hi - o) / sp, -1e30, 1e30));
-  }
+  // Clipping and cropping planes in the integrator's index space: the ones classification used.
+  static_assert(sizeof f.clip == sizeof d.cropClip.clip && sizeof f.crop == sizeof d.cropClip.crop);
+  f.numClipPlanes = d.cropClip.numClipPlanes;
+  std::memcpy(f.clip, d.cropClip.clip, sizeof f.clip);
+  f.cropping = d.cropClip.cropping;
+  f.cropFlags = d.cropClip.cropFlags;
+  std::memcpy(f.crop, d.cropClip.crop, sizeof f.crop);
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
   f.firstSample = float(std::max(0.0, d.render.firstSampleOffset));
