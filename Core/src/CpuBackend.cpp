@@ -75,14 +75,7 @@ class CpuBackend final : public Backend {
     out.width = f.width;
     out.height = f.height;
     out.rgba.assign(size_t(f.width) * size_t(f.height), vec4f{0, 0, 0, 0});
-    switch (volume_.type) {
-      case VoxelType::UInt8: run<uint8_t>(f, out); break;
-      case VoxelType::Int8: run<int8_t>(f, out); break;
-      case VoxelType::UInt16: run<uint16_t>(f, out); break;
-      case VoxelType::Int16: run<int16_t>(f, out); break;
-      case VoxelType::Float32: run<float>(f, out); break;
-      case VoxelType::Float64: run<double>(f, out); break;
-    }
+    dispatchVoxelType(volume_.type, [&](auto voxel) { run<decltype(voxel)>(f, out); });
   }
 
   const OccupancyGrid& occupancy() override { return occ_; }

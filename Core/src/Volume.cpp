@@ -96,15 +96,7 @@ double at(const void* d, int64_t i) {
 
 double Volume::value(int64_t i, int64_t j, int64_t k) const {
   int64_t idx = i + dims.x * (j + dims.y * k);
-  switch (type) {
-    case VoxelType::UInt8: return at<uint8_t>(data, idx);
-    case VoxelType::Int8: return at<int8_t>(data, idx);
-    case VoxelType::UInt16: return at<uint16_t>(data, idx);
-    case VoxelType::Int16: return at<int16_t>(data, idx);
-    case VoxelType::Float32: return at<float>(data, idx);
-    case VoxelType::Float64: return at<double>(data, idx);
-  }
-  return 0;
+  return dispatchVoxelType(type, [&](auto voxel) { return at<decltype(voxel)>(data, idx); });
 }
 
 namespace {
@@ -151,15 +143,7 @@ bool finiteRange(const void* data, int64_t n, double& lo, double& hi) {
 
 bool Volume::scalarRange(double& lo, double& hi) const {
   const int64_t n = voxelCount();
-  switch (type) {
-    case VoxelType::UInt8: return finiteRange<uint8_t>(data, n, lo, hi);
-    case VoxelType::Int8: return finiteRange<int8_t>(data, n, lo, hi);
-    case VoxelType::UInt16: return finiteRange<uint16_t>(data, n, lo, hi);
-    case VoxelType::Int16: return finiteRange<int16_t>(data, n, lo, hi);
-    case VoxelType::Float32: return finiteRange<float>(data, n, lo, hi);
-    case VoxelType::Float64: return finiteRange<double>(data, n, lo, hi);
-  }
-  return finiteRange<double>(data, n, lo, hi);
+  return dispatchVoxelType(type, [&](auto voxel) { return finiteRange<decltype(voxel)>(data, n, lo, hi); });
 }
 
 void Volume::allocate(vec3l d, VoxelType t) {

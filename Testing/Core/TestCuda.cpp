@@ -89,12 +89,7 @@ Built run(const Volume& v, const TransferFunction& tf, BuildParams p, BackendKin
 }
 
 BuildParams params(BuilderKind k, LeafCriterion leaf = LeafCriterion::Deep, int mls = 0, int bins = 4) {
-  BuildParams p;
-  p.builder = k;
-  p.leaf = leaf;
-  p.maxLeafSize = mls;
-  p.bins = bins;
-  return p;
+  return test::builder(k, leaf, mls, bins);
 }
 
 std::string describe(const BuildParams& p) {

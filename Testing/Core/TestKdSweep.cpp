@@ -84,13 +84,7 @@ Tree sharedDecisionTree(const OccupancyGrid& g, const BuildParams& p, bool useSv
 }
 
 BuildParams kd(LeafCriterion leaf, int mls, int bins, int brick) {
-  BuildParams p;
-  p.builder = BuilderKind::KdTreeCPU;
-  p.leaf = leaf;
-  p.maxLeafSize = mls;
-  p.bins = bins;
-  p.brick = brick;
-  return p;
+  return test::builder(BuilderKind::KdTreeCPU, leaf, mls, bins, brick);
 }
 
 std::string describe(const BuildParams& p) {

@@ -38,9 +38,14 @@ inline Image renderWith(const Volume& v, const TransferFunction& tf, BuildParams
   return img;
 }
 
-inline BuildParams builder(BuilderKind k) {
+inline BuildParams builder(BuilderKind k, LeafCriterion leaf = LeafCriterion::Deep, int mls = 0, int bins = 4,
+                           int brick = 8) {
   BuildParams p;
   p.builder = k;
+  p.leaf = leaf;
+  p.maxLeafSize = mls;
+  p.bins = bins;
+  p.brick = brick;
   return p;
 }
 
