@@ -491,13 +491,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.boxHi = vec3f{float(cd.x), float(cd.y), float(cd.z)};
   f.dt = float(d.dt());
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
-  // Clipping and cropping planes in the integrator's index space: the ones classification used.
-  static_assert(sizeof f.clip == sizeof d.cropClip.clip && sizeof f.crop == sizeof d.cropClip.crop);
-  f.numClipPlanes = d.cropClip.numClipPlanes;
-  std::memcpy(f.clip, d.cropClip.clip, sizeof f.clip);
-  f.cropping = d.cropClip.cropping;
-  f.cropFlags = d.cropClip.cropFlags;
-  std::memcpy(f.crop, d.cropClip.crop, sizeof f.crop);
+  f.cut = d.cropClip;  // the planes classification used
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
   f.firstSample = float(std::max(0.0, d.render.firstSampleOffset));

@@ -1,6 +1,7 @@
 // What both executors read per frame: plain data only (no virtuals, no STL), host pointers on
 // the oneTBB backend and device pointers on CUDA, filled once per frame by the backend.
 #pragma once
+#include "../CropClip.h"
 #include "../Math.h"
 #include "../TransferFunction.h"
 #include "../Tree.h"
@@ -52,11 +53,7 @@ struct FrameView {
   TreeView tree;           ///< Tree and Hybrid
   TransferFunctionView tf;
   unsigned* sampleCount;   ///< optional per-pixel count of samples taken (statistics)
-  int numClipPlanes;       ///< index-space half-spaces n.p + d >= 0 kept (convex: one interval)
-  float clip[6][4];
-  int cropping;            ///< 1: only regions of cropFlags between the planes are drawn
-  int cropFlags;           ///< bit i + 3j + 9k: region (i, j, k) of the 3x3x3 split is drawn
-  float crop[6];           ///< index-space planes x0, x1, y0, y1, z0, z1
+  CropClip cut;            ///< clipping and cropping planes: the ones classification used
   // Blend mode and shading (vtkVolumeMapper / vtkVolumeProperty semantics).
   BlendMode blend;
   float normLo, normScale;  ///< additive/average: normalised scalar = (v - normLo) * normScale

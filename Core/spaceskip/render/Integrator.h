@@ -294,13 +294,13 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
     return true;
   };
   float a = tEnter, b = tExit;
-  if (f.numClipPlanes == 0 || clipToPlanes(f, r, a, b)) {
-    if (f.cropping) {
+  if (f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {
+    if (f.cut.cropping) {
       // VTK starts cropped rays on the face of the first drawn region itself, not one step in
       // (measured against vtkGPUVolumeRayCastMapper: sub-volume 43.5 dB this way, 38.9 dB one
       // step in, 40.7 dB on the box's lattice).
       lead -= f.firstSample * f.dt;
-      forEachCroppedInterval(f, r, a, b, march);
+      forEachCroppedInterval(f.cut, r, a, b, march);
     } else if (f.firstSample > 0.f && !(a + lead < b)) {
       // Starting one or more steps in, the ray may leave the box before its first sample: that
       // sample is still taken (clamped to the box), as vtkGPUVolumeRayCastMapper does; every

@@ -62,9 +62,9 @@ SS_FUNC PrimaryRay primaryRay(const FrameView& f, int px, int py) {
 }
 
 /// Clips [tmin, tmax] to the convex intersection of the clipping half-spaces; false if empty.
-SS_FUNC bool clipToPlanes(const FrameView& f, const Ray& r, float& tmin, float& tmax) {
-  for (int i = 0; i < f.numClipPlanes; ++i) {
-    const float* c = f.clip[i];
+SS_FUNC bool clipToPlanes(const CropClip& cc, const Ray& r, float& tmin, float& tmax) {
+  for (int i = 0; i < cc.numClipPlanes; ++i) {
+    const float* c = cc.clip[i];
     const float num = c[0] * r.org.x + c[1] * r.org.y + c[2] * r.org.z + c[3];
     const float den = c[0] * r.dir.x + c[1] * r.dir.y + c[2] * r.dir.z;
     if (den == 0.f) {
@@ -84,7 +84,7 @@ SS_FUNC int cropSlab(float x, float lo, float hi) { return x < lo ? 0 : (x < hi 
 /// Calls march(a, b) for each part of [tmin, tmax] that lies in a drawn cropping region, front
 /// to back: the six planes split the ray into at most seven pieces, each inside one region.
 template <class March>
-SS_FUNC void forEachCroppedInterval(const FrameView& f, const Ray& r, float tmin, float tmax, March&& march) {
+SS_FUNC void forEachCroppedInterval(const CropClip& cc, const Ray& r, float tmin, float tmax, March&& march) {
   float ts[8];
   int n = 0;
   ts[n++] = tmin;
@@ -92,7 +92,7 @@ SS_FUNC void forEachCroppedInterval(const FrameView& f, const Ray& r, float tmin
     const float o = a < 2 ? r.org.x : (a < 4 ? r.org.y : r.org.z);
     const float d = a < 2 ? r.dir.x : (a < 4 ? r.dir.y : r.dir.z);
     if (d == 0.f) continue;
-    const float t = (f.crop[a] - o) / d;
+    const float t = (cc.crop[a] - o) / d;
     if (t > tmin && t < tmax) ts[n++] = t;
   }
   ts[n++] = tmax;
@@ -107,9 +107,9 @@ SS_FUNC void forEachCroppedInterval(const FrameView& f, const Ray& r, float tmin
     if (!(a < b)) continue;
     const float tm = 0.5f * (a + b);
     const vec3f p = r.org + r.dir * tm;
-    const int region = cropSlab(p.x, f.crop[0], f.crop[1]) + 3 * cropSlab(p.y, f.crop[2], f.crop[3]) +
-                       9 * cropSlab(p.z, f.crop[4], f.crop[5]);
-    if ((f.cropFlags >> region) & 1)
+    const int region = cropSlab(p.x, cc.crop[0], cc.crop[1]) + 3 * cropSlab(p.y, cc.crop[2], cc.crop[3]) +
+                       9 * cropSlab(p.z, cc.crop[4], cc.crop[5]);
+    if ((cc.cropFlags >> region) & 1)
       if (!march(a, b)) return;
   }
 }
