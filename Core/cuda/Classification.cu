@@ -11,14 +11,14 @@ namespace {
 constexpr int kThreads = 256;
 
 // Launch shape: one thread per brick, 256 per block. brickRange over the brick's voxels.
-template <class T>
+template <class T, int NC>
 __global__ void rangeKernel(const T* data, vec3l dims, vec3i bdims, int brick, float* vmin, float* vmax) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   const int64_t nb = int64_t(bdims.x) * bdims.y * bdims.z;
   if (i >= nb) return;
   const int64_t bx = i % bdims.x, by = (i / bdims.x) % bdims.y, bz = i / (int64_t(bdims.x) * bdims.y);
   float lo, hi;
-  brickRange(data, dims, brick, bx, by, bz, lo, hi);
+  brickRange<T, NC>(data, dims, brick, bx, by, bz, lo, hi);
   vmin[i] = lo;
   vmax[i] = hi;
 }
@@ -47,13 +47,15 @@ __global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims
 
 }  // namespace
 
-cudaError_t brickRanges(const void* d_voxels, VoxelType type, vec3l dims, vec3i bdims, int brick, float* d_vmin,
-                        float* d_vmax, cudaStream_t stream) {
+cudaError_t brickRanges(const void* d_voxels, VoxelType type, int components, vec3l dims, vec3i bdims, int brick,
+                        float* d_vmin, float* d_vmax, cudaStream_t stream) {
   const int64_t nb = int64_t(bdims.x) * bdims.y * bdims.z;
   dispatchVoxelType(type, [&](auto t) {
     using T = decltype(t);
-    rangeKernel<T><<<blocksFor(nb, kThreads), kThreads, 0, stream>>>(
-        static_cast<const T*>(d_voxels), dims, bdims, brick, d_vmin, d_vmax);
+    dispatchComponents(components, [&](auto nc) {
+      rangeKernel<T, decltype(nc)::value><<<blocksFor(nb, kThreads), kThreads, 0, stream>>>(
+          static_cast<const T*>(d_voxels), dims, bdims, brick, d_vmin, d_vmax);
+    });
   });
   return cudaPeekAtLastError();
 }
@@ -79,7 +81,7 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
   d_vmax.reserve(nb);
   d_occ[0].reserve(nb);
   d_occ[1].reserve(nb);
-  SS_CUDA_CHECK(brickRanges(v.d_voxels<unsigned char>(), vol.type, vol.dims, bdims, brick, d_vmin.get(), d_vmax.get(),
+  SS_CUDA_CHECK(brickRanges(v.d_voxels<unsigned char>(), vol.type, vol.components, vol.dims, bdims, brick, d_vmin.get(), d_vmax.get(),
                             stream));
 }
 

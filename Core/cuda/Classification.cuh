@@ -13,9 +13,10 @@ struct ClassifyFlags {
 };
 
 /// d_vmin/d_vmax[i] = brickRange of brick i (x fastest) of the `bdims` bricks of `brick` cells
-/// over the `type` voxels at d_voxels.
-cudaError_t brickRanges(const void* d_voxels, VoxelType type, vec3l dims, vec3i bdims, int brick, float* d_vmin,
-                        float* d_vmax, cudaStream_t stream);
+/// over the `type` voxels at d_voxels (of the opacity channel, the last of `components`
+/// interleaved ones).
+cudaError_t brickRanges(const void* d_voxels, VoxelType type, int components, vec3l dims, vec3i bdims, int brick,
+                        float* d_vmin, float* d_vmax, cudaStream_t stream);
 
 /// d_occ[i] = 1 when brick i of the `bdims` bricks of `brick` cells (of `cellDims`) is occupied
 /// by brickOccupied: its range can have opacity > 0 (rmq.levels on the device) and `cc` leaves

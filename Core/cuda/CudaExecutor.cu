@@ -72,13 +72,19 @@ using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigne
 
 template <class Sampler>
 RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
-  switch (t) {
-    case TraversalKind::Naive: return renderKernel<Sampler, int(TraversalKind::Naive)>;
-    case TraversalKind::Grid: return renderKernel<Sampler, int(TraversalKind::Grid)>;
-    case TraversalKind::Tree: return renderKernel<Sampler, int(TraversalKind::Tree)>;
-    case TraversalKind::Hybrid: return renderKernel<Sampler, int(TraversalKind::Hybrid)>;
+  // Dependent components: one kernel reading the traversal from the frame (a rare mode: six
+  // voxel types times four traversals more would double this file's compile time).
+  if constexpr (IsChannelSampler<Sampler>::value) {
+    return renderKernel<Sampler, -1>;
+  } else {
+    switch (t) {
+      case TraversalKind::Naive: return renderKernel<Sampler, int(TraversalKind::Naive)>;
+      case TraversalKind::Grid: return renderKernel<Sampler, int(TraversalKind::Grid)>;
+      case TraversalKind::Tree: return renderKernel<Sampler, int(TraversalKind::Tree)>;
+      case TraversalKind::Hybrid: return renderKernel<Sampler, int(TraversalKind::Hybrid)>;
+    }
+    return renderKernel<Sampler, int(TraversalKind::Naive)>;
   }
-  return renderKernel<Sampler, int(TraversalKind::Naive)>;
 }
 
 bool validBlock(const LaunchParams& p) {
@@ -138,11 +144,17 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   const dim3 block(bx, by);
   const dim3 grid(unsigned((f.width + bx - 1) / bx), unsigned((f.height + by - 1) / by));
   SS_CUDA_CHECK(cudaEventRecord(ev0_, stream));
-  if (filter == FilterMode::Hardware) {
+  const Volume& v = vol.volume();
+  if (v.components > 1) {  // dependent components (render/Components.h): exact sampling only
+    dispatchVoxelType(v.type, [&](auto t) {
+      using T = decltype(t);
+      launch(f, ChannelSampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z, v.components}, grid, block, 0,
+             stream);
+    });
+  } else if (filter == FilterMode::Hardware) {
     const TextureSampler s = vol.texture(stream);
     launch(f, s, grid, block, vol.textureBytes(), stream);
   } else {
-    const Volume& v = vol.volume();
     dispatchVoxelType(v.type, [&](auto t) {
       using T = decltype(t);
       launch(f, ArraySampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z}, grid, block, 0, stream);

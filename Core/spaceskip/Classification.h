@@ -6,11 +6,13 @@
 #include "Volume.h"
 
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace spaceskip {
 
-/// Min/max of the voxels a trilinear sample inside each brick of `brick`^3 cells can touch:
+/// Min/max of the voxels a trilinear sample inside each brick of `brick`^3 cells can touch
+/// (of the opacity channel with dependent components, which alone decides what is empty):
 /// cells [b*B, (b+1)*B) use voxels [b*B, (b+1)*B] (the +1 halo). NaN voxels are skipped
 /// (a sample touching one is NaN, which the integrator treats as transparent).
 struct RangeGrid {
@@ -32,12 +34,14 @@ SS_FUNC void brickVoxelSpan(int64_t b, int brick, int64_t n, int64_t& v0, int64_
   v1 = v0 + brick < n - 1 ? v0 + brick : n - 1;
 }
 
-/// Folds voxels line[x0..x1] into [lo, hi], skipping NaN.
-template <class T>
+/// Folds voxels line[x0..x1] into [lo, hi], skipping NaN. `NC` > 1: interleaved tuples of NC
+/// components, `line` already points at the wanted component (dependent components: the opacity
+/// channel), so voxel x is line[x * NC].
+template <class T, int NC = 1>
 SS_FUNC void foldRange(const T* line, int64_t x0, int64_t x1, float& lo, float& hi) {
   float l = lo, h = hi;
   for (int64_t x = x0; x <= x1; ++x) {
-    const float v = float(line[x]);
+    const float v = float(line[x * NC]);
     if (v != v) continue;  // NaN
     l = v < l ? v : l;
     h = v > h ? v : h;
@@ -49,7 +53,8 @@ SS_FUNC void foldRange(const T* line, int64_t x0, int64_t x1, float& lo, float& 
 /// RangeGrid's rule for brick (bx, by, bz) of a volume of `dims` voxels at `data`: min/max over
 /// its voxels with the +1 halo, NaN skipped; (+inf, -inf) when all are NaN. One CUDA thread per
 /// brick runs it as it is; the oneTBB twin folds the same spans in line order, one pass per row.
-template <class T>
+/// `NC` > 1: tuples of NC components, the last (the opacity channel) is the one ranged.
+template <class T, int NC = 1>
 SS_FUNC void brickRange(const T* data, vec3l dims, int brick, int64_t bx, int64_t by, int64_t bz, float& lo,
                         float& hi) {
   int64_t x0, x1, y0, y1, z0, z1;
@@ -59,7 +64,19 @@ SS_FUNC void brickRange(const T* data, vec3l dims, int brick, int64_t bx, int64_
   lo = INFINITY;
   hi = -INFINITY;
   for (int64_t z = z0; z <= z1; ++z)
-    for (int64_t y = y0; y <= y1; ++y) foldRange(data + dims.x * (y + dims.y * z), x0, x1, lo, hi);
+    for (int64_t y = y0; y <= y1; ++y)
+      foldRange<T, NC>(data + (dims.x * (y + dims.y * z)) * NC + (NC - 1), x0, x1, lo, hi);
+}
+
+/// Calls f(std::integral_constant<int, NC>()) for a volume's component count (1, 2 or 4).
+template <class F>
+decltype(auto) dispatchComponents(int components, F&& f) {
+  switch (components) {
+    case 2: return f(std::integral_constant<int, 2>());
+    case 4: return f(std::integral_constant<int, 4>());
+    default: break;
+  }
+  return f(std::integral_constant<int, 1>());
 }
 
 /// Parallel (oneTBB) computation of the range grid.

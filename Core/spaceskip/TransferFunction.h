@@ -30,6 +30,13 @@ struct TransferFunction {
   std::vector<vec4f> table;
   double rangeMin = 0, rangeMax = 1;
   double unitDistance = 1;
+  /// Dependent components (Volume::components 2 or 4): the alpha entries span
+  /// [opacityRangeMin, opacityRangeMax] of the opacity channel instead of [rangeMin, rangeMax]
+  /// (vtkGPUVolumeRayCastMapper builds the opacity table over that component's range).
+  bool ownOpacityRange = false;
+  double opacityRangeMin = 0, opacityRangeMax = 1;
+  double alphaMin() const { return ownOpacityRange ? opacityRangeMin : rangeMin; }
+  double alphaMax() const { return ownOpacityRange ? opacityRangeMax : rangeMax; }
 
   /// Piecewise-linear table of `size` entries through the points (sorted by value).
   static TransferFunction fromPoints(std::vector<TFPoint> pts, double lo, double hi, int size = 1024);

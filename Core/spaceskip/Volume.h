@@ -34,6 +34,10 @@ decltype(auto) dispatchVoxelType(VoxelType t, F&& f) {
 
 /// Host volume. Either owns its voxels (`storage`) or borrows a caller's buffer (`data`).
 /// Voxel (i,j,k) lives at i + dims.x*(j + dims.y*k) with 64-bit arithmetic.
+/// With `components` > 1 the voxels are interleaved tuples (component c of voxel n at
+/// n*components + c) rendered as vtkVolumeProperty's dependent components
+/// (IndependentComponentsOff): 2 = colour value + opacity value, 4 = RGB + opacity value; the
+/// last component is always the one opacity (and so classification) reads.
 struct Volume {
   vec3l dims{0, 0, 0};
   VoxelType type = VoxelType::UInt8;
@@ -43,9 +47,12 @@ struct Volume {
   double direction[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
   const void* data = nullptr;
   std::shared_ptr<std::vector<unsigned char>> storage;
+  int components = 1;  ///< 1, 2 or 4 (see above; validate() refuses others)
 
   int64_t voxelCount() const { return dims.x * dims.y * dims.z; }
-  size_t byteSize() const { return size_t(voxelCount()) * voxelSize(type); }
+  size_t byteSize() const { return size_t(voxelCount()) * size_t(components) * voxelSize(type); }
+  /// The component opacity and classification read: the last one.
+  int opacityComponent() const { return components - 1; }
   /// Number of cells per axis. An axis of one voxel gets one cell of constant value, so that
   /// 1xNxM volumes render as a slab one spacing thick instead of vanishing.
   vec3i cellDims() const;
@@ -55,15 +62,19 @@ struct Volume {
   void worldBounds(double bounds[6]) const;
   double value(int64_t i, int64_t j, int64_t k) const;
   /// Finite min/max of the voxels (NaN and +-Inf skipped); false if no finite voxel exists.
+  /// With several components: over all of them.
   bool scalarRange(double& lo, double& hi) const;
+  /// The same over component `c` only.
+  bool componentRange(int c, double& lo, double& hi) const;
   /// Allocates owned storage of dims*voxelSize bytes (zeroed). Throws std::runtime_error when a
   /// dimension is not positive or the byte count overflows 64 bits (see checkedByteSize).
-  void allocate(vec3l d, VoxelType t);
+  void allocate(vec3l d, VoxelType t, int components = 1);
   unsigned char* mutableData() { return storage ? storage->data() : nullptr; }
 };
 
 /// Throws std::runtime_error on bad dims (non-positive, > 2^30 voxels per axis, or a voxel or
-/// byte count that overflows 64 bits), missing data, or non-positive/non-finite spacing.
+/// byte count that overflows 64 bits), missing data, non-positive/non-finite spacing, or a
+/// component count other than 1, 2 or 4.
 void validate(const Volume& v);
 
 /// Largest axis length any volume may have (cell indices are 32-bit in the traversals).

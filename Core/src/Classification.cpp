@@ -14,7 +14,7 @@ namespace spaceskip {
 namespace {
 box3i brickBoxOf(vec3i cellDims, int brick, int x, int y, int z) { return brickCellBox(vec3i{x, y, z}, brick, cellDims); }
 
-template <class T>
+template <class T, int NC>
 void rangesOf(const Volume& v, RangeGrid& g) {
   const T* data = static_cast<const T*>(v.data);
   const int64_t nx = v.dims.x, ny = v.dims.y, nz = v.dims.z;
@@ -32,11 +32,11 @@ void rangesOf(const Volume& v, RangeGrid& g) {
       brickVoxelSpan(bz, g.brick, nz, z0, z1);
       for (int64_t z = z0; z <= z1; ++z)
         for (int64_t y = y0; y <= y1; ++y) {
-          const T* line = data + nx * (y + ny * z);
+          const T* line = data + (nx * (y + ny * z)) * NC + (NC - 1);  // the opacity channel
           for (int bx = 0; bx < g.dims.x; ++bx) {
             int64_t x0, x1;
             brickVoxelSpan(bx, g.brick, nx, x0, x1);
-            foldRange(line, x0, x1, lo[size_t(bx)], hi[size_t(bx)]);
+            foldRange<T, NC>(line, x0, x1, lo[size_t(bx)], hi[size_t(bx)]);
           }
         }
       for (int bx = 0; bx < g.dims.x; ++bx) {
@@ -60,7 +60,9 @@ RangeGrid computeRangeGrid(const Volume& v, int brick) {
                  (g.cellDims.z + g.brick - 1) / g.brick};
   g.vmin.resize(size_t(g.size()));
   g.vmax.resize(size_t(g.size()));
-  dispatchVoxelType(v.type, [&](auto t) { rangesOf<decltype(t)>(v, g); });
+  dispatchVoxelType(v.type, [&](auto t) {
+    dispatchComponents(v.components, [&](auto nc) { rangesOf<decltype(t), decltype(nc)::value>(v, g); });
+  });
   return g;
 }
 

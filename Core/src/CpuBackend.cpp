@@ -84,7 +84,16 @@ class CpuBackend final : public Backend {
  private:
   template <class T>
   void run(const FrameView& f, Image& out) {
-    ArraySampler<T> s{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y, volume_.dims.z};
+    if (volume_.components > 1) {  // dependent components (render/Components.h)
+      tiles(f, out, ChannelSampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y,
+                                      volume_.dims.z, volume_.components});
+      return;
+    }
+    tiles(f, out, ArraySampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y, volume_.dims.z});
+  }
+
+  template <class Sampler>
+  void tiles(const FrameView& f, Image& out, const Sampler& s) {
     vec4f* px = out.rgba.data();
     tbb::parallel_for(tbb::blocked_range2d<int>(0, f.height, kTile, 0, f.width, kTile),
                       [&](const tbb::blocked_range2d<int>& r) {

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <limits>
 #include <set>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -225,11 +226,32 @@ struct Engine::Impl {
     autoState = AutoState{};
   }
 
+  /// 4 dependent components: the colour channels' finite ranges (of the sampled values).
+  double rgbRange[3][2] = {{0, 1}, {0, 1}, {0, 1}};
+  void componentRanges() {
+    if (volume.components != 4) return;
+    for (int c = 0; c < 3; ++c)
+      if (!volume.componentRange(c, rgbRange[c][0], rgbRange[c][1])) rgbRange[c][0] = 0, rgbRange[c][1] = 1;
+  }
+
+  /// Dependent components composite (the only mode vtkGPUVolumeRayCastMapper defines colour and
+  /// opacity for from several components): other blend modes are drawn composite, with a warning.
+  BlendMode blendMode() {
+    if (volume.components > 1 && render.blend != BlendMode::Composite) {
+      warn("blend mode " + std::to_string(int(render.blend)) + " with " + std::to_string(volume.components) +
+           " dependent components is not supported: drawn as composite");
+      return BlendMode::Composite;
+    }
+    return render.blend;
+  }
+
   TransferFunction scaledTF() const {
     if (valueExponent == 0) return tf;
     TransferFunction t = tf;
     t.rangeMin = std::ldexp(t.rangeMin, valueExponent);
     t.rangeMax = std::ldexp(t.rangeMax, valueExponent);
+    t.opacityRangeMin = std::ldexp(t.opacityRangeMin, valueExponent);
+    t.opacityRangeMax = std::ldexp(t.opacityRangeMax, valueExponent);
     return t;
   }
 
@@ -303,7 +325,7 @@ struct Engine::Impl {
       if (!note.empty()) warn(note);
       float lo, scale;
       tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
-      backend->setTransferTable(tableForBlend(tf, float(step), render.blend), lo, scale);
+      backend->setTransferTable(tableForBlend(tf, float(step), blendMode()), lo, scale);
       tableDirty = colorDirty = false;
     }
     if (buildDirty) {
@@ -361,7 +383,7 @@ void Engine::setVolume(const Volume& v) {
   // float copy scaled by an exact power of two; the TF range is scaled alike, so the image is
   // the one of the unscaled data. NaN stays NaN and +-Inf stays +-Inf in the copy.
   if (v.type == VoxelType::Float32 || v.type == VoxelType::Float64) {
-    const int64_t n = v.voxelCount();
+    const int64_t n = v.voxelCount() * v.components;
     double lo = 0, hi = 0;  // the parallel finite range pass (NaN and +-Inf skipped)
     const double m = v.scalarRange(lo, hi) ? std::max(std::fabs(lo), std::fabs(hi)) : 0.0;
     if (m > 0 && (m > 0x1p60 || m < 0x1p-60)) {
@@ -378,6 +400,7 @@ void Engine::setVolume(const Volume& v) {
       impl_->valueExponent = -e;
     }
   }
+  impl_->componentRanges();
   impl_->haveVolume = true;
   impl_->rangesDirty = true;
   impl_->tableDirty = true;  // the default sample distance follows the spacing
@@ -430,7 +453,7 @@ namespace {
 template <class Impl>
 void fillBlend(Impl& d, FrameView& f) {
   const RenderParams& r = d.render;
-  f.blend = r.blend;
+  f.blend = d.blendMode();
   // Scalar values in the frame are in the sampled units: times 2^valueExponent (setVolume).
   auto scaled = [&](double v) { return std::ldexp(v, d.valueExponent); };
   double lo = r.scalarRange[0], hi = r.scalarRange[1];
@@ -459,6 +482,34 @@ void fillBlend(Impl& d, FrameView& f) {
   f.specular = float(r.specular);
   f.specularPower = float(r.specularPower);
   f.lightDir = vec3f{float(r.lightDirection[0]), float(r.lightDirection[1]), float(r.lightDirection[2])};
+}
+
+/// Dependent components (render/Components.h): the opacity channel's table mapping, the direct
+/// colour channels' normalisation and the component shading differentiates.
+template <class Impl>
+void fillComponents(Impl& d, FrameView& f) {
+  const Volume& v = d.volume;
+  TransferFunction alpha = d.scaledTF();
+  alpha.rangeMin = alpha.alphaMin();
+  alpha.rangeMax = alpha.alphaMax();
+  tableMapping(alpha, static_cast<int>(d.tf.table.size()), f.alphaLo, f.alphaScale);
+  // vtkVolumeTexture::GetScaleAndBias maps the texture's normalised value (v / max for integer
+  // types) with a range scaled by 1 / (max + 1) (unsigned) or 2 / (2 max + 2) (signed): colour
+  // = (v k - lo) / (hi - lo) with k = (max + 1) / max; 1 for floating types.
+  const double k = dispatchVoxelType(v.type, [](auto t) -> double {
+    using T = decltype(t);
+    if constexpr (std::is_integral_v<T>) return (double(std::numeric_limits<T>::max()) + 1.0) / double(std::numeric_limits<T>::max());
+    else return 1.0;
+  });
+  for (int c = 0; c < 3; ++c) {
+    const double lo = d.rgbRange[c][0], hi = d.rgbRange[c][1];
+    f.rgbLo[c] = float(lo / k);
+    f.rgbScale[c] = hi > lo ? float(k / (hi - lo)) : 0.f;
+  }
+  // vtkVolumeShaderComposer: computeLighting(color, 0) for 2 components, (color, 3) for 4.
+  f.gradientComponent = v.components == 4 ? 3 : 0;
+  if (v.components > 1 && d.render.filter == FilterMode::Hardware)
+    d.warn("hardware filtering with dependent components: sampling exactly");
 }
 }  // namespace
 
@@ -501,6 +552,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.eyeW = vec3f{float(iv.m[12] - d.volume.origin[0]), float(iv.m[13] - d.volume.origin[1]),
                  float(iv.m[14] - d.volume.origin[2])};
   fillBlend(d, f);
+  fillComponents(d, f);
   std::vector<unsigned> counts;
   if (d.render.countSamples) {
     counts.assign(size_t(width) * size_t(height), 0u);

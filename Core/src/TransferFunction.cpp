@@ -75,7 +75,7 @@ TransferFunction TransferFunction::load(const std::string& path, double lo, doub
 }
 
 bool TransferFunction::sameOpacity(const TransferFunction& o) const {
-  if (table.size() != o.table.size() || rangeMin != o.rangeMin || rangeMax != o.rangeMax ||
+  if (table.size() != o.table.size() || alphaMin() != o.alphaMin() || alphaMax() != o.alphaMax() ||
       unitDistance != o.unitDistance)
     return false;
   for (size_t i = 0; i < table.size(); ++i)
@@ -110,8 +110,10 @@ OpacityRangeMax::OpacityRangeMax(const TransferFunction& tf) {
   if (tf.table.empty()) throw std::invalid_argument("empty transfer-function table");
   const int size = int(tf.table.size());
   view_.size = size;
-  view_.lo = tf.rangeMin;
-  view_.scale = tf.rangeMax > tf.rangeMin ? double(size - 1) / (tf.rangeMax - tf.rangeMin) : 0.0;
+  // Over the alpha entries' own range (dependent components: the opacity channel's).
+  const double lo = tf.alphaMin(), hi = tf.alphaMax();
+  view_.lo = lo;
+  view_.scale = hi > lo ? double(size - 1) / (hi - lo) : 0.0;
   // Level k (entries i..i+2^k-1) at offset[k]: the max of two entries of level k-1.
   size_t total = 0;
   int levels = 0;

@@ -95,7 +95,7 @@ double at(const void* d, int64_t i) {
 }  // namespace
 
 double Volume::value(int64_t i, int64_t j, int64_t k) const {
-  int64_t idx = i + dims.x * (j + dims.y * k);
+  const int64_t idx = (i + dims.x * (j + dims.y * k)) * components + opacityComponent();
   return dispatchVoxelType(type, [&](auto voxel) { return at<decltype(voxel)>(data, idx); });
 }
 
@@ -106,25 +106,33 @@ constexpr int64_t kRangeGrain = int64_t(1) << 20;
 
 // Finite min/max of n voxels of type T, oneTBB parallel (a 2048^3 uint8 volume is 8 Gi voxels:
 // the serial per-voxel switch took tens of seconds there).
+// Values p[i * stride] for i < n (stride: the component count when one component is wanted).
 template <class T>
-bool finiteRange(const void* data, int64_t n, double& lo, double& hi) {
+bool finiteRange(const void* data, int64_t n, double& lo, double& hi, int64_t stride = 1) {
   const T* p = static_cast<const T*>(data);
   using MinMax = std::pair<double, double>;
   const MinMax empty{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   const MinMax r = tbb::parallel_reduce(
       tbb::blocked_range<int64_t>(0, n, kRangeGrain), empty,
-      [p](const tbb::blocked_range<int64_t>& br, MinMax acc) {
+      [p, stride](const tbb::blocked_range<int64_t>& br, MinMax acc) {
         if constexpr (std::is_integral_v<T>) {
           T mn = std::numeric_limits<T>::max(), mx = std::numeric_limits<T>::lowest();
-          for (int64_t i = br.begin(); i < br.end(); ++i) {
-            mn = std::min(mn, p[i]);
-            mx = std::max(mx, p[i]);
+          if (stride == 1) {
+            for (int64_t i = br.begin(); i < br.end(); ++i) {
+              mn = std::min(mn, p[i]);
+              mx = std::max(mx, p[i]);
+            }
+          } else {
+            for (int64_t i = br.begin(); i < br.end(); ++i) {
+              mn = std::min(mn, p[i * stride]);
+              mx = std::max(mx, p[i * stride]);
+            }
           }
           acc.first = std::min(acc.first, double(mn));
           acc.second = std::max(acc.second, double(mx));
         } else {
           for (int64_t i = br.begin(); i < br.end(); ++i) {
-            const double v = double(p[i]);
+            const double v = double(p[i * stride]);
             if (!std::isfinite(v)) continue;
             acc.first = std::min(acc.first, v);
             acc.second = std::max(acc.second, v);
@@ -142,14 +150,29 @@ bool finiteRange(const void* data, int64_t n, double& lo, double& hi) {
 }  // namespace
 
 bool Volume::scalarRange(double& lo, double& hi) const {
-  const int64_t n = voxelCount();
+  const int64_t n = voxelCount() * components;
   return dispatchVoxelType(type, [&](auto voxel) { return finiteRange<decltype(voxel)>(data, n, lo, hi); });
 }
 
-void Volume::allocate(vec3l d, VoxelType t) {
+bool Volume::componentRange(int c, double& lo, double& hi) const {
+  if (c < 0 || c >= components) throw std::out_of_range("component " + std::to_string(c) + " of a volume of " +
+                                                        std::to_string(components));
+  const int64_t n = voxelCount();
+  return dispatchVoxelType(type, [&](auto voxel) {
+    using T = decltype(voxel);
+    return finiteRange<T>(static_cast<const T*>(data) + c, n, lo, hi, components);
+  });
+}
+
+void Volume::allocate(vec3l d, VoxelType t, int nc) {
+  if (nc != 1 && nc != 2 && nc != 4)
+    throw std::runtime_error("volume: " + std::to_string(nc) + " components (1, 2 or 4 are supported)");
   // Checked first: a wrapped product would allocate a small buffer that later reads overrun.
   const uint64_t bytes = checkedByteSize(d, t, std::numeric_limits<uint64_t>::max(), "volume");
-  auto buf = std::make_shared<std::vector<unsigned char>>(size_t(bytes));
+  if (bytes > std::numeric_limits<uint64_t>::max() / uint64_t(nc))
+    throw std::runtime_error("volume: byte count overflows 64 bits");
+  auto buf = std::make_shared<std::vector<unsigned char>>(size_t(bytes * uint64_t(nc)));
+  components = nc;
   dims = d;
   type = t;
   storage = std::move(buf);
@@ -199,6 +222,9 @@ uint64_t checkedByteSize(vec3l d, VoxelType t, uint64_t maxBytes, const std::str
 void validate(const Volume& v) {
   // Overflow and axis checks, no size cap: the voxels are already in memory.
   checkedByteSize(v.dims, v.type, std::numeric_limits<uint64_t>::max(), "volume");
+  if (v.components != 1 && v.components != 2 && v.components != 4)
+    throw std::runtime_error("volume has " + std::to_string(v.components) +
+                             " components: 1, or dependent components 2 (value + opacity) or 4 (RGB + opacity)");
   if (!v.data) throw std::runtime_error("volume has no voxel data");
   for (int i = 0; i < 3; ++i)
     if (!(v.spacing[i] > 0) || !std::isfinite(v.spacing[i]))

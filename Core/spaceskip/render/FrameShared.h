@@ -64,6 +64,10 @@ struct FrameView {
   float ambient, diffuse, specular, specularPower;
   vec3f lightDir;           ///< world direction towards the light; (0,0,0): headlight
   vec3f eyeW;               ///< camera position in world space (the headlight; parallel views too)
+  // Dependent components (Volume::components 2 or 4; render/Components.h). Unused with 1.
+  float alphaLo, alphaScale;    ///< opacity channel -> table entry: (v - alphaLo) * alphaScale
+  float rgbLo[3], rgbScale[3];  ///< 4 components: colour c = clamp((v_c - rgbLo[c]) * rgbScale[c], 0, 1)
+  int gradientComponent;        ///< shading: the component whose gradient lights a sample
 };
 
 }  // namespace spaceskip

@@ -61,6 +61,12 @@ struct ArraySampler {
   }
 };
 
+}  // namespace spaceskip
+
+#include "Components.h"  // needs voxelValue and ArraySampler
+
+namespace spaceskip {
+
 /// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
 /// never before `nextK`, so adjacent intervals never take a sample twice. Sample indices are
 /// 64-bit: the engine bounds a ray to kMaxSamplesPerRay samples, but an index computed from a
@@ -100,9 +106,9 @@ struct IntervalMarcher {
   /// index->world), two-sided diffuse, specular from the reflected light vector, white light,
   /// specular not tinted, the result clamped to [0, 1].
   SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p) const {
-    const float gx = s->sample(p + vec3f{1, 0, 0}) - s->sample(p - vec3f{1, 0, 0});
-    const float gy = s->sample(p + vec3f{0, 1, 0}) - s->sample(p - vec3f{0, 1, 0});
-    const float gz = s->sample(p + vec3f{0, 0, 1}) - s->sample(p - vec3f{0, 0, 1});
+    const float gx = gradientSample(*f, *s, p + vec3f{1, 0, 0}) - gradientSample(*f, *s, p - vec3f{1, 0, 0});
+    const float gy = gradientSample(*f, *s, p + vec3f{0, 1, 0}) - gradientSample(*f, *s, p - vec3f{0, 1, 0});
+    const float gz = gradientSample(*f, *s, p + vec3f{0, 0, 1}) - gradientSample(*f, *s, p - vec3f{0, 0, 1});
     const float* M = f->worldToIndex;
     vec3f n{M[0] * gx + M[4] * gy + M[8] * gz, M[1] * gx + M[5] * gy + M[9] * gz, M[2] * gx + M[6] * gy + M[10] * gz};
     const float len = length(n);
@@ -191,7 +197,7 @@ struct IntervalMarcher {
       const vec3f p = ray.org + ray.dir * t;
       bool go;
       if (comp) {
-        vec4f c = lookup(f->tf, s->sample(p));
+        vec4f c = classifySample(*f, *s, p);  // lookup(f->tf, s->sample(p)) but with dependent components
         go = c.w > 0.f ? composite(c, p) : true;
       } else {
         go = blendSample(s->sample(p), p);
