@@ -61,10 +61,24 @@ bool ConvertibleToFloat(int vtkType)
   }
 }
 
-// The selected component (or the magnitude) of every tuple, as float, in parallel.
+// The selected component (or the magnitude) of every tuple, as float, in parallel; all
+// components (interleaved) when `component` < 0.
 void ConvertToFloat(vtkDataArray* scalars, bool magnitude, int component, float* out)
 {
   const int ncomp = scalars->GetNumberOfComponents();
+  if (component < 0)
+  {
+    vtkSMPTools::For(0, scalars->GetNumberOfTuples(), [&](vtkIdType begin, vtkIdType end) {
+      for (vtkIdType i = begin; i < end; ++i)
+      {
+        for (int c = 0; c < ncomp; ++c)
+        {
+          out[i * ncomp + c] = static_cast<float>(scalars->GetComponent(i, c));
+        }
+      }
+    });
+    return;
+  }
   vtkSMPTools::For(0, scalars->GetNumberOfTuples(), [&](vtkIdType begin, vtkIdType end) {
     std::vector<double> tuple(static_cast<size_t>(ncomp));
     for (vtkIdType i = begin; i < end; ++i)
@@ -90,8 +104,8 @@ void ConvertToFloat(vtkDataArray* scalars, bool magnitude, int component, float*
 
 //------------------------------------------------------------------------------
 bool vtkSpaceSkipInputConverter::Select(vtkImageData* input, vtkDataArray* scalars, int cellFlag,
-  int vectorMode, int vectorComponent, bool independentComponents, const WarnFunction& warnOnce,
-  std::string& problem)
+  int vectorMode, int vectorComponent, bool independentComponents, bool composite,
+  const WarnFunction& warnOnce, std::string& problem)
 {
   this->Input = input;
   this->Scalars = scalars;
@@ -126,13 +140,19 @@ bool vtkSpaceSkipInputConverter::Select(vtkImageData* input, vtkDataArray* scala
   this->Magnitude = ncomp > 1 && vectorMode == vtkScalarsToColors::MAGNITUDE;
   this->Component =
     ncomp > 1 && !this->Magnitude ? std::min(std::max(vectorComponent, 0), ncomp - 1) : 0;
-  if (ncomp > 1 && !independentComponents)
+  // Independent components off (ParaView: Multi Components Mapping, or Map Scalars off): 2 or 4
+  // components are drawn as vtkGPUVolumeRayCastMapper does; what it does not define is said.
+  this->Dependent = (ncomp == 2 || ncomp == 4) && !independentComponents && composite;
+  if (ncomp > 1 && !independentComponents && !this->Dependent)
   {
-    warnOnce("dependent components (direct RGBA, or value + opacity: Multi Components "
-             "Mapping) are not supported; rendering " +
-      std::string(
-        this->Magnitude ? "the magnitude" : "component " + std::to_string(this->Component)) +
-      " through the transfer functions");
+    const std::string drawn = std::string("rendering ") +
+      (this->Magnitude ? "the magnitude" : "component " + std::to_string(this->Component)) +
+      " through the transfer functions";
+    warnOnce(ncomp == 2 || ncomp == 4
+        ? "dependent components (Multi Components Mapping) are drawn with composite blending "
+          "only; " + drawn
+        : "dependent components (Multi Components Mapping) need 2 (value + opacity) or 4 (RGBA) "
+          "components, not " + std::to_string(ncomp) + "; " + drawn);
   }
   if (scalars->GetNumberOfTuples() != input->GetNumberOfPoints())
   {
@@ -156,7 +176,7 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
 {
   vtkImageData* input = this->Input;
   vtkDataArray* scalars = this->Scalars;
-  const int selection = this->Magnitude ? -1 : this->Component;
+  const int selection = this->Dependent ? -2 : (this->Magnitude ? -1 : this->Component);
   if (this->HaveVolume && this->InputKey == input && this->InputMTime == input->GetMTime() &&
     this->ScalarsKey == scalars && this->ScalarsMTime == scalars->GetMTime() &&
     this->Selection == selection)
@@ -176,8 +196,11 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   std::copy(dir, dir + 9, v.direction);
   spaceskip::VoxelType vtype = spaceskip::VoxelType::Float32;
   const bool native = CoreTypeOf(scalars->GetDataType(), vtype);
-  if (native && this->NumberOfComponents == 1 && scalars->HasStandardMemoryLayout())
+  v.components = this->Dependent ? this->NumberOfComponents : 1;
+  if (native && (this->NumberOfComponents == 1 || this->Dependent) &&
+    scalars->HasStandardMemoryLayout())
   {
+    // Borrowed as it is: dependent components stay interleaved, no copy.
     v.type = vtype;
     v.data = scalars->GetVoidPointer(0);
     this->Borrowed = scalars;
@@ -191,8 +214,9 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
       warnOnce(std::string("scalar type ") + scalars->GetDataTypeAsString() +
         " converted to float (values beyond 2^24 lose precision)");
     }
-    this->Converted.resize(static_cast<size_t>(input->GetNumberOfPoints()));
-    ConvertToFloat(scalars, this->Magnitude, this->Component, this->Converted.data());
+    this->Converted.resize(static_cast<size_t>(input->GetNumberOfPoints()) * v.components);
+    ConvertToFloat(
+      scalars, this->Magnitude, this->Dependent ? -1 : this->Component, this->Converted.data());
     v.type = spaceskip::VoxelType::Float32;
     v.data = this->Converted.data();
     this->Borrowed = nullptr;
@@ -201,10 +225,19 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   // One parallel pass over the voxels the engine reads (vtkDataArray::GetFiniteRange was
   // serial here: 267 s for the first frame of a 2048^3 uint8 volume).
   const auto tRange = std::chrono::steady_clock::now();
-  if (!v.scalarRange(this->ScalarRange[0], this->ScalarRange[1]))
+  // Dependent components: the colour TF spans component 0's range, the opacity function the
+  // last component's (vtkVolumeInputHelper, ColorRangeType/ScalarOpacityRangeType SCALAR).
+  if (!(this->Dependent ? v.componentRange(0, this->ScalarRange[0], this->ScalarRange[1])
+                        : v.scalarRange(this->ScalarRange[0], this->ScalarRange[1])))
   {
     this->ScalarRange[0] = 0; // no finite value at all: an empty table range
     this->ScalarRange[1] = 1;
+  }
+  if (this->Dependent &&
+    !v.componentRange(v.components - 1, this->OpacityRange[0], this->OpacityRange[1]))
+  {
+    this->OpacityRange[0] = 0;
+    this->OpacityRange[1] = 1;
   }
   const double seconds =
     std::chrono::duration<double>(std::chrono::steady_clock::now() - tRange).count();

@@ -25,11 +25,14 @@ public:
   /**
    * Picks what this frame draws: `scalars` (vtkAbstractMapper::GetScalars of `input`) and,
    * with several components, the one VectorMode/VectorComponent select, as vtkSmartVolumeMapper
-   * does. False, with `problem` set, when nothing can be drawn (no image, empty extent, no point
-   * scalars, wrong length, unsupported type).
+   * does; or, with independent components off, 2 or 4 components and composite blending
+   * (`composite`), all of them as vtkGPUVolumeRayCastMapper's dependent components (2: colour
+   * value + opacity value, 4: RGB + opacity value). Other dependent cases are said once and
+   * drawn as the selected component. False, with `problem` set, when nothing can be drawn (no
+   * image, empty extent, no point scalars, wrong length, unsupported type).
    */
   bool Select(vtkImageData* input, vtkDataArray* scalars, int cellFlag, int vectorMode,
-    int vectorComponent, bool independentComponents, const WarnFunction& warnOnce,
+    int vectorComponent, bool independentComponents, bool composite, const WarnFunction& warnOnce,
     std::string& problem);
 
   /**
@@ -40,8 +43,15 @@ public:
    */
   double Update(spaceskip::Engine& engine, const WarnFunction& warnOnce);
 
-  /// Finite range of the scalars the engine reads ({0, 1} when none is finite).
+  /// Finite range of the scalars the engine reads ({0, 1} when none is finite); with dependent
+  /// components, of component 0 (the colour TF's range, as vtkGPUVolumeRayCastMapper's).
   const double* GetScalarRange() const { return this->ScalarRange; }
+
+  /// Dependent components: the finite range of the opacity component (the last), over which
+  /// the scalar opacity function is sampled; nullptr otherwise.
+  const double* GetOpacityRange() const { return this->Dependent ? this->OpacityRange : nullptr; }
+  /// Dependent components: the opacity component's index (its unit distance is used, as VTK's).
+  int GetOpacityComponent() const { return this->Dependent ? this->NumberOfComponents - 1 : 0; }
 
   /// Forgets what the engine was given (a new engine): the next Update hands the volume again.
   void Reset();
@@ -53,6 +63,7 @@ private:
   int NumberOfComponents = 1;
   bool Magnitude = false;
   int Component = 0;
+  bool Dependent = false; // all components, vtkGPUVolumeRayCastMapper's dependent modes
 
   // What the engine was last given; compared by identity and MTime to redo only what changed.
   const void* InputKey = nullptr;
@@ -60,11 +71,12 @@ private:
   vtkMTimeType InputMTime = 0;
   vtkMTimeType ScalarsMTime = 0;
   bool HaveVolume = false;
-  int Selection = 0; // the component the volume was made from; -1: the magnitude
+  int Selection = 0; // the component the volume was made from; -1: the magnitude; -2: all
   std::vector<float> Converted; // int/long scalars (or a component, the magnitude) as float
   // The array whose voxels the engine borrows: held so it outlives the engine's use of it.
   vtkSmartPointer<vtkDataArray> Borrowed;
   double ScalarRange[2] = { 0, 1 };
+  double OpacityRange[2] = { 0, 1 };
 };
 
 #endif

@@ -56,8 +56,9 @@ spaceskip::mat4 ToCore(const vtkMatrix4x4* m)
 } // namespace
 
 //------------------------------------------------------------------------------
-void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(
-  spaceskip::Engine& engine, vtkVolumeProperty* prop, const double scalarRange[2])
+void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& engine,
+  vtkVolumeProperty* prop, const double scalarRange[2], const double* opacityRange,
+  int opacityComponent)
 {
   const bool gray = prop->GetColorChannels(0) == 1;
   vtkObject* color = gray ? static_cast<vtkObject*>(prop->GetGrayTransferFunction(0))
@@ -68,17 +69,27 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(
   {
     hi = lo + 1.0; // constant volume: any non-empty range samples its one value
   }
+  double alo = 0, ahi = 0; // dependent components: the opacity component's range
+  if (opacityRange)
+  {
+    alo = opacityRange[0];
+    ahi = opacityRange[1] > alo ? opacityRange[1] : alo + 1.0;
+  }
   if (this->HaveTF && this->PropertyKey == prop && this->PropertyMTime == prop->GetMTime() &&
     this->ColorKey == color && this->ColorMTime == color->GetMTime() &&
     this->OpacityKey == opacity && this->OpacityMTime == opacity->GetMTime() &&
-    this->TableRange[0] == lo && this->TableRange[1] == hi)
+    this->TableRange[0] == lo && this->TableRange[1] == hi && this->OpacityTableRange[0] == alo &&
+    this->OpacityTableRange[1] == ahi && this->OpacityComponent == opacityComponent)
   {
     return;
   }
   spaceskip::TransferFunction tf;
   tf.rangeMin = lo;
   tf.rangeMax = hi;
-  tf.unitDistance = std::max(prop->GetScalarOpacityUnitDistance(0), 1e-12);
+  tf.unitDistance = std::max(prop->GetScalarOpacityUnitDistance(opacityComponent), 1e-12);
+  tf.ownOpacityRange = opacityRange != nullptr;
+  tf.opacityRangeMin = alo;
+  tf.opacityRangeMax = ahi;
   std::vector<float> rgb(3 * kTableSize), alpha(kTableSize);
   if (gray)
   {
@@ -93,7 +104,7 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(
   {
     static_cast<vtkColorTransferFunction*>(color)->GetTable(lo, hi, kTableSize, rgb.data());
   }
-  opacity->GetTable(lo, hi, kTableSize, alpha.data());
+  opacity->GetTable(opacityRange ? alo : lo, opacityRange ? ahi : hi, kTableSize, alpha.data());
   tf.table.resize(kTableSize);
   for (int i = 0; i < kTableSize; ++i)
   {
@@ -109,6 +120,9 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(
   this->OpacityMTime = opacity->GetMTime();
   this->TableRange[0] = lo;
   this->TableRange[1] = hi;
+  this->OpacityTableRange[0] = alo;
+  this->OpacityTableRange[1] = ahi;
+  this->OpacityComponent = opacityComponent;
   this->HaveTF = true;
 }
 

@@ -30,10 +30,12 @@ public:
   /**
    * Resamples the property's colour and scalar-opacity functions over `scalarRange` into the
    * engine's table, only when the property, one of its functions or the range changed (the
-   * engine itself tells a colour-only edit from an opacity edit).
+   * engine itself tells a colour-only edit from an opacity edit). Dependent components: the
+   * opacity function over `opacityRange` instead, with component `opacityComponent`'s unit
+   * distance (vtkVolumeInputHelper::UpdateOpacityTransferFunction).
    */
-  void UpdateTransferFunction(
-    spaceskip::Engine& engine, vtkVolumeProperty* prop, const double scalarRange[2]);
+  void UpdateTransferFunction(spaceskip::Engine& engine, vtkVolumeProperty* prop,
+    const double scalarRange[2], const double* opacityRange = nullptr, int opacityComponent = 0);
 
   /**
    * Gives the engine the mapper's build parameters and its render parameters (blend mode
@@ -67,6 +69,8 @@ private:
   vtkMTimeType ColorMTime = 0;
   vtkMTimeType OpacityMTime = 0;
   double TableRange[2] = { 0, 0 };
+  double OpacityTableRange[2] = { 0, 0 }; // dependent components; {0, 0}: none
+  int OpacityComponent = 0;
   bool HaveTF = false;
 
   // Unsupported features already said (the lights say their first cause only).

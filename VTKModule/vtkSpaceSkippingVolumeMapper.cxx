@@ -154,7 +154,8 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::SelectInput(vtkVolume* vol)
                                 : nullptr;
   std::string problem;
   if (!this->Input.Select(input, scalars, cellFlag, self->VectorMode, self->VectorComponent,
-        vol->GetProperty()->GetIndependentComponents() != 0, this->Warn, problem))
+        vol->GetProperty()->GetIndependentComponents() != 0,
+        self->EffectiveBlendMode() == vtkVolumeMapper::COMPOSITE_BLEND, this->Warn, problem))
   {
     this->Fail(problem);
     return false;
@@ -459,7 +460,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // function, the build and render parameters.
     spaceskip::Engine& engine = *d.Engine;
     d.RangeSeconds = d.Input.Update(engine, d.Warn);
-    d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), d.Input.GetScalarRange());
+    d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), d.Input.GetScalarRange(),
+      d.Input.GetOpacityRange(), d.Input.GetOpacityComponent());
     d.Properties.UpdateParameters(
       engine, this, this->EffectiveBlendMode(), ren, vol, d.Input.GetScalarRange(), d.Warn);
     const spaceskip::Camera camera = vtkSpaceSkipPropertyTranslator::ToCamera(ren, cam, vol);

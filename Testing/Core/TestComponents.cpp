@@ -183,8 +183,8 @@ TEST(Components, TwoComponentsColourFromChannelZero) {
   EXPECT_EQ(b, 0.0) << "the colour channel is below 90 wherever the opacity channel is visible";
 }
 
-// 4 components: RGB straight from the data, normalised as vtkVolumeTexture does (uint8: the
-// texture's v/255 against a range scaled by 1/256, so 255 maps to 1 after the clamp).
+// 4 components: RGB straight from the data, each normalised over its own range as
+// vtkVolumeTexture's scale and bias do (red: [0, 255] -> 255 is 1; green, blue constant -> 0).
 TEST(Components, FourComponentsDirectColour) {
   const Volume v = makeVolume<uint8_t>(24, 24, 24, 4, VoxelType::UInt8, [](int i, int j, int k, int c) {
     if (c == 0) return i == 0 && j == 0 && k == 0 ? 0.f : 255.f;  // red range [0, 255]
