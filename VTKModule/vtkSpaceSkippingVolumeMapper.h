@@ -200,8 +200,11 @@ public:
   /**
    * Multi-component scalars (vtkSmartVolumeMapper's API, set by ParaView's representation from
    * the colour map's Magnitude/Component choice): vtkScalarsToColors::MAGNITUDE renders the
-   * Euclidean norm of each tuple, COMPONENT (default) the component VectorComponent. Dependent
-   * components (direct RGBA, value + opacity) are not supported: one warning, then the same.
+   * Euclidean norm of each tuple, COMPONENT (default) the component VectorComponent. With the
+   * volume property's IndependentComponents off (ParaView: Multi Components Mapping, or Map
+   * Scalars off) and composite blending, 2 components are drawn as colour value + opacity value
+   * and 4 as RGB + opacity value, as vtkGPUVolumeRayCastMapper does (these modes are then
+   * ignored); 3 components, or another blend mode: one warning, then the selected component.
    */
   vtkSetMacro(VectorMode, int);
   vtkGetMacro(VectorMode, int);
