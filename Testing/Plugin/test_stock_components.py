@@ -103,7 +103,9 @@ for ncomp in [2, 4]:
         lut.RGBPoints = [lo, 0.23, 0.30, 0.75, 0.5 * (lo + hi), 0.87, 0.87, 0.87, hi, 0.71, 0.02, 0.15]
         # Opacity over the opacity component's 0..250 (dependent) or the magnitude (independent).
         pwf.Points = [0.0, 0.0, 0.5, 0.0, 60.0, 0.0, 0.5, 0.0, 250.0, 0.5, 0.5, 0.0]
-        d.ScalarOpacityUnitDistance = 1.0
+        # Not 1: with dependent components VTK corrects opacity with the opacity component's
+        # unit distance (vtkVolumeInputHelper), which ParaView's property (index 0) leaves at 1.
+        d.ScalarOpacityUnitDistance = 4.0
         if rep == "Space Skipping Volume":
             d.Builder = "Naive"
             d.Backend = "CPU"
