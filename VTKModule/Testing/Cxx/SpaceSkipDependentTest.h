@@ -140,6 +140,17 @@ inline int RunDependentTest(int argc, char* argv[], vtkImageData* image, const c
   scene.Shot();
   std::cout << "warnings: " << messages->WarningCount << " " << messages->Warnings << "\n";
   SS_CHECK(messages->WarningCount == 0 && messages->ErrorCount == 0);
+  // No dependent-component rule for the other blend modes: one warning, then component 0
+  // through the transfer functions (still drawn).
+  ours->SetBlendModeToMaximumIntensity();
+  scene.Shot();
+  auto mip = scene.Shot();
+  std::cout << "maximum intensity: " << messages->WarningCount << " warning(s): " << messages->Warnings
+            << "\n";
+  SS_CHECK(messages->WarningCount == 1 && messages->ErrorCount == 0);
+  SS_CHECK(CountNonBackground(mip, kNavy) > 5000);
+  ours->SetBlendModeToComposite();
+  scene.Shot();
   return scene.Regression(argc, argv);
 }
 
