@@ -88,6 +88,27 @@ bool vtkSpaceSkipBlockRenderer::IsComposite(vtkDataObject* input)
 }
 
 //------------------------------------------------------------------------------
+vtkImageData* vtkSpaceSkipBlockRenderer::FirstImage(vtkDataObject* input)
+{
+  auto* cds = vtkCompositeDataSet::SafeDownCast(input);
+  if (!cds)
+  {
+    return nullptr;
+  }
+  vtkSmartPointer<vtkCompositeDataIterator> it;
+  it.TakeReference(cds->NewIterator());
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
+    auto* image = vtkImageData::SafeDownCast(it->GetCurrentDataObject());
+    if (image && image->GetNumberOfPoints() > 0)
+    {
+      return image;
+    }
+  }
+  return nullptr;
+}
+
+//------------------------------------------------------------------------------
 bool vtkSpaceSkipBlockRenderer::ComputeBounds(vtkDataObject* input, double bounds[6])
 {
   vtkMath::UninitializeBounds(bounds);

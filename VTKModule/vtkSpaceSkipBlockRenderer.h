@@ -43,6 +43,9 @@ public:
   bool Render(vtkSpaceSkippingVolumeMapper* parent, vtkDataObject* input, vtkRenderer* ren,
     vtkVolume* vol, const WarnFunction& warnOnce, std::string& problem);
 
+  /// The first non-empty vtkImageData leaf of `input`, or null.
+  static vtkImageData* FirstImage(vtkDataObject* input);
+
   /// Union of the bounds of the image leaves of `input`; false when it holds none.
   static bool ComputeBounds(vtkDataObject* input, double bounds[6]);
 

@@ -627,6 +627,18 @@ double* vtkSpaceSkippingVolumeMapper::GetBounds()
 }
 
 //------------------------------------------------------------------------------
+vtkDataSet* vtkSpaceSkippingVolumeMapper::GetInput()
+{
+  vtkDataObject* input =
+    this->GetNumberOfInputConnections(0) > 0 ? this->GetInputDataObject(0, 0) : nullptr;
+  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
+  {
+    return vtkSpaceSkipBlockRenderer::FirstImage(input);
+  }
+  return this->Superclass::GetInput();
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::SetBinCount(int bins)
 {
   // 0 is the sweep; 1 (no candidate plane) would make the engine throw, so it clamps to 2.

@@ -301,6 +301,14 @@ public:
   double* GetBounds() override;
   using vtkAbstractVolumeMapper::GetBounds;
 
+  /**
+   * The input as a data set; for composite input its first non-empty vtkImageData block
+   * (ParaView's vtkPVLODVolume draws a vtkVolumeMapper only when GetInput() has the selected
+   * scalars).
+   */
+  vtkDataSet* GetInput() override;
+  using vtkVolumeMapper::GetInput;
+
 protected:
   vtkSpaceSkippingVolumeMapper();
   ~vtkSpaceSkippingVolumeMapper() override;
