@@ -15,6 +15,10 @@
  * oneTBB CPU backend, clipped by the depth of opaque geometry already drawn, and blended into
  * the render window as premultiplied RGBA.
  *
+ * Composite input (vtkMultiBlockDataSet, vtkPartitionedDataSet, vtkPartitionedDataSetCollection
+ * of vtkImageData) draws every image block with a hierarchy of its own, back to front (see
+ * GetBounds()).
+ *
  * Bad input (no/cell scalars, several components, unsupported type, empty extent) raises one
  * vtkErrorMacro and draws nothing; backend failures (no device, out of device memory) fall back
  * to the CPU backend with a warning.

@@ -3,6 +3,7 @@ blocks by a Programmable Filter (vtkPartitionedDataSet, vtkMultiBlockDataSet,
 vtkPartitionedDataSetCollection) renders with the Space Skipping Volume as the single image does
 (each block with its own hierarchy), and like ParaView's own Volume on the same blocks."""
 from paraview.simple import *
+from paraview import servermanager
 import ssptest
 
 ssptest.load_plugin()
@@ -42,15 +43,45 @@ whole = ssptest.read_png(whole_path)
 whole_stats = ssptest.stats(disp)
 Hide(reader, view)
 
-for kind in ("vtkPartitionedDataSet", "vtkMultiblockDataSet", "vtkPartitionedDataSetCollection"):
-    cut = ProgrammableFilter(Input=reader, OutputDataSetType=kind, Script=CUT)
+def blocks_from_file():
+    """The 4 blocks written to a .vtpd (here, in this process) and read back by ParaView."""
+    from vtkmodules.vtkCommonDataModel import vtkPartitionedDataSet
+    from vtkmodules.vtkIOParallelXML import vtkXMLPartitionedDataSetWriter
+
+    class Cutter:  # runs CUT as the Programmable Filter would
+        def __init__(self, image):
+            self.image, self.out = image, vtkPartitionedDataSet()
+
+        def GetInputDataObject(self, port, index):
+            return self.image
+
+        def GetOutputDataObject(self, port):
+            return self.out
+
+    cutter = Cutter(servermanager.Fetch(reader))
+    exec(CUT, {"self": cutter})
+    path = ssptest.temp_path("partitioned_shell.vtpd")
+    w = vtkXMLPartitionedDataSetWriter()
+    w.SetInputData(cutter.out)
+    w.SetFileName(path)
+    ok.check(w.Write() == 1, "wrote %d blocks to %s" % (cutter.out.GetNumberOfPartitions(), path))
+    return XMLPartitionedDatasetReader(FileName=[path])
+
+
+for kind in ("vtkPartitionedDataSet", "vtkMultiblockDataSet", "vtkPartitionedDataSetCollection",
+             ".vtpd"):
+    if kind == ".vtpd":
+        cut = blocks_from_file()
+    else:
+        cut = ProgrammableFilter(Input=reader, OutputDataSetType=kind, Script=CUT)
     bdisp = ssptest.show_space_skipping(cut, view, "KdTreeCPU", "CPU")
     path = ssptest.render_to(view, "partitioned_%s.png" % kind)
     blocks = ssptest.read_png(path)
     p = ssptest.psnr(whole, blocks)
     diff = int(abs(whole - blocks).max())
     print("%s: PSNR vs the single image %.2f dB, max diff %d/255" % (kind, p, diff))
-    # Each block starts its samples at its own box entry: a seam residue (see README).
+    # Each block starts its samples at its own box entry: a seam residue (see README); measured
+    # 52.9 dB, max 8/255 (and 50.6 dB against ParaView's Volume below), Mesa, 2026-11-24.
     ok.check(p >= 40.0 and ssptest.lit_fraction(blocks) > 0.05,
              "%s renders as the single image (PSNR %.2f >= 40 dB, max %d/255)" % (kind, p, diff))
     s = ssptest.stats(bdisp)
