@@ -20,6 +20,9 @@
 
 namespace
 {
+// Above this many image blocks the per-block engines and frame buffers are said to be costly.
+constexpr size_t kManyBlocks = 64;
+
 // The parent's settings, as vtkMultiBlockVolumeMapper hands its own to each block's mapper.
 void CopySettings(vtkSpaceSkippingVolumeMapper* from, vtkSpaceSkippingVolumeMapper* to)
 {
@@ -176,6 +179,14 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
     warnOnce("composite input: blocks of type " + names +
       " are not drawn (vtkSpaceSkippingVolumeMapper draws vtkImageData blocks only; resample "
       "rectilinear or unstructured data to an image first)");
+  }
+
+  if (images.size() > kManyBlocks)
+  {
+    warnOnce("composite input with more than " + std::to_string(kManyBlocks) +
+      " image blocks: each block has its own engine, hierarchy and frame-sized image buffer, so "
+      "memory and time grow with the block count (merge blocks, e.g. with Merge Blocks or "
+      "Resample To Image, for many small pieces)");
   }
 
   // One block mapper per image leaf, reused in leaf order; the surplus goes (with its GL

@@ -560,6 +560,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.Blocks.ReleaseGraphicsResources(renWin);
     d.Blocks.Clear();
   }
+  if (input && input->IsA("vtkRectilinearGrid"))
+  {
+    d.Fail("vtkRectilinearGrid input is not drawn: vtkSpaceSkippingVolumeMapper draws "
+           "vtkImageData (resample the grid to an image first, e.g. vtkResampleToImage)");
+    return;
+  }
   // Input conversion, first half: what to draw, or why nothing.
   if (!d.SelectInput(vol))
   {

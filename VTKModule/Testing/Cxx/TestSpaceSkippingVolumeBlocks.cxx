@@ -194,6 +194,19 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
     std::cerr << "the rectilinear block was warned about again: " << messages->Warnings << "\n";
     ok = false;
   }
+  // A rectilinear grid alone: one error naming it, nothing drawn.
+  vtkNew<vtkRectilinearGrid> lonely;
+  lonely->DeepCopy(grid);
+  messages->Clear();
+  blocks->SetInputDataObject(lonely);
+  scene.Window->Render();
+  scene.Window->Render();
+  if (messages->ErrorCount != 1 || messages->Errors.find("vtkRectilinearGrid") == std::string::npos)
+  {
+    std::cerr << "rectilinear grid input: expected one error naming it, got [" << messages->Errors
+              << "] (" << messages->ErrorCount << ")\n";
+    ok = false;
+  }
   // Back to a plain image: the blocks go, the mapper draws the image itself again.
   blocks->SetInputData(image);
   auto again = sstest::RenderWith(scene.Window, scene.Volume, blocks);
