@@ -5,11 +5,14 @@
 #include "vtkSpaceSkippingVolumeMapper.h"
 
 #include "vtkImageData.h"
+#include "vtkInformation.h"
 #include "vtkLogger.h"
+#include "vtkMath.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkRenderer.h"
+#include "vtkSpaceSkipBlockRenderer.h"
 #include "vtkSpaceSkipCompositor.h"
 #include "vtkSpaceSkipInputConverter.h"
 #include "vtkSpaceSkipPropertyTranslator.h"
@@ -102,6 +105,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   const float* FrameDepth = nullptr; // this frame's depth (the compositor's buffer), or null
   // Last, so that it goes (with its CUDA-GL interop registration) before the engine.
   vtkSpaceSkipCompositor Compositor;
+  // Composite input: one mapper per image block (each with its engine and compositor).
+  vtkSpaceSkipBlockRenderer Blocks;
 
   // Reports a problem once (until the next different one); the caller then draws nothing.
   void Fail(const std::string& msg)
@@ -314,18 +319,34 @@ const char* vtkSpaceSkippingVolumeMapper::GetBuilderAsString()
 //------------------------------------------------------------------------------
 double vtkSpaceSkippingVolumeMapper::GetLastBuildSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastBuildSeconds);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().seconds : 0.0;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().classifySeconds : 0.0;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds);
+  }
   return this->Internals->Engine ? this->Internals->Engine->frameStats().seconds : 0.0;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds);
+  }
   if (!this->Internals->Engine)
   {
     return 0.0;
@@ -335,14 +356,26 @@ double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
 }
 double vtkSpaceSkippingVolumeMapper::GetLastScalarRangeSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastScalarRangeSeconds);
+  }
   return this->Internals->RangeSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastUpdateSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastUpdateSeconds);
+  }
   return this->Internals->UpdateSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds);
+  }
   return this->Internals->DepthSeconds;
 }
 bool vtkSpaceSkippingVolumeMapper::GetLastFrameReadDepth()
@@ -351,10 +384,18 @@ bool vtkSpaceSkippingVolumeMapper::GetLastFrameReadDepth()
 }
 double vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds);
+  }
   return this->Internals->EngineSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastCompositeSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastCompositeSeconds);
+  }
   return this->Internals->CompositeSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastMapperSeconds()
@@ -363,38 +404,74 @@ double vtkSpaceSkippingVolumeMapper::GetLastMapperSeconds()
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetNodeCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetNodeCount);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().nodes : 0;
 }
 int vtkSpaceSkippingVolumeMapper::GetTreeHeight()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Max(&vtkSpaceSkippingVolumeMapper::GetTreeHeight);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().height : 0;
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetLeafCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLeafCount);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().leaves : 0;
 }
 double vtkSpaceSkippingVolumeMapper::GetOccupancy()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Occupancy();
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().occupancy : 0.0;
 }
 const char* vtkSpaceSkippingVolumeMapper::GetBackendUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBackendUsed);
+  }
   return this->Internals->BackendUsed.c_str();
 }
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBuilderUsed);
+  }
   return this->Internals->BuilderUsed.c_str();
 }
 const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetCompositePathUsed);
+  }
   return this->Internals->Compositor.GetCompositePath().c_str();
 }
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderChoice()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBuilderChoice);
+  }
   return this->Internals->BuilderChoice.c_str();
 }
 double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.MinSampleDistance();
+  }
   return this->Internals->SampleDistanceUsed;
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetDeviceBytesInUse()
@@ -410,24 +487,41 @@ void vtkSpaceSkippingVolumeMapper::WarnOnce(const std::string& message)
 }
 int vtkSpaceSkippingVolumeMapper::GetBuildCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetBuildCount);
+  }
   return this->Internals->Counts().builds;
 }
 int vtkSpaceSkippingVolumeMapper::GetClassifyCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetClassifyCount);
+  }
   return this->Internals->Counts().classifications;
 }
 int vtkSpaceSkippingVolumeMapper::GetColorUpdateCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetColorUpdateCount);
+  }
   return this->Internals->Counts().colorUpdates;
 }
 int vtkSpaceSkippingVolumeMapper::GetFrameCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.GetFrameCount();
+  }
   return this->Internals->Counts().frames;
 }
 
 //------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
+  this->Internals->Blocks.ReleaseGraphicsResources(win);
   this->Internals->Compositor.ReleaseGraphicsResources(win);
   this->Superclass::ReleaseGraphicsResources(win);
 }
@@ -441,6 +535,36 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   if (!renWin || !cam || !vol || !vol->GetProperty())
   {
     d.Fail("needs an OpenGL render window, an OpenGL camera and a volume with a property");
+    return;
+  }
+  // Composite input: every image block through a mapper of its own (vtkSpaceSkipBlockRenderer).
+  if (this->GetNumberOfInputConnections(0) > 0 && this->GetInputAlgorithm())
+  {
+    this->GetInputAlgorithm()->Update();
+  }
+  vtkDataObject* input = this->GetInputDataObject(0, 0);
+  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
+  {
+    std::string problem;
+    if (d.Blocks.Render(this, input, ren, vol, d.Warn, problem))
+    {
+      d.LastProblem.clear();
+    }
+    else
+    {
+      d.Fail(problem);
+    }
+    return;
+  }
+  if (d.Blocks.IsActive())
+  {
+    d.Blocks.ReleaseGraphicsResources(renWin);
+    d.Blocks.Clear();
+  }
+  if (input && input->IsA("vtkRectilinearGrid"))
+  {
+    d.Fail("vtkRectilinearGrid input is not drawn: vtkSpaceSkippingVolumeMapper draws "
+           "vtkImageData (resample the grid to an image first, e.g. vtkResampleToImage)");
     return;
   }
   // Input conversion, first half: what to draw, or why nothing.
@@ -460,10 +584,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // function, the build and render parameters.
     spaceskip::Engine& engine = *d.Engine;
     d.RangeSeconds = d.Input.Update(engine, d.Warn);
-    d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), d.Input.GetScalarRange(),
+    // A block of a composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
+    const double* range = this->UseTableRange ? this->TableRange : d.Input.GetScalarRange();
+    d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), range,
       d.Input.GetOpacityRange(), d.Input.GetOpacityComponent());
     d.Properties.UpdateParameters(
-      engine, this, this->EffectiveBlendMode(), ren, vol, d.Input.GetScalarRange(), d.Warn);
+      engine, this, this->EffectiveBlendMode(), ren, vol, range, d.Warn);
     const spaceskip::Camera camera = vtkSpaceSkipPropertyTranslator::ToCamera(ren, cam, vol);
 
     int width, height, x0, y0;
@@ -484,6 +610,40 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   {
     d.Fail(std::string("SpaceSkip engine error: ") + e.what() + ": nothing drawn");
   }
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkippingVolumeMapper::FillInputPortInformation(int port, vtkInformation* info)
+{
+  this->Superclass::FillInputPortInformation(port, info);
+  // vtkMultiBlockDataSet, vtkPartitionedDataSet, vtkPartitionedDataSetCollection.
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataObjectTree");
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+double* vtkSpaceSkippingVolumeMapper::GetBounds()
+{
+  if (this->GetNumberOfInputConnections(0) == 0 ||
+    !vtkSpaceSkipBlockRenderer::IsComposite(this->GetInputDataObject(0, 0)))
+  {
+    return this->Superclass::GetBounds();
+  }
+  this->Update();
+  vtkSpaceSkipBlockRenderer::ComputeBounds(this->GetInputDataObject(0, 0), this->Bounds);
+  return this->Bounds;
+}
+
+//------------------------------------------------------------------------------
+vtkDataSet* vtkSpaceSkippingVolumeMapper::GetInput()
+{
+  vtkDataObject* input =
+    this->GetNumberOfInputConnections(0) > 0 ? this->GetInputDataObject(0, 0) : nullptr;
+  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
+  {
+    return vtkSpaceSkipBlockRenderer::FirstImage(input);
+  }
+  return this->Superclass::GetInput();
 }
 
 //------------------------------------------------------------------------------

@@ -2,8 +2,14 @@
 #include "vtkSpaceSkipVolumeRepresentation.h"
 
 #include "vtkColorTransferFunction.h"
+#include "vtkImageData.h"
+#include "vtkInformationVector.h"
+#include "vtkMath.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkOutlineSource.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPartitionedDataSet.h"
 #include "vtkScalarsToColors.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
 #include "vtkVolumeProperty.h"
@@ -39,6 +45,52 @@ void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
   const bool indep = prop->GetIndependentComponents() != 0;
   this->SpaceSkipMapper->SetVectorMode(indep ? ctf->GetVectorMode() : vtkScalarsToColors::COMPONENT);
   this->SpaceSkipMapper->SetVectorComponent(indep ? ctf->GetVectorComponent() : 0);
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPartitionedDataSet* input = inputVector[0]->GetNumberOfInformationObjects() == 1
+    ? vtkPartitionedDataSet::GetData(inputVector[0], 0)
+    : nullptr;
+  if (!input)
+  {
+    return this->Superclass::RequestData(request, inputVector, outputVector);
+  }
+  // What vtkImageVolumeRepresentation::RequestData does for partitioned input with
+  // vtkMultiBlockVolumeMapper, plus the outline (drawn where the data is not) and the data size.
+  vtkMath::UninitializeBounds(this->DataBounds);
+  this->DataSize = 0;
+  this->WholeExtent[0] = this->WholeExtent[2] = this->WholeExtent[4] = 0;
+  this->WholeExtent[1] = this->WholeExtent[3] = this->WholeExtent[5] = -1;
+  vtkNew<vtkPartitionedDataSet> cache;
+  unsigned int n = 0;
+  for (unsigned int i = 0; i < input->GetNumberOfPartitions(); ++i)
+  {
+    vtkDataSet* partition = input->GetPartition(i);
+    if (!partition)
+    {
+      continue;
+    }
+    if (this->UseSeparateOpacityArray)
+    {
+      this->AppendOpacityComponent(partition);
+    }
+    // Other types stay in: the mapper says once that it skips them.
+    cache->SetPartition(n++, partition);
+  }
+  cache->GetBounds(this->DataBounds);
+  if (vtkMath::AreBoundsInitialized(this->DataBounds))
+  {
+    this->OutlineSource->SetBounds(this->DataBounds);
+    this->OutlineSource->Update();
+  }
+  this->DataSize = cache->GetActualMemorySize();
+  this->Actor->SetEnableLOD(0);
+  this->Cache = cache;
+  // Skips vtkImageVolumeRepresentation::RequestData (it would refuse the partitions).
+  return this->vtkVolumeRepresentation::RequestData(request, inputVector, outputVector);
 }
 
 //------------------------------------------------------------------------------

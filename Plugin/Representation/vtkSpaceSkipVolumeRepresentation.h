@@ -8,8 +8,10 @@
  * (each rank renders its own piece; ParaView composites the pieces in visibility order).
  * The setters forward to the mapper; the getters report its last build and frame.
  *
- * Limits: vtkImageData input only (a vtkPartitionedDataSet or vtkRectilinearGrid is refused by the
- * base class or by the mapper with a warning); 1-component point scalars.
+ * Input: vtkImageData, and the vtkPartitionedDataSet of vtkImageData that ParaView makes of
+ * partitioned, multiblock and partitioned-collection image data (the base class keeps those for
+ * vtkMultiBlockVolumeMapper; the mapper draws each block with its own hierarchy). Rectilinear
+ * grids are refused by the mapper with a warning.
  */
 #ifndef vtkSpaceSkipVolumeRepresentation_h
 #define vtkSpaceSkipVolumeRepresentation_h
@@ -84,6 +86,11 @@ protected:
   /// The base class hands the colour map's Magnitude/Component choice only to VTK's own
   /// mappers; this passes it to ours as well.
   void UpdateMapperParameters() override;
+
+  /// vtkPartitionedDataSet input, which the base class renders only with
+  /// vtkMultiBlockVolumeMapper: the same cache of partitions for our mapper (it accepts composite
+  /// input), with the outline and data size of the whole; other input goes to the base class.
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;

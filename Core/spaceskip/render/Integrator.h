@@ -73,7 +73,14 @@ namespace spaceskip {
 /// far interval end must never wrap (a tiny step once overflowed int and drew nothing). It also
 /// keeps each blend mode's running state, from which `active` decides which bricks can still
 /// matter.
-template <class Sampler>
+/// A plain frame: composite blending, no shading, no clipping planes, no cropping. The GPU
+/// compiles its kernels for plain frames separately (renderPixel's `Plain`): without the code of
+/// the other modes the kernel needs far fewer registers, so more warps hide the voxel fetches.
+SS_FUNC bool isPlainFrame(const FrameView& f) {
+  return f.blend == BlendMode::Composite && !f.shade && f.cut.numClipPlanes == 0 && !f.cut.cropping;
+}
+
+template <class Sampler, bool Plain = false>
 struct IntervalMarcher {
   const FrameView* f;
   const Sampler* s;
@@ -89,6 +96,7 @@ struct IntervalMarcher {
 
   /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
   SS_FUNC bool active(float lo, float hi) const {
+    if (Plain) return true;
     switch (f->blend) {
       case BlendMode::MaximumIntensity: return count == 0 || hi > extreme;
       case BlendMode::MinimumIntensity: return count == 0 || lo < extreme;
@@ -124,7 +132,7 @@ struct IntervalMarcher {
 
   /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
   SS_FUNC bool composite(vec4f c, vec3f p) {
-    if (f->shade) {
+    if (!Plain && f->shade) {
       vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p);
       c.x = rgb.x;
       c.y = rgb.y;
@@ -200,7 +208,7 @@ struct IntervalMarcher {
     const float t = t0 + float(k) * f->dt;
     const vec3f p = ray.org + ray.dir * t;
     ++samples;
-    if (f->blend == BlendMode::Composite) {
+    if (Plain || f->blend == BlendMode::Composite) {
       const vec4f c = classifySample(*f, *s, p);  // lookup(f->tf, s->sample(p)); dependent components
       return c.w > 0.f ? composite(c, p) : true;
     }
@@ -301,7 +309,8 @@ struct IntervalMarcher {
 /// Premultiplied RGBA of pixel (px, py); row 0 is the bottom row (OpenGL convention).
 /// `Traversal` >= 0 fixes the traversal at compile time (the CUDA kernels, one per traversal);
 /// -1 reads f.traversal.
-template <class Sampler, int Traversal = -1>
+/// `Plain` (only for frames where isPlainFrame holds) compiles the composite path alone.
+template <class Sampler, int Traversal = -1, bool Plain = false>
 SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) {
   const PrimaryRay p = primaryRay(f, px, py);
   const Ray& r = p.r;
@@ -311,9 +320,9 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
 
-  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
+  IntervalMarcher<Sampler, Plain> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
                              0.f, 0u, -1};
-  if (f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
+  if (!Plain && f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
     const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
     const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
     m.lightW = head ? toEye : normalize(f.lightDir);
@@ -353,8 +362,8 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
     return true;
   };
   float a = tEnter, b = tExit;
-  if (f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {
-    if (f.cut.cropping) {
+  if (Plain || f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {
+    if (!Plain && f.cut.cropping) {
       // VTK starts cropped rays on the face of the first drawn region itself, not one step in
       // (measured against vtkGPUVolumeRayCastMapper: sub-volume 43.5 dB this way, 38.9 dB one
       // step in, 40.7 dB on the box's lattice).
