@@ -7,7 +7,7 @@ our ratio to the paper per cell (data set x structure), both as frame rates and 
 naive (which cancels most of the hardware and scale difference).
 
 usage: plot-paper-bench.py OURS.csv [--paper paper_results.csv] [--out DIR] [--title TEXT]
-Needs matplotlib (Debian: python3-matplotlib, installed by scripts/setup-debian.sh; not used by
+Needs matplotlib (Debian: python3-matplotlib; SPACESKIP_PLOTS=1 bash scripts/setup-debian.sh; not used by
 the tests or CI).
 """
 import argparse
@@ -22,7 +22,7 @@ try:
     import matplotlib.pyplot as plt
 except ImportError:  # a clear message rather than a traceback
     sys.exit("plot-paper-bench.py needs matplotlib: apt-get install python3-matplotlib "
-             "(or bash scripts/setup-debian.sh)")
+             "(or SPACESKIP_PLOTS=1 bash scripts/setup-debian.sh)")
 
 PAPER_KEYS = ["naive", "lbvh", "cpu_shallow", "cpu_mls32", "cpu_mls128", "gpu_shallow", "gpu_mls32",
               "gpu_mls128", "hybrid"]
@@ -152,7 +152,8 @@ def main():
     # paper's (at its full dims) hatched beside them.
     fig, ax = grid_axes(len(sets), w=5.0)
     for i, ds in enumerate(sets):
-        vs = [v for v in variants if (ds, v) in cell and v not in ("naive",) and (metric(ds, v, "build_s") or 0) > 0]
+        # Builders with nothing to build (naive, grid: classification only) are left out.
+        vs = [v for v in variants if (ds, v) in cell and (metric(ds, v, "build_s") or 0) > 1e-6]
         xs = list(range(len(vs)))
         ours = [voxels(cell[(ds, v)]["dims"]) / metric(ds, v, "build_s") for v in vs]
         theirs = []
