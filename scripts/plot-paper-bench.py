@@ -6,7 +6,7 @@ Skipping": Fig. 3 (frame rates per data set and structure), Fig. 4 (build rates,
 our ratio to the paper per cell (data set x structure), both as frame rates and as speed-up over
 naive (which cancels most of the hardware and scale difference).
 
-usage: plot-paper-bench.py OURS.csv [--paper paper_results.csv] [--out DIR] [--title TEXT]
+usage: plot-paper-bench.py OURS.csv [MORE.csv...] [--paper paper_results.csv] [--out DIR] [--title TEXT]
 Needs matplotlib (Debian: python3-matplotlib; SPACESKIP_PLOTS=1 bash scripts/setup-debian.sh; not used by
 the tests or CI).
 """
@@ -46,8 +46,8 @@ def voxels(dims):
     return x * y * z
 
 
-def read_ours(path):
-    rows = [r for r in csv.DictReader(open(path)) if r.get("status", "ok") == "ok"]
+def read_ours(paths):
+    rows = [r for path in paths for r in csv.DictReader(open(path)) if r.get("status", "ok") == "ok"]
     sets, variants, cell = [], [], {}
     for r in rows:
         if r["dataset"] not in sets:
@@ -107,7 +107,7 @@ def color(k):
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("ours")
+    ap.add_argument("ours", nargs="+", help="one or more CSVs of bench --paper (rows are merged)")
     ap.add_argument("--paper", default=os.path.join(here, "..", "docs", "results", "paper-bench", "paper",
                                                     "paper_results.csv"))
     ap.add_argument("--out", default=".")
@@ -115,7 +115,7 @@ def main():
     a = ap.parse_args()
     sets, variants, cell = read_ours(a.ours)
     if not sets:
-        sys.exit("no measured rows in " + a.ours)
+        sys.exit("no measured rows in " + " ".join(a.ours))
     paper = read_paper(a.paper)
     os.makedirs(a.out, exist_ok=True)
     sub = (" - " + a.title) if a.title else ""
