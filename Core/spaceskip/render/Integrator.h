@@ -180,31 +180,93 @@ struct IntervalMarcher {
     }
   }
 
-  SS_FUNC bool operator()(float a, float b) {
+  /// The samples of interval [a, b) not taken yet: k in [kBegin, kEnd). Marks them as taken.
+  SS_FUNC void range(float a, float b, int64_t& kBegin, int64_t& kEnd) {
     const float dt = f->dt;
-    int64_t kBegin = int64_t(ceilf((a - t0) / dt));
-    int64_t kEnd = int64_t(ceilf((b - t0) / dt));
+    kBegin = int64_t(ceilf((a - t0) / dt));
+    kEnd = int64_t(ceilf((b - t0) / dt));
     if (kBegin < nextK) kBegin = nextK;
-    const bool comp = f->blend == BlendMode::Composite;
-    for (int64_t k = kBegin; k < kEnd; ++k) {
-      float t = t0 + float(k) * dt;
-      const vec3f p = ray.org + ray.dir * t;
-      bool go;
-      if (comp) {
-        vec4f c = lookup(f->tf, s->sample(p));
-        go = c.w > 0.f ? composite(c, p) : true;
+    if (kEnd > nextK) nextK = kEnd;
+  }
+
+  /// Sample k of the ray; false: terminate.
+  SS_FUNC bool take(int64_t k) {
+    const float t = t0 + float(k) * f->dt;
+    const vec3f p = ray.org + ray.dir * t;
+    ++samples;
+    if (f->blend == BlendMode::Composite) {
+      const vec4f c = lookup(f->tf, s->sample(p));
+      return c.w > 0.f ? composite(c, p) : true;
+    }
+    return blendSample(s->sample(p), p);
+  }
+
+  /// Every sample of [a, b) in one loop (Naive, and the last step of cropping's edge cases).
+  SS_FUNC bool operator()(float a, float b) {
+    int64_t k, kEnd;
+    range(a, b, k, kEnd);
+    for (; k < kEnd; ++k)
+      if (!take(k)) return false;
+    return true;
+  }
+
+  /// Walks a traversal iterator (Traversal.h) the way a CPU core likes it: consecutive
+  /// intervals are merged into runs and each run is marched in one tight loop (the samples are
+  /// the same: intervals that touch share their end points). With value ranges every interval
+  /// is marched before the next brick is decided. false: terminated.
+  template <class Iter>
+  SS_FUNC bool marchRuns(Iter& it) {
+    const bool eachOnItsOwn = f->grid.vmin != nullptr;
+    float ra = 0.f, rb = 0.f;
+    bool have = false;
+    for (;;) {
+      float a, b;
+      const Step st = it.next(*this, a, b);
+      if (st == Step::Done) break;
+      if (st != Step::Interval) continue;
+      if (have && a == rb) {
+        rb = b;
       } else {
-        go = blendSample(s->sample(p), p);
+        if (have && !(*this)(ra, rb)) return false;
+        ra = a;
+        rb = b;
+        have = true;
       }
-      if (!go) {
-        samples += unsigned(k + 1 - kBegin);
-        nextK = k + 1;
-        return false;
+      if (eachOnItsOwn) {
+        have = false;
+        if (!(*this)(ra, rb)) return false;
       }
     }
-    if (kEnd > kBegin) samples += unsigned(kEnd - kBegin);
-    if (kEnd > nextK) nextK = kEnd;
-    return true;
+    return have ? (*this)(ra, rb) : true;
+  }
+
+  /// The iterator's driver for this processor: on a GPU one traversal step or one sample per
+  /// loop iteration (march), on a CPU whole runs (marchRuns). Same samples either way.
+  template <class Iter>
+  SS_FUNC bool walk(Iter& it) {
+#ifdef __CUDA_ARCH__
+    return march(it);
+#else
+    return marchRuns(it);
+#endif
+  }
+
+  /// Walks a traversal iterator (Traversal.h), one traversal step or one sample per iteration,
+  /// so neighbouring rays of a warp advance together. false: terminated.
+  template <class Iter>
+  SS_FUNC bool march(Iter& it) {
+    int64_t k = 0, kEnd = 0;
+    for (;;) {
+      if (k < kEnd) {
+        if (!take(k)) return false;
+        ++k;
+        continue;
+      }
+      float a, b;
+      const Step st = it.next(*this, a, b);
+      if (st == Step::Done) return true;
+      if (st == Step::Interval) range(a, b, k, kEnd);
+    }
   }
 
   /// The pixel's premultiplied RGBA once the march is over.
@@ -228,21 +290,6 @@ struct IntervalMarcher {
       default: return acc;
     }
   }
-};
-
-template <class Sampler>
-struct HybridLeaf {
-  IntervalMarcher<Sampler>* m;
-  vec3f inv;
-  SS_FUNC bool operator()(int, float a, float b) {
-    return traverseGrid(m->f->grid, m->ray, inv, a, b, *m);
-  }
-};
-
-template <class Sampler>
-struct TreeLeaf {
-  IntervalMarcher<Sampler>* m;
-  SS_FUNC bool operator()(int, float a, float b) { return (*m)(a, b); }
 };
 
 /// Premultiplied RGBA of pixel (px, py); row 0 is the bottom row (OpenGL convention).
@@ -281,14 +328,20 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
     }
     switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
       case TraversalKind::Naive: return m(a, b);
-      case TraversalKind::Grid: return traverseGrid(f.grid, r, inv, a, b, m);
+      case TraversalKind::Grid: {
+        GridIter it;
+        it.init(f.grid, r, inv, a, b);
+        return m.walk(it);
+      }
       case TraversalKind::Tree: {
-        TreeLeaf<Sampler> leaf{&m};
-        return traverseTree(f.tree, r, inv, a, b, leaf);
+        TreeIter it;
+        it.init(f.tree, r, inv, a, b);
+        return m.walk(it);
       }
       case TraversalKind::Hybrid: {
-        HybridLeaf<Sampler> leaf{&m, inv};
-        return traverseTree(f.tree, r, inv, a, b, leaf);
+        HybridIter it;
+        it.init(f.tree, f.grid, r, inv, a, b);
+        return m.walk(it);
       }
     }
     return true;
