@@ -285,6 +285,17 @@ BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemTex
   return row;
 }
 
+/// `s` with quotes, backslashes and control characters escaped for a JSON string.
+std::string jsonEscape(const std::string& s) {
+  std::string o;
+  for (const char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) o += ' ';
+    else o += c;
+  }
+  return o;
+}
+
 std::string dimsText(vec3l d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
 }
@@ -572,7 +583,7 @@ int cmdBenchPaper(const Options& o) {
            << ", \"height\": " << s.height << ", \"leaves\": " << s.leaves << ", \"brick_occupancy\": " << s.occupancy
            << ", \"voxel_occupancy_pct\": " << voxelOcc << ", \"paper_occupancy_pct\": " << ds.occupancyPct
            << ", \"samples_per_frame\": " << r.samples << ", \"vs_naive_kernel\": " << vsNaive
-           << (s.choice.empty() ? std::string() : ", \"choice\": \"" + s.choice + "\"") << "}";
+           << (s.choice.empty() ? std::string() : ", \"choice\": \"" + jsonEscape(s.choice) + "\"") << "}";
       progress.step(done, std::string(ds.name) + " " + pv.key + " done");
     }
   }
