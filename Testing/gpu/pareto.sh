@@ -8,7 +8,7 @@
 set -uo pipefail
 out=${1:?usage: pareto.sh OUTDIR CLI} cli=${2:?}
 mkdir -p "$out"
-shapes=${SHAPES:-aneurism xmas_tree magnetic stag_beetle kingsnake menger rm nbody}
+shapes=${SHAPES:-aneurism xmas_tree magnetic stag_beetle kingsnake menger richtmyer_meshkov nbody}
 for be in ${BACKENDS:-cuda cpu}; do
   n=${N:-256}; size=${SIZE:-512x512}
   [ "$be" = cpu ] && n=${CPU_N:-128} && size=${CPU_SIZE:-256x256}
