@@ -18,6 +18,7 @@
 #include "vtkSpaceSkipRepresentationModule.h" // for export macro
 
 #include <string> // for std::string
+#include <vector> // for std::vector
 
 class vtkSpaceSkippingVolumeMapper;
 
@@ -84,6 +85,19 @@ protected:
   /// The base class hands the colour map's Magnitude/Component choice only to VTK's own
   /// mappers; this passes it to ours as well.
   void UpdateMapperParameters() override;
+
+  ///@{
+  /// In pieces (MPI): one ghost layer is requested and kept (the base class crops it away), the
+  /// whole extent and the whole data's scalar range go to the mapper, which samples the whole
+  /// image's lattice and draws its own cells only; the pieces then composite to the serial image.
+  int RequestUpdateExtent(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+  int RequestData(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+  /// Finite ranges of the colour array over all ranks (lo, hi per component, then the
+  /// magnitude's); empty in a serial run.
+  std::vector<double> WholeRanges;
+  ///@}
 
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
