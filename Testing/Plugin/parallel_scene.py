@@ -61,7 +61,7 @@ if stock:
 else:
     # Early ray termination stops a ray at opacity 0.99 inside one piece; the pieces behind it
     # still add their (at most 1 %) share: off for the exact comparison (README, Parallel).
-    disp.EarlyRayTermination = 0
+    disp.EarlyRayTermination = 1 if os.environ.get("SPACESKIP_PARALLEL_ERT") else 0
 progress("scene set up; remote rendering available: %s"
          % view.GetClientSideObject().GetRemoteRenderingAvailable())
 Render(view)

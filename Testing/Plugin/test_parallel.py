@@ -72,7 +72,7 @@ if a is not None:
              % (100 * ssptest.lit_fraction(a)))
 env_args = []
 for name in ("DISPLAY", "PYTHONPATH", "SPACESKIP_PIECE_BIAS", "SPACESKIP_PLUGIN", "SPACESKIP_DATA", "SPACESKIP_TEMP",
-             "SPACESKIP_BASELINES"):
+             "SPACESKIP_BASELINES", "SPACESKIP_PIECE_BIAS", "SPACESKIP_PARALLEL_ERT"):
     if name in os.environ:
         env_args += ["-x", name]
 for n in ranks:
