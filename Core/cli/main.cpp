@@ -46,8 +46,9 @@ const char* kUsage = R"(usage:
   spaceskip generate SHAPE --dims X Y Z [--seed N] -o FILE(.nrrd|_XxYxZ_TYPE.raw)
       SHAPE: menger nbody shell noise rm vessels
   spaceskip render VOLUME -o out.png [options]
-  spaceskip accuracy VOLUME [--builder B] [--size WxH] [options]
-      speed/accuracy trade: sample distance x filter x ERT vs PSNR/SSIM against a fine reference, and fps
+  spaceskip accuracy VOLUME [--builder B] [--size WxH] [--csv FILE] [options]
+      speed/accuracy trade: sample distance 0.25-4 voxels x filter x ERT x jitter vs PSNR/SSIM
+      against a fine reference, and fps (scripts/plot_pareto.py draws the Pareto fronts)
   spaceskip bench VOLUME... [--builders b1,b2,...] [--frames N] [--json FILE] [--csv FILE] [options]
       each builder may carry suffixes overriding --leaf/--mls/--bins/--brick, e.g.
       --builders naive,grid,lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid
@@ -341,34 +342,49 @@ int cmdAccuracy(const Options& o) {
   engine.render(cam, w, h, reference);
   std::printf("reference: sample distance %g (1/8 voxel), exact filtering, no ERT, backend %s\n",
               ref.sampleDistance, engine.backendName());
-  std::printf("%-10s %-9s %-5s %10s %10s %8s %9s %9s\n", "dt/voxel", "filter", "ert", "max_diff", "psnr_db", "ssim",
-              "fps", "Msmp/frm");
+  std::printf("%-10s %-9s %-5s %-6s %10s %10s %8s %9s %9s %9s\n", "dt/voxel", "filter", "ert", "jitter", "max_diff",
+              "psnr_db", "ssim", "fps", "kern_fps", "Msmp/frm");
+  std::ofstream csv;
+  if (o.has("--csv")) {
+    csv.open(o.get("--csv", ""));
+    if (!csv) throw std::runtime_error("cannot write " + o.get("--csv", ""));
+    csv << "dataset,backend,builder,dt_voxel,filter,ert,jitter,max_diff,psnr_db,ssim,fps,kernel_fps,msamples\n";
+  }
   std::vector<FilterMode> filters{FilterMode::Exact};
   if (std::string(engine.backendName()) == "cuda") filters.push_back(FilterMode::Hardware);
-  for (double f : {0.25, 0.5, 1.0, 2.0}) {
+  for (double f : {0.25, 0.5, 1.0, 2.0, 4.0}) {
     for (FilterMode fm : filters) {
       for (bool ert : {false, true}) {
-        RenderParams rp;
-        rp.sampleDistance = f * minSpacing;
-        rp.filter = fm;
-        rp.ertThreshold = ert ? 0.99 : 2.0;
-        engine.setRenderParams(rp);
-        Image img;
-        engine.render(cam, w, h, img);  // warm-up
-        double t = 0;
-        const int frames = 3;
-        for (int i = 0; i < frames; ++i) {
+        for (bool jitter : {false, true}) {
+          RenderParams rp;
+          rp.sampleDistance = f * minSpacing;
+          rp.filter = fm;
+          rp.ertThreshold = ert ? 0.99 : 2.0;
+          rp.jitter = jitter;
+          engine.setRenderParams(rp);
+          Image img;
+          engine.render(cam, w, h, img);  // warm-up
+          double t = 0, tk = 0;
+          const int frames = 3;
+          for (int i = 0; i < frames; ++i) {
+            engine.render(cam, w, h, img);
+            t += engine.frameStats().seconds;
+            tk += engine.frameStats().deviceSeconds > 0 ? engine.frameStats().deviceSeconds : engine.frameStats().seconds;
+          }
+          rp.countSamples = true;
+          engine.setRenderParams(rp);
           engine.render(cam, w, h, img);
-          t += engine.frameStats().seconds;
+          ImageDiff d = compareImages(reference, img);
+          const double s = ssim(reference, img), ms = double(engine.frameStats().samples) * 1e-6;
+          const char* fname = fm == FilterMode::Exact ? "exact" : "hardware";
+          std::printf("%-10.2f %-9s %-5s %-6s %10.4f %10.2f %8.4f %9.2f %9.2f %9.2f\n", f, fname, ert ? "0.99" : "off",
+                      jitter ? "on" : "off", d.maxAbs, d.psnr, s, frames / t, frames / tk, ms);
+          std::fflush(stdout);
+          if (csv.is_open())
+            csv << o.positional[0] << ',' << engine.backendName() << ',' << builderName(engine.buildStats().builder) << ','
+                << f << ',' << fname << ',' << (ert ? "0.99" : "off") << ',' << (jitter ? "on" : "off") << ','
+                << d.maxAbs << ',' << d.psnr << ',' << s << ',' << frames / t << ',' << frames / tk << ',' << ms << '\n';
         }
-        rp.countSamples = true;
-        engine.setRenderParams(rp);
-        engine.render(cam, w, h, img);
-        ImageDiff d = compareImages(reference, img);
-        std::printf("%-10.2f %-9s %-5s %10.4f %10.2f %8.4f %9.2f %9.2f\n", f, fm == FilterMode::Exact ? "exact" : "hardware",
-                    ert ? "0.99" : "off", d.maxAbs, d.psnr, ssim(reference, img), frames / t,
-                    double(engine.frameStats().samples) * 1e-6);
-        std::fflush(stdout);
       }
     }
   }

@@ -50,9 +50,13 @@ struct BuildParams {
   /// Engine::setBuildParams throws std::invalid_argument for 1 and negative values.
   int bins = 4;
   int brick = 8;        ///< macro-cell edge in cells (classification granularity)
+  /// Builder Auto, progressive refinement: after an edit that changes the occupancy, when the
+  /// kept structure took longer than this to build, the first frame is drawn with Grid (no build
+  /// beyond classification) and the kept structure is rebuilt for the frame after. < 0: never.
+  double autoQuickBuildSeconds = 1e-3;
   bool operator==(const BuildParams& o) const {
     return builder == o.builder && leaf == o.leaf && maxLeafSize == o.maxLeafSize &&
-           bins == o.bins && brick == o.brick;
+           bins == o.bins && brick == o.brick && autoQuickBuildSeconds == o.autoQuickBuildSeconds;
   }
   bool operator!=(const BuildParams& o) const { return !(*this == o); }
 };

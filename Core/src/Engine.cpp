@@ -105,6 +105,9 @@ struct Engine::Impl {
   struct AutoState {
     std::vector<BuildParams> candidates;
     std::vector<double> seconds;  ///< measured frame time per candidate, < 0: not yet
+    std::vector<double> buildSeconds;  ///< last build time per candidate, < 0: not yet
+    bool standIn = false;         ///< this frame draws Grid while the kept one waits (refinement)
+    bool refined = false;         ///< the kept structure was rebuilt after a stand-in frame
     int current = -1;             ///< the candidate built now
     bool exploring = false;
     double occupancy = -1;        ///< when the choice was made
@@ -131,9 +134,17 @@ struct Engine::Impl {
             with(BuilderKind::KdTreeCPU, 32)};
   }
 
+  /// The Grid candidate's index, -1 when there is none.
+  int gridCandidate() const {
+    for (size_t i = 0; i < autoState.candidates.size(); ++i)
+      if (autoState.candidates[i].builder == BuilderKind::Grid) return int(i);
+    return -1;
+  }
+
   void startAutoExploration() {
     autoState.candidates = autoCandidates();
     autoState.seconds.assign(autoState.candidates.size(), -1.0);
+    autoState.buildSeconds.assign(autoState.candidates.size(), -1.0);
     autoState.current = 0;
     autoState.exploring = true;
     autoState.choice = "Auto: measuring " + std::to_string(autoState.candidates.size()) + " structures";
@@ -144,6 +155,7 @@ struct Engine::Impl {
   void autoFrameDone(double seconds, int width, int height) {
     AutoState& a = autoState;
     if (!a.exploring) {
+      if (a.standIn) return;  // Grid stood in for the kept structure: not its frame time
       if (width != a.width || height != a.height) {
         startAutoExploration();
         return;
@@ -298,6 +310,8 @@ struct Engine::Impl {
   void update() {
     if (!haveVolume) throw std::runtime_error("no volume set");
     if (!haveTF) throw std::runtime_error("no transfer function set");
+    const bool refineNow = autoState.standIn;  // the last frame stood in: build the kept one now
+    bool edited = false;                       // this update's classification changed the occupancy
     const CropClip cc = cropClipFor();
     if (cc != cropClip) {
       cropClip = cc;
@@ -317,7 +331,7 @@ struct Engine::Impl {
       ++counters.classifications;
       if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
       opacityDirty = cropClipDirty = false;
-      if (changed) buildDirty = true;
+      if (changed) buildDirty = edited = true;
       if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
           std::fabs(backend->occupiedFraction() - autoState.occupancy) > kAutoReexplore)
         startAutoExploration();
@@ -333,9 +347,24 @@ struct Engine::Impl {
       backend->setTransferTable(tableForBlend(tf, float(step), render.blend), lo, scale);
       tableDirty = colorDirty = false;
     }
+    if (refineNow && !buildDirty) buildDirty = true;
     if (buildDirty) {
       const bool isAuto = build.builder == BuilderKind::Auto;
-      BuildParams p = isAuto ? autoState.candidates[size_t(autoState.current)] : build;
+      int use = isAuto ? autoState.current : -1;
+      if (isAuto) {
+        // Progressive refinement: right after an edit, a kept structure that is slow to build
+        // gives way to Grid (its occupancy grid is classification's output) for one frame; the
+        // image is the same (lossless), only that frame's speed differs.
+        AutoState& a = autoState;
+        const int grid = gridCandidate();
+        const double kept = a.buildSeconds.empty() ? -1.0 : a.buildSeconds[size_t(a.current)];
+        a.standIn = edited && !a.exploring && grid >= 0 && grid != a.current &&
+                    a.candidates[size_t(a.current)].builder != BuilderKind::Naive && build.autoQuickBuildSeconds >= 0 &&
+                    kept > build.autoQuickBuildSeconds;
+        a.refined = refineNow && !a.standIn;
+        if (a.standIn) use = grid;
+      }
+      BuildParams p = isAuto ? autoState.candidates[size_t(use)] : build;
       const BuilderInfo& info = builderInfo(p.builder);
       if (!runsOnCpu(info) && backend->kind() != BackendKind::CUDA) {
         warn(std::string("builder ") + info.name + " needs the CUDA backend; building " + builderName(info.fallback) +
@@ -354,7 +383,13 @@ struct Engine::Impl {
       s.builder = p.builder;
       s.classifySeconds = stats.classifySeconds;
       s.occupancy = backend->occupiedFraction();
-      s.choice = isAuto ? autoState.choice : std::string();
+      if (isAuto) {
+        autoState.buildSeconds[size_t(use)] = s.seconds;
+        s.choice = autoState.choice;
+        if (autoState.standIn)
+          s.choice += std::string("; this frame: Grid after the edit, ") +
+                      builderName(autoState.candidates[size_t(autoState.current)].builder) + " next frame";
+      }
       stats = s;
       ++counters.builds;
       buildDirty = false;
