@@ -108,6 +108,7 @@ struct Engine::Impl {
     std::vector<double> buildSeconds;  ///< last build time per candidate, < 0: not yet
     bool standIn = false;         ///< this frame draws Grid while the kept one waits (refinement)
     bool refined = false;         ///< the kept structure was rebuilt after a stand-in frame
+    bool freshEstimate = false;   ///< the next frame's time replaces the kept one's estimate
     int current = -1;             ///< the candidate built now
     bool exploring = false;
     double occupancy = -1;        ///< when the choice was made
@@ -170,13 +171,17 @@ struct Engine::Impl {
       // (running mean of the last few); when it falls clearly behind another candidate's
       // estimate, that one is built and measured in turn. On H100 Menger 1024^3 the axis-aligned
       // view favoured Grid while oblique views favoured Naive by 1.7x: one probe is not enough.
+      // The first frame after a switch replaces the new structure's estimate (it was measured at
+      // another view, maybe long ago); later frames blend in.
       double& e = a.seconds[size_t(a.current)];
-      e = 0.75 * e + 0.25 * seconds;
+      e = a.freshEstimate ? seconds : 0.75 * e + 0.25 * seconds;
+      a.freshEstimate = false;
       int best = a.current;
       for (size_t i = 0; i < a.seconds.size(); ++i)
         if (a.seconds[i] < a.seconds[size_t(best)]) best = int(i);
       if (best != a.current && e > kAutoSwitch * a.seconds[size_t(best)]) {
         a.current = best;
+        a.freshEstimate = true;
         ++a.switches;
         buildDirty = true;
         describeAutoChoice();
