@@ -4,8 +4,12 @@
 // Core parameters) and vtkSpaceSkipCompositor (depth readback, upload or interop, blending).
 #include "vtkSpaceSkippingVolumeMapper.h"
 
+#include "vtkCellData.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkStructuredData.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkLogger.h"
 #include "vtkMath.h"
 #include "vtkObjectFactory.h"
@@ -51,6 +55,92 @@ int BackendFromEnvironment()
     return vtkSpaceSkippingVolumeMapper::Auto;
   }
   return -1;
+}
+
+// The input as a piece of the image of extent `whole` (an empty `whole`: its own extent), and
+// the cells it draws: those its vtkGhostType cell array does not mark as duplicates of another
+// piece's. Inactive (the serial path, untouched) when the input is the whole image without ghosts.
+spaceskip::VolumePiece PieceOf(
+  vtkImageData* input, const int whole[6], const std::function<void(const std::string&)>& warn)
+{
+  spaceskip::VolumePiece piece;
+  int ext[6], w[6];
+  input->GetExtent(ext);
+  std::copy(whole, whole + 6, w);
+  bool haveWhole = w[0] <= w[1] && w[2] <= w[3] && w[4] <= w[5];
+  if (haveWhole &&
+    !(w[0] <= ext[0] && ext[1] <= w[1] && w[2] <= ext[2] && ext[3] <= w[3] && w[4] <= ext[4] &&
+      ext[5] <= w[5]))
+  {
+    warn("WholeExtent does not contain the input's extent: ignored (the input is drawn as a "
+         "whole image)");
+    haveWhole = false;
+  }
+  if (!haveWhole)
+  {
+    std::copy(ext, ext + 6, w);
+  }
+  // Owned cells, [lo, hi] inclusive in cell indices (an axis of one point has one cell).
+  int own[6];
+  for (int a = 0; a < 3; ++a)
+  {
+    own[2 * a] = ext[2 * a];
+    own[2 * a + 1] = std::max(ext[2 * a + 1] - 1, ext[2 * a]);
+  }
+  bool ghosts = false;
+  if (vtkUnsignedCharArray* g = input->GetCellData()->GetGhostArray())
+  {
+    // The first and the last cell that is not a duplicate bound the owned cells (an image
+    // piece's ghost cells are layers on its faces), as ParaView's volume representation does.
+    const vtkIdType n = g->GetNumberOfTuples();
+    const unsigned char* v = g->GetPointer(0);
+    const unsigned char dup = vtkDataSetAttributes::DUPLICATECELL;
+    vtkIdType first = 0, last = n - 1;
+    while (first < n && (v[first] & dup))
+    {
+      ++first;
+    }
+    while (last >= 0 && (v[last] & dup))
+    {
+      --last;
+    }
+    ghosts = first > 0 || last < n - 1;
+    if (first > last)
+    {
+      own[1] = own[0] - 1; // all ghost: nothing owned
+    }
+    else if (ghosts)
+    {
+      int ijk[3], ijk1[3];
+      vtkStructuredData::ComputeCellStructuredCoordsForExtent(first, ext, ijk);
+      vtkStructuredData::ComputeCellStructuredCoordsForExtent(last, ext, ijk1);
+      for (int a = 0; a < 3; ++a)
+      {
+        own[2 * a] = ijk[a];
+        own[2 * a + 1] = ijk1[a];
+      }
+    }
+  }
+  bool same = !ghosts;
+  for (int i = 0; i < 6; ++i)
+  {
+    same = same && w[i] == ext[i];
+  }
+  if (same)
+  {
+    return piece;
+  }
+  input->TransformIndexToPhysicalPoint(w[0], w[2], w[4], piece.wholeOrigin);
+  piece.wholeDims = spaceskip::vec3l{ w[1] - w[0] + 1, w[3] - w[2] + 1, w[5] - w[4] + 1 };
+  piece.offset = spaceskip::vec3l{ ext[0] - w[0], ext[2] - w[2], ext[4] - w[4] };
+  piece.ownedLo = spaceskip::vec3l{ own[0] - w[0], own[2] - w[2], own[4] - w[4] };
+  piece.ownedHi = spaceskip::vec3l{ own[1] + 1 - w[0], own[3] + 1 - w[2], own[5] + 1 - w[4] };
+  // The window and IceT hold 8 bits: a piece in front rounds up by half a unit what IceT's
+  // blend truncates (README, Parallel). SPACESKIP_PIECE_BIAS (in 1/255) overrides, for
+  // measurements.
+  const char* bias = std::getenv("SPACESKIP_PIECE_BIAS");
+  piece.followBias = static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
+  return piece;
 }
 
 double SecondsSince(std::chrono::steady_clock::time_point t0)
@@ -584,8 +674,12 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // function, the build and render parameters.
     spaceskip::Engine& engine = *d.Engine;
     d.RangeSeconds = d.Input.Update(engine, d.Warn);
-    // A block of a composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
-    const double* range = this->UseTableRange ? this->TableRange : d.Input.GetScalarRange();
+    // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
+    // composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
+    engine.setPiece(PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent, d.Warn));
+    const double* range = this->UseTableRange ? this->TableRange
+      : this->WholeScalarRange[0] <= this->WholeScalarRange[1] ? this->WholeScalarRange
+                                                               : d.Input.GetScalarRange();
     d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), range,
       d.Input.GetOpacityRange(), d.Input.GetOpacityComponent());
     d.Properties.UpdateParameters(

@@ -228,6 +228,23 @@ public:
 
   ///@{
   /**
+   * The input as one piece of a larger image (ParaView's ranks under MPI; set by
+   * vtkSpaceSkipVolumeRepresentation). WholeExtent: the extent of the whole image the input is a
+   * piece of; the rays then sample the whole image's lattice, as a serial render of it would, and
+   * the mapper draws only the input's own cells: those not marked ghost in its vtkGhostType cell
+   * array (ghost layers are read by interpolation and shading), half-open so that composited
+   * pieces give the serial image. WholeScalarRange: the whole image's range of the drawn scalars
+   * (the transfer function's table spans it on every rank). Empty (the defaults): the input's
+   * own extent and range.
+   */
+  vtkSetVector6Macro(WholeExtent, int);
+  vtkGetVector6Macro(WholeExtent, int);
+  vtkSetVector2Macro(WholeScalarRange, double);
+  vtkGetVector2Macro(WholeScalarRange, double);
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -334,6 +351,8 @@ protected:
   int VectorMode = 1; // vtkScalarsToColors::COMPONENT
   int VectorComponent = 0;
   int BlendModeOverride = -1;
+  int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  double WholeScalarRange[2] = { 1, 0 };
 
   /// vtkImageData, and composite data sets of them (see GetBounds()).
   int FillInputPortInformation(int port, vtkInformation* info) override;

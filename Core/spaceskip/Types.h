@@ -30,7 +30,9 @@ enum class BuilderKind : int {
   DistanceGrid,   ///< ours: the Grid DDA leaping through empty space with a distance field
   Auto            ///< measures a few structures (Naive among them) one frame each, keeps the fastest
 };
-enum class LeafCriterion : int { Shallow, Deep };
+/// Empty (ours): Deep, but a leaf is kept or split by its empty space, not its size
+/// (KdTreeSplit.h, kdEmptySplit); MLS is ignored.
+enum class LeafCriterion : int { Shallow, Deep, Empty };
 enum class BackendKind : int { Auto, CPU, CUDA };
 enum class FilterMode : int { Exact, Hardware };
 

@@ -314,13 +314,16 @@ template <class Sampler, int Traversal = -1, bool Plain = false>
 SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) {
   const PrimaryRay p = primaryRay(f, px, py);
   const Ray& r = p.r;
+  const Ray rl = pieceRay(f, r);  // voxels, grid and tree (a piece's own index space; RayGen.h)
   const vec3f inv = p.inv;
   const vec3f nearW = p.nearW, dirW = p.dirW;
   const float tEnter = p.tEnter, tExit = p.tExit;
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
+  float ownA = 0.f, ownB = 0.f;  // a piece of the volume (MPI): where this ray is its own
+  if (f.lattice.active && !ownedInterval(f, r, inv, ownA, ownB)) return vec4f{0, 0, 0, 0};
 
-  IntervalMarcher<Sampler, Plain> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
+  IntervalMarcher<Sampler, Plain> m{&f, &s, rl, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
                              0.f, 0u, -1};
   if (!Plain && f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
     const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
@@ -336,26 +339,31 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   float lead = f.firstSample * f.dt +
                      (f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f);
   bool anchored = false;
-  auto march = [&](float a, float b) -> bool {
+  auto march = [&](float a, float b) -> bool {  // [a, b): a drawn part of the whole ray
     if (!anchored) {
       m.t0 = a + lead;
       anchored = true;
+    }
+    if (f.lattice.active) {  // anchored on the whole ray above; draws its owned part only
+      a = ss_max(a, ownA);
+      b = ss_min(b, ownB);
+      if (!(a < b)) return true;
     }
     switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
       case TraversalKind::Naive: return m(a, b);
       case TraversalKind::Grid: {
         GridIter it;
-        it.init(f.grid, r, inv, a, b);
+        it.init(f.grid, rl, inv, a, b);
         return m.walk(it);
       }
       case TraversalKind::Tree: {
         TreeIter it;
-        it.init(f.tree, r, inv, a, b);
+        it.init(f.tree, rl, inv, a, b);
         return m.walk(it);
       }
       case TraversalKind::Hybrid: {
         HybridIter it;
-        it.init(f.tree, f.grid, r, inv, a, b);
+        it.init(f.tree, f.grid, rl, inv, a, b);
         return m.walk(it);
       }
     }
@@ -374,13 +382,13 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
       // sample is still taken (clamped to the box), as vtkGPUVolumeRayCastMapper does; every
       // traversal alike.
       m.t0 = a + lead;
-      m(m.t0, m.t0 + f.dt);
+      if (!f.lattice.active || ownsClampedSample(f, r.org + r.dir * m.t0)) m(m.t0, m.t0 + f.dt);
     } else {
       march(a, b);
     }
   }
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
-  return m.result();
+  return f.lattice.active ? pieceResult(f, m.result(), ownB, tExit) : m.result();
 }
 
 }  // namespace spaceskip
