@@ -125,6 +125,11 @@ struct RenderParams {
   // the box centre normal to z, with one warning).
   double sliceOrigin[3] = {0, 0, 0};
   double sliceNormal[3] = {0, 0, 1};
+  /// true: read the slice's sample where vtkGPUVolumeRayCastMapper (VTK 9.2 to 9.4) reads it: at
+  /// the plane point's texture coordinate without its half-texel adjustment, i.e. index
+  /// i (N+1)/N - 1/2 per axis (N cells), up to half a voxel off the plane (ParaView's images);
+  /// false: at the plane point itself.
+  bool sliceAsVTK = true;
 };
 /// At most this many clipping planes (VTK's mappers take six).
 constexpr int kMaxClipPlanes = 6;

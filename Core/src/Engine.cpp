@@ -487,6 +487,7 @@ void fillSlice(Impl& d, FrameView& f) {
   const mat4 indexToWorld = vol.indexToWorld();
   const double* L = indexToWorld.m;  // column-major: index axis k is column k
   for (int k = 0; k < 3; ++k) f.slicePlane[k] = float(n[0] * L[k * 4] + n[1] * L[k * 4 + 1] + n[2] * L[k * 4 + 2]);
+  f.sliceAsVTK = r.sliceAsVTK ? 1 : 0;
   f.slicePlane[3] = float(n[0] * (vol.origin[0] - o[0]) + n[1] * (vol.origin[1] - o[1]) + n[2] * (vol.origin[2] - o[2]));
 }
 

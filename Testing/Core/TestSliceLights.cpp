@@ -84,6 +84,8 @@ std::vector<Mode> sliceAndLightModes(const Volume& v) {
   std::vector<Mode> m;
   RenderParams r = sliceParams(cx + 3.3, cy, cz, 0.6, 0.3, 0.74);
   m.push_back({"slice-oblique", r});
+  r.sliceAsVTK = false;
+  m.push_back({"slice-oblique-at-the-plane", r});
   r.shade = true;
   r.specular = 0.4;
   m.push_back({"slice-shade-headlight", r});
@@ -144,17 +146,25 @@ TEST(Slice, TheRaysValueIsTheSampleOnThePlane) {
   TransferFunction tf = TransferFunction::fromPoints({{0, 0.f, 0.f, 1.f, 0.1f}, {248, 1.f, 0.f, 0.f, 0.5f}}, 0, 248, 256);
   RenderParams s = sliceParams(10.25, 0, 0, 1, 0, 0);
   s.sampleDistance = 0.1;
+  s.sliceAsVTK = false;
   Image a = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 48, BackendKind::CPU, s);
   const float f = 82.f / 248.f;
   const vec4f c = centre(a);
   EXPECT_NEAR(c.w, 0.1f + 0.4f * f, 2e-3f);
   EXPECT_NEAR(c.x / c.w, f, 5e-3f);
   EXPECT_NEAR(c.z / c.w, 1.f - f, 5e-3f);
+  // Where VTK's shader reads it: x = 10.25 * 32 / 31 - 0.5 (31 cells), the value 80.65.
+  s.sliceAsVTK = true;
+  const float fv = (10.25f * 32.f / 31.f - 0.5f) * 8.f / 248.f;
+  EXPECT_NEAR(centre(test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 48, BackendKind::CPU, s)).w,
+              0.1f + 0.4f * fv, 2e-3f);
+  s.sliceAsVTK = false;
   // Moving the plane changes the value; seen along z instead, each pixel sees its own x.
   s.sliceOrigin[0] = 20.5;
   EXPECT_NEAR(centre(test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 48, BackendKind::CPU, s)).w,
               0.1f + 0.4f * 164.f / 248.f, 2e-3f);
   RenderParams z = sliceParams(0, 0, 15.5, 0, 0, 1);
+  z.sliceAsVTK = false;
   Image along = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 0, 0, false, 48, BackendKind::CPU, z);
   Image mip = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 0, 0, false, 48, BackendKind::CPU,
                                [] { RenderParams m; m.blend = BlendMode::MaximumIntensity; return m; }());
@@ -215,7 +225,8 @@ TEST(Slice, ABadPlaneFallsBackToTheCentreWithOneWarning) {
   e.render(test::orbit(v, 0, 0), 32, 32, img);
   ASSERT_EQ(said.size(), 1u);
   EXPECT_NE(said[0].find("slice"), std::string::npos);
-  // The centre plane z = 11.5 holds the value 115: opacity 0.2 + 0.4 * 0.5.
+  // The centre plane z = 11.5 holds the value 115: opacity 0.2 + 0.4 * 0.5 (VTK reads it at
+  // 11.5 * 24 / 23 - 0.5 = 11.5 too: the centre is where its coordinates are exact).
   EXPECT_NEAR(centre(img).w, 0.4f, 2e-3f);
 }
 

@@ -84,6 +84,7 @@ struct FrameView {
   vec3f lightAmbient;       ///< sum of the lights' ambient colours * intensities
   LightView lights[kMaxLights];
   float slicePlane[4];      ///< slice blend mode: the index-space plane s.p + s[3] = 0
+  int sliceAsVTK;           ///< slice: sample where vtkGPUVolumeRayCastMapper does (RenderParams)
 };
 
 }  // namespace spaceskip

@@ -167,14 +167,23 @@ struct IntervalMarcher {
 
   /// Slice blend mode (vtkVolumeShaderComposer, VTK 9.2): the ray's value is its one sample where
   /// it meets the plane, through the transfer functions (raw opacity, shaded when shading is on),
-  /// when that point lies in [a, b), a drawn part of the ray; no marching. false: done.
+  /// when that point lies in [a, b), a drawn part of the ray; no marching. false: done. With
+  /// sliceAsVTK the sample is read where VTK's shader reads it (its unadjusted texture
+  /// coordinates: up to half a voxel off the plane), else at the plane point itself.
   SS_FUNC bool slice(float a, float b) {
     const float* P = f->slicePlane;
     const float den = P[0] * ray.dir.x + P[1] * ray.dir.y + P[2] * ray.dir.z;
     if (den == 0.f) return true;  // parallel to the plane: never meets it
     const float t = -(P[0] * ray.org.x + P[1] * ray.org.y + P[2] * ray.org.z + P[3]) / den;
     if (!(t >= a && t < b)) return true;
-    const vec3f p = ray.org + ray.dir * t;
+    vec3f p = ray.org + ray.dir * t;
+    if (f->sliceAsVTK) {
+      // VTK 9.2 takes the plane point's texture coordinate over the box (0..1 from the first to
+      // the last point) and samples the texture of N+1 texels there: index i(N+1)/N - 1/2.
+      const vec3f N = f->boxHi;
+      p = vec3f{N.x > 0.f ? p.x * (N.x + 1.f) / N.x - 0.5f : p.x, N.y > 0.f ? p.y * (N.y + 1.f) / N.y - 0.5f : p.y,
+                N.z > 0.f ? p.z * (N.z + 1.f) / N.z - 0.5f : p.z};
+    }
     vec4f c = lookup(f->tf, s->sample(p));
     if (f->shade && c.w > 0.f) {
       const vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p);

@@ -105,7 +105,9 @@ int TestSpaceSkippingVolumeSlice(int argc, char* argv[])
   SS_CHECK(sstest::MaxDiff(before, moved) > 30);
 
   // No slice function, or one that is not a plane: one warning each mapper, the centre plane.
-  SS_CHECK(messages->WarningCount == 0);
+  // (Until here only the GPU builders' fallbacks may have warned, on machines without CUDA.)
+  SS_CHECK(messages->Warnings.find("slice") == std::string::npos);
+  messages->Clear();
   vtkNew<vtkSphere> sphere;
   prop->SetSliceFunction(sphere);
   auto centre1 = t.Stage.Shot();
