@@ -4,12 +4,19 @@
 // Core parameters) and vtkSpaceSkipCompositor (depth readback, upload or interop, blending).
 #include "vtkSpaceSkippingVolumeMapper.h"
 
+#include "vtkCellData.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkStructuredData.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkLogger.h"
+#include "vtkMath.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkRenderer.h"
+#include "vtkSpaceSkipBlockRenderer.h"
 #include "vtkSpaceSkipCompositor.h"
 #include "vtkSpaceSkipInputConverter.h"
 #include "vtkSpaceSkipPropertyTranslator.h"
@@ -48,6 +55,92 @@ int BackendFromEnvironment()
     return vtkSpaceSkippingVolumeMapper::Auto;
   }
   return -1;
+}
+
+// The input as a piece of the image of extent `whole` (an empty `whole`: its own extent), and
+// the cells it draws: those its vtkGhostType cell array does not mark as duplicates of another
+// piece's. Inactive (the serial path, untouched) when the input is the whole image without ghosts.
+spaceskip::VolumePiece PieceOf(
+  vtkImageData* input, const int whole[6], const std::function<void(const std::string&)>& warn)
+{
+  spaceskip::VolumePiece piece;
+  int ext[6], w[6];
+  input->GetExtent(ext);
+  std::copy(whole, whole + 6, w);
+  bool haveWhole = w[0] <= w[1] && w[2] <= w[3] && w[4] <= w[5];
+  if (haveWhole &&
+    !(w[0] <= ext[0] && ext[1] <= w[1] && w[2] <= ext[2] && ext[3] <= w[3] && w[4] <= ext[4] &&
+      ext[5] <= w[5]))
+  {
+    warn("WholeExtent does not contain the input's extent: ignored (the input is drawn as a "
+         "whole image)");
+    haveWhole = false;
+  }
+  if (!haveWhole)
+  {
+    std::copy(ext, ext + 6, w);
+  }
+  // Owned cells, [lo, hi] inclusive in cell indices (an axis of one point has one cell).
+  int own[6];
+  for (int a = 0; a < 3; ++a)
+  {
+    own[2 * a] = ext[2 * a];
+    own[2 * a + 1] = std::max(ext[2 * a + 1] - 1, ext[2 * a]);
+  }
+  bool ghosts = false;
+  if (vtkUnsignedCharArray* g = input->GetCellData()->GetGhostArray())
+  {
+    // The first and the last cell that is not a duplicate bound the owned cells (an image
+    // piece's ghost cells are layers on its faces), as ParaView's volume representation does.
+    const vtkIdType n = g->GetNumberOfTuples();
+    const unsigned char* v = g->GetPointer(0);
+    const unsigned char dup = vtkDataSetAttributes::DUPLICATECELL;
+    vtkIdType first = 0, last = n - 1;
+    while (first < n && (v[first] & dup))
+    {
+      ++first;
+    }
+    while (last >= 0 && (v[last] & dup))
+    {
+      --last;
+    }
+    ghosts = first > 0 || last < n - 1;
+    if (first > last)
+    {
+      own[1] = own[0] - 1; // all ghost: nothing owned
+    }
+    else if (ghosts)
+    {
+      int ijk[3], ijk1[3];
+      vtkStructuredData::ComputeCellStructuredCoordsForExtent(first, ext, ijk);
+      vtkStructuredData::ComputeCellStructuredCoordsForExtent(last, ext, ijk1);
+      for (int a = 0; a < 3; ++a)
+      {
+        own[2 * a] = ijk[a];
+        own[2 * a + 1] = ijk1[a];
+      }
+    }
+  }
+  bool same = !ghosts;
+  for (int i = 0; i < 6; ++i)
+  {
+    same = same && w[i] == ext[i];
+  }
+  if (same)
+  {
+    return piece;
+  }
+  input->TransformIndexToPhysicalPoint(w[0], w[2], w[4], piece.wholeOrigin);
+  piece.wholeDims = spaceskip::vec3l{ w[1] - w[0] + 1, w[3] - w[2] + 1, w[5] - w[4] + 1 };
+  piece.offset = spaceskip::vec3l{ ext[0] - w[0], ext[2] - w[2], ext[4] - w[4] };
+  piece.ownedLo = spaceskip::vec3l{ own[0] - w[0], own[2] - w[2], own[4] - w[4] };
+  piece.ownedHi = spaceskip::vec3l{ own[1] + 1 - w[0], own[3] + 1 - w[2], own[5] + 1 - w[4] };
+  // The window and IceT hold 8 bits: a piece in front rounds up by half a unit what IceT's
+  // blend truncates (README, Parallel). SPACESKIP_PIECE_BIAS (in 1/255) overrides, for
+  // measurements.
+  const char* bias = std::getenv("SPACESKIP_PIECE_BIAS");
+  piece.followBias = static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
+  return piece;
 }
 
 double SecondsSince(std::chrono::steady_clock::time_point t0)
@@ -102,6 +195,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   const float* FrameDepth = nullptr; // this frame's depth (the compositor's buffer), or null
   // Last, so that it goes (with its CUDA-GL interop registration) before the engine.
   vtkSpaceSkipCompositor Compositor;
+  // Composite input: one mapper per image block (each with its engine and compositor).
+  vtkSpaceSkipBlockRenderer Blocks;
 
   // Reports a problem once (until the next different one); the caller then draws nothing.
   void Fail(const std::string& msg)
@@ -313,18 +408,34 @@ const char* vtkSpaceSkippingVolumeMapper::GetBuilderAsString()
 //------------------------------------------------------------------------------
 double vtkSpaceSkippingVolumeMapper::GetLastBuildSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastBuildSeconds);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().seconds : 0.0;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().classifySeconds : 0.0;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds);
+  }
   return this->Internals->Engine ? this->Internals->Engine->frameStats().seconds : 0.0;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds);
+  }
   if (!this->Internals->Engine)
   {
     return 0.0;
@@ -334,14 +445,26 @@ double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
 }
 double vtkSpaceSkippingVolumeMapper::GetLastScalarRangeSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastScalarRangeSeconds);
+  }
   return this->Internals->RangeSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastUpdateSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastUpdateSeconds);
+  }
   return this->Internals->UpdateSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds);
+  }
   return this->Internals->DepthSeconds;
 }
 bool vtkSpaceSkippingVolumeMapper::GetLastFrameReadDepth()
@@ -350,10 +473,18 @@ bool vtkSpaceSkippingVolumeMapper::GetLastFrameReadDepth()
 }
 double vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds);
+  }
   return this->Internals->EngineSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastCompositeSeconds()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastCompositeSeconds);
+  }
   return this->Internals->CompositeSeconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastMapperSeconds()
@@ -362,38 +493,74 @@ double vtkSpaceSkippingVolumeMapper::GetLastMapperSeconds()
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetNodeCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetNodeCount);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().nodes : 0;
 }
 int vtkSpaceSkippingVolumeMapper::GetTreeHeight()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Max(&vtkSpaceSkippingVolumeMapper::GetTreeHeight);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().height : 0;
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetLeafCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLeafCount);
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().leaves : 0;
 }
 double vtkSpaceSkippingVolumeMapper::GetOccupancy()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Occupancy();
+  }
   return this->Internals->Engine ? this->Internals->Engine->buildStats().occupancy : 0.0;
 }
 const char* vtkSpaceSkippingVolumeMapper::GetBackendUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBackendUsed);
+  }
   return this->Internals->BackendUsed.c_str();
 }
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBuilderUsed);
+  }
   return this->Internals->BuilderUsed.c_str();
 }
 const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetCompositePathUsed);
+  }
   return this->Internals->Compositor.GetCompositePath().c_str();
 }
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderChoice()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBuilderChoice);
+  }
   return this->Internals->BuilderChoice.c_str();
 }
 double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.MinSampleDistance();
+  }
   return this->Internals->SampleDistanceUsed;
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetDeviceBytesInUse()
@@ -409,24 +576,41 @@ void vtkSpaceSkippingVolumeMapper::WarnOnce(const std::string& message)
 }
 int vtkSpaceSkippingVolumeMapper::GetBuildCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetBuildCount);
+  }
   return this->Internals->Counts().builds;
 }
 int vtkSpaceSkippingVolumeMapper::GetClassifyCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetClassifyCount);
+  }
   return this->Internals->Counts().classifications;
 }
 int vtkSpaceSkippingVolumeMapper::GetColorUpdateCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetColorUpdateCount);
+  }
   return this->Internals->Counts().colorUpdates;
 }
 int vtkSpaceSkippingVolumeMapper::GetFrameCount()
 {
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.GetFrameCount();
+  }
   return this->Internals->Counts().frames;
 }
 
 //------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
+  this->Internals->Blocks.ReleaseGraphicsResources(win);
   this->Internals->Compositor.ReleaseGraphicsResources(win);
   this->Superclass::ReleaseGraphicsResources(win);
 }
@@ -440,6 +624,36 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   if (!renWin || !cam || !vol || !vol->GetProperty())
   {
     d.Fail("needs an OpenGL render window, an OpenGL camera and a volume with a property");
+    return;
+  }
+  // Composite input: every image block through a mapper of its own (vtkSpaceSkipBlockRenderer).
+  if (this->GetNumberOfInputConnections(0) > 0 && this->GetInputAlgorithm())
+  {
+    this->GetInputAlgorithm()->Update();
+  }
+  vtkDataObject* input = this->GetInputDataObject(0, 0);
+  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
+  {
+    std::string problem;
+    if (d.Blocks.Render(this, input, ren, vol, d.Warn, problem))
+    {
+      d.LastProblem.clear();
+    }
+    else
+    {
+      d.Fail(problem);
+    }
+    return;
+  }
+  if (d.Blocks.IsActive())
+  {
+    d.Blocks.ReleaseGraphicsResources(renWin);
+    d.Blocks.Clear();
+  }
+  if (input && input->IsA("vtkRectilinearGrid"))
+  {
+    d.Fail("vtkRectilinearGrid input is not drawn: vtkSpaceSkippingVolumeMapper draws "
+           "vtkImageData (resample the grid to an image first, e.g. vtkResampleToImage)");
     return;
   }
   // Input conversion, first half: what to draw, or why nothing.
@@ -459,9 +673,15 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     // function, the build and render parameters.
     spaceskip::Engine& engine = *d.Engine;
     d.RangeSeconds = d.Input.Update(engine, d.Warn);
-    d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), d.Input.GetScalarRange());
+    // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
+    // composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
+    engine.setPiece(PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent, d.Warn));
+    const double* range = this->UseTableRange ? this->TableRange
+      : this->WholeScalarRange[0] <= this->WholeScalarRange[1] ? this->WholeScalarRange
+                                                               : d.Input.GetScalarRange();
+    d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), range);
     d.Properties.UpdateParameters(
-      engine, this, this->EffectiveBlendMode(), ren, vol, d.Input.GetScalarRange(), d.Warn);
+      engine, this, this->EffectiveBlendMode(), ren, vol, range, d.Warn);
     const spaceskip::Camera camera = vtkSpaceSkipPropertyTranslator::ToCamera(ren, cam, vol);
 
     int width, height, x0, y0;
@@ -482,6 +702,40 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   {
     d.Fail(std::string("SpaceSkip engine error: ") + e.what() + ": nothing drawn");
   }
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkippingVolumeMapper::FillInputPortInformation(int port, vtkInformation* info)
+{
+  this->Superclass::FillInputPortInformation(port, info);
+  // vtkMultiBlockDataSet, vtkPartitionedDataSet, vtkPartitionedDataSetCollection.
+  info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkDataObjectTree");
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+double* vtkSpaceSkippingVolumeMapper::GetBounds()
+{
+  if (this->GetNumberOfInputConnections(0) == 0 ||
+    !vtkSpaceSkipBlockRenderer::IsComposite(this->GetInputDataObject(0, 0)))
+  {
+    return this->Superclass::GetBounds();
+  }
+  this->Update();
+  vtkSpaceSkipBlockRenderer::ComputeBounds(this->GetInputDataObject(0, 0), this->Bounds);
+  return this->Bounds;
+}
+
+//------------------------------------------------------------------------------
+vtkDataSet* vtkSpaceSkippingVolumeMapper::GetInput()
+{
+  vtkDataObject* input =
+    this->GetNumberOfInputConnections(0) > 0 ? this->GetInputDataObject(0, 0) : nullptr;
+  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
+  {
+    return vtkSpaceSkipBlockRenderer::FirstImage(input);
+  }
+  return this->Superclass::GetInput();
 }
 
 //------------------------------------------------------------------------------

@@ -16,6 +16,10 @@
  * oneTBB CPU backend, clipped by the depth of opaque geometry already drawn, and blended into
  * the render window as premultiplied RGBA.
  *
+ * Composite input (vtkMultiBlockDataSet, vtkPartitionedDataSet, vtkPartitionedDataSetCollection
+ * of vtkImageData) draws every image block with a hierarchy of its own, back to front (see
+ * GetBounds()).
+ *
  * Bad input (no/cell scalars, several components, unsupported type, empty extent) raises one
  * vtkErrorMacro and draws nothing; backend failures (no device, out of device memory) fall back
  * to the CPU backend with a warning.
@@ -222,6 +226,23 @@ public:
 
   ///@{
   /**
+   * The input as one piece of a larger image (ParaView's ranks under MPI; set by
+   * vtkSpaceSkipVolumeRepresentation). WholeExtent: the extent of the whole image the input is a
+   * piece of; the rays then sample the whole image's lattice, as a serial render of it would, and
+   * the mapper draws only the input's own cells: those not marked ghost in its vtkGhostType cell
+   * array (ghost layers are read by interpolation and shading), half-open so that composited
+   * pieces give the serial image. WholeScalarRange: the whole image's range of the drawn scalars
+   * (the transfer function's table spans it on every rank). Empty (the defaults): the input's
+   * own extent and range.
+   */
+  vtkSetVector6Macro(WholeExtent, int);
+  vtkGetVector6Macro(WholeExtent, int);
+  vtkSetVector2Macro(WholeScalarRange, double);
+  vtkGetVector2Macro(WholeScalarRange, double);
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -291,6 +312,25 @@ public:
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
   void ReleaseGraphicsResources(vtkWindow*) override;
 
+  /**
+   * Composite input (vtkMultiBlockDataSet, vtkPartitionedDataSet,
+   * vtkPartitionedDataSetCollection of vtkImageData): the union of the image blocks' bounds.
+   * Each image block is drawn by a mapper of its own (its own hierarchy), back to front, as
+   * vtkMultiBlockVolumeMapper does; other blocks are skipped with one warning. The statistics
+   * then add up the blocks (times, nodes, leaves, stage counts; the tree height is the largest,
+   * the occupancy the voxel-weighted mean, names one per distinct value joined by '/').
+   */
+  double* GetBounds() override;
+  using vtkAbstractVolumeMapper::GetBounds;
+
+  /**
+   * The input as a data set; for composite input its first non-empty vtkImageData block
+   * (ParaView's vtkPVLODVolume draws a vtkVolumeMapper only when GetInput() has the selected
+   * scalars).
+   */
+  vtkDataSet* GetInput() override;
+  using vtkVolumeMapper::GetInput;
+
 protected:
   vtkSpaceSkippingVolumeMapper();
   ~vtkSpaceSkippingVolumeMapper() override;
@@ -309,6 +349,11 @@ protected:
   int VectorMode = 1; // vtkScalarsToColors::COMPONENT
   int VectorComponent = 0;
   int BlendModeOverride = -1;
+  int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  double WholeScalarRange[2] = { 1, 0 };
+
+  /// vtkImageData, and composite data sets of them (see GetBounds()).
+  int FillInputPortInformation(int port, vtkInformation* info) override;
 
 private:
   vtkSpaceSkippingVolumeMapper(const vtkSpaceSkippingVolumeMapper&) = delete;
@@ -325,6 +370,18 @@ private:
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
+
+  // Composite input: the block mappers sample the transfer function over the range of all
+  // blocks, not over their own (vtkSpaceSkipBlockRenderer sets it).
+  friend class vtkSpaceSkipBlockRenderer;
+  void SetTableRange(const double range[2])
+  {
+    this->UseTableRange = true;
+    this->TableRange[0] = range[0];
+    this->TableRange[1] = range[1];
+  }
+  bool UseTableRange = false;
+  double TableRange[2] = { 0, 1 };
 };
 
 #endif

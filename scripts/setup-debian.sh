@@ -11,6 +11,8 @@ pkgs=(build-essential cmake ninja-build pkg-config libtbb-dev libpng-dev libgtes
       paraview paraview-dev python3-paraview python3-numpy python3-dev xvfb xauth
       libopenmpi-dev openmpi-bin libdouble-conversion-dev liblz4-dev libglew-dev libutfcpp-dev libtiff-dev
       clang libclang-rt-14-dev)
+# SPACESKIP_PLOTS=1: also matplotlib for scripts/plot-paper-bench.py (not needed by the tests or CI).
+if [ "${SPACESKIP_PLOTS:-0}" = 1 ]; then pkgs+=(python3-matplotlib); fi
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -25,11 +25,11 @@ const std::set<std::string>& valueOptions() {
       "-o", "--dims", "--seed", "--builder", "--builders", "--leaf", "--mls", "--bins", "--brick", "--backend",
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
-      "--shade", "--cuda-block", "--cuda-carveout"};
+      "--shade", "--cuda-block", "--cuda-carveout", "--scale", "--datasets", "--time-limit"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
-  static const std::set<std::string> s = {"--perspective", "--jitter"};
+  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper"};
   return s;
 }
 
@@ -175,7 +175,8 @@ BuildParams buildParams(const Options& o, const std::string& spec) {
   std::string leaf = o.get("--leaf", "deep");
   if (leaf == "shallow") p.leaf = LeafCriterion::Shallow;
   else if (leaf == "deep") p.leaf = LeafCriterion::Deep;
-  else throw bad("--leaf", leaf, "is not shallow or deep");
+  else if (leaf == "empty") p.leaf = LeafCriterion::Empty;
+  else throw bad("--leaf", leaf, "is not shallow, deep or empty");
   p.maxLeafSize = int(o.getInt("--mls", 0, 0, kMaxMls));
   p.bins = int(o.getInt("--bins", 4, 0, kMaxBins));
   p.brick = int(o.getInt("--brick", 8, 1, kMaxBrick));
@@ -183,10 +184,11 @@ BuildParams buildParams(const Options& o, const std::string& spec) {
     const std::string& it = parts[i];
     if (it == "shallow") p.leaf = LeafCriterion::Shallow;
     else if (it == "deep") p.leaf = LeafCriterion::Deep;
+    else if (it == "empty") p.leaf = LeafCriterion::Empty;
     else if (it.rfind("mls", 0) == 0) p.maxLeafSize = suffixNumber(it, "mls", spec, 0, kMaxMls);
     else if (it.rfind("bins", 0) == 0) p.bins = suffixNumber(it, "bins", spec, 0, kMaxBins);
     else if (it.rfind("brick", 0) == 0) p.brick = suffixNumber(it, "brick", spec, 1, kMaxBrick);
-    else throw bad("builder suffix", it, "in '" + spec.substr(0, 60) + "' is not one of shallow deep mlsN binsN brickN");
+    else throw bad("builder suffix", it, "in '" + spec.substr(0, 60) + "' is not one of shallow deep empty mlsN binsN brickN");
   }
   try {
     validate(p);

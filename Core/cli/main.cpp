@@ -9,6 +9,8 @@
 
 #include <tbb/global_control.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -44,10 +46,12 @@ double processCpuSeconds() {
 
 const char* kUsage = R"(usage:
   spaceskip generate SHAPE --dims X Y Z [--seed N] -o FILE(.nrrd|_XxYxZ_TYPE.raw)
-      SHAPE: menger nbody shell noise rm vessels
+      SHAPE: menger nbody shell noise rm vessels, and the paper's data sets: aneurism xmas_tree
+      magnetic stag_beetle kingsnake richtmyer_meshkov
   spaceskip render VOLUME -o out.png [options]
-  spaceskip accuracy VOLUME [--builder B] [--size WxH] [options]
-      speed/accuracy trade: sample distance x filter x ERT vs PSNR/SSIM against a fine reference, and fps
+  spaceskip accuracy VOLUME [--builder B] [--size WxH] [--csv FILE] [options]
+      speed/accuracy trade: sample distance 0.25-4 voxels x filter x ERT x jitter vs PSNR/SSIM
+      against a fine reference, and fps (scripts/plot_pareto.py draws the Pareto fronts)
   spaceskip bench VOLUME... [--builders b1,b2,...] [--frames N] [--json FILE] [--csv FILE] [options]
       each builder may carry suffixes overriding --leaf/--mls/--bins/--brick, e.g.
       --builders naive,grid,lbvh-cpu,kdtree-cpu:shallow,kdtree-cpu:deep:mls32,kdtree-cpu:deep:mls128,hybrid
@@ -55,12 +59,20 @@ const char* kUsage = R"(usage:
       --build-reps N: report the fastest of N rebuilds (default 1)
       bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only),
       :resN (CUDA: persistent launch with N blocks per SM; res0 = plain)
+  spaceskip bench --paper [--scale F] [--datasets a,b] [--builders k1,k2] [--frames N] [--time-limit S]
+                  [--csv FILE] [--json FILE] [options]
+      the paper's whole benchmark: stand-ins for its 11 data sets (dims x F), every builder and
+      parameter set of its table (naive lbvh cpu_shallow cpu_mls32 cpu_mls128 gpu_shallow gpu_mls32
+      gpu_mls128 hybrid) plus ours (grid distance_grid kdtree_gpu_fast kdtree_empty auto), 1024x1024,
+      rotating orthographic camera, no ERT; progress on stderr; --time-limit S stops starting new
+      items after S seconds (the rest are written as skipped). Figures: scripts/plot-paper-bench.py
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
   --builder B        auto (default: one frame with each of naive, grid, distance-grid and a
                      k-d tree, then the fastest) or one of the builders listed at the end
-  --leaf shallow|deep  --mls N  --bins N  --brick N
+  --leaf shallow|deep|empty  --mls N  --bins N  --brick N
+      empty: deep, but leaves are kept or split by their empty space, not their size (MLS ignored)
       --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;
       0 sweeps every brick boundary, the kdtree-cpu tree (kdtree-cpu always sweeps)
   --backend auto|cpu|cuda     --threads N (oneTBB worker limit)
@@ -188,8 +200,112 @@ int cmdRender(const Options& o) {
   return 0;
 }
 
+/// One measured bench item: a builder variant on one volume, the paper's protocol (orthographic
+/// camera rotating about the volume, `frames` frames, the TF of --tf, no ERT unless --ert).
+struct BenchRow {
+  std::string label;  ///< the variant as asked for, "->Used" when the engine fell back
+  BuildParams bp;
+  BuildStats s;
+  double cold = 0, fps = 0, kernelFps = 0, frameCpu = 0, samples = 0, gsps = 0, voxelGBs = 0;
+  const char* filter = "exact";
+  const char* leaf = "deep";
+};
+
+const char* leafName(LeafCriterion l) {
+  return l == LeafCriterion::Shallow ? "shallow" : l == LeafCriterion::Empty ? "empty" : "deep";
+}
+
+BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemText, const Options& o, int w, int h,
+                     int frames, int buildReps, const LaunchParams& launch) {
+  BenchRow row;
+  const BenchItem item = benchItem(itemText);
+  const BuildParams bp = buildParams(o, item.spec);
+  row.bp = bp;
+  RenderParams rp = renderParams(o);
+  if (item.filter >= 0) rp.filter = FilterMode(item.filter);
+  engine.setRenderParams(rp);
+  engine.setBuildParams(bp);
+  engine.update();
+  row.cold = engine.buildStats().seconds;
+  // Rebuild, timed alone (the first build includes one-time allocations); with
+  // --build-reps N the fastest of N rebuilds. A Naive build in between (which costs nothing)
+  // forces each rebuild.
+  BuildStats s = engine.buildStats();
+  for (int rep = 0; rep < buildReps && !item.cold; ++rep) {
+    BuildParams none = bp;
+    none.builder = BuilderKind::Naive;
+    engine.setBuildParams(none);
+    engine.update();
+    engine.setBuildParams(bp);
+    engine.update();
+    if (rep == 0 || engine.buildStats().seconds < s.seconds) s = engine.buildStats();
+  }
+  LaunchParams itemLaunch = launch;
+  if (item.resident >= 0) itemLaunch.resident = item.resident;
+  engine.setLaunchParams(itemLaunch);
+  double b6[6];
+  v.worldBounds(b6);
+  Image img;
+  engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
+  // Auto: its measuring frames (one per candidate) are not timed; then what it chose is.
+  for (int i = 0; i < 16 && engine.exploring(); ++i)
+    engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);
+  if (bp.builder == BuilderKind::Auto) {
+    engine.update();  // builds the kept structure when it was not the last one measured
+    s = engine.buildStats();
+    std::printf("%s\n", s.choice.c_str());
+  }
+  double total = 0, totalDevice = 0, cpuTotal = 0;
+  for (int f = 0; f < frames; ++f) {
+    const double c0 = processCpuSeconds();
+    engine.render(orbitCamera(b6, 360.0 * f / frames, 15, 1, false, double(w) / h), w, h, img);
+    cpuTotal += processCpuSeconds() - c0;
+    total += engine.frameStats().seconds;
+    totalDevice += engine.frameStats().deviceSeconds;
+  }
+  row.fps = frames / total;
+  // CUDA: frame rate of the render kernel alone (CUDA events), without the host copy.
+  row.kernelFps = totalDevice > 0 ? frames / totalDevice : row.fps;
+  row.frameCpu = cpuTotal / frames;
+  // One more frame with sample counting (not timed): samples/frame and samples/s.
+  RenderParams counted = rp;
+  counted.countSamples = true;
+  engine.setRenderParams(counted);
+  engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
+  row.samples = double(engine.frameStats().samples);
+  row.gsps = row.samples * row.kernelFps * 1e-9;
+  // Logical voxel traffic of trilinear sampling: 8 voxels per sample (mostly cache hits).
+  row.voxelGBs = row.gsps * 8.0 * double(voxelSize(v.type));
+  // The variant as asked for; when the engine fell back (e.g. a GPU builder on the CPU), say so.
+  row.label = itemText;
+  if (s.builder != bp.builder) row.label += std::string("->") + builderName(s.builder);
+  row.filter = rp.filter == FilterMode::Hardware ? "hardware" : "exact";
+  // Hybrid always builds the shallow tree (paper 3.3).
+  row.leaf = s.builder == BuilderKind::Hybrid ? "shallow" : leafName(bp.leaf);
+  row.s = s;
+  return row;
+}
+
+/// `s` with quotes, backslashes and control characters escaped for a JSON string.
+std::string jsonEscape(const std::string& s) {
+  std::string o;
+  for (const char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) o += ' ';
+    else o += c;
+  }
+  return o;
+}
+
+std::string dimsText(vec3l d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+int cmdBenchPaper(const Options& o);
+
 int cmdBench(const Options& o) {
-  if (o.positional.empty()) throw std::invalid_argument("bench needs at least one VOLUME");
+  if (o.has("--paper")) return cmdBenchPaper(o);
+  if (o.positional.empty()) throw std::invalid_argument("bench needs at least one VOLUME (or --paper)");
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
   const int frames = int(o.getInt("--frames", 8, 1, 1000000));
   const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
@@ -219,95 +335,35 @@ int cmdBench(const Options& o) {
     engine.setVolume(v);
     engine.setTransferFunction(tf);
     for (const std::string& b : builders) {
-      const BenchItem item = benchItem(b);
-      const BuildParams bp = buildParams(o, item.spec);
-      RenderParams rp = renderParams(o);
-      if (item.filter >= 0) rp.filter = FilterMode(item.filter);
-      engine.setRenderParams(rp);
-      engine.setBuildParams(bp);
-      engine.update();
-      const double cold = engine.buildStats().seconds;
-      // Rebuild, timed alone (the first build includes one-time allocations); with
-      // --build-reps N the fastest of N rebuilds. A Naive build in between (which costs nothing)
-      // forces each rebuild.
-      BuildStats s = engine.buildStats();
-      for (int rep = 0; rep < buildReps && !item.cold; ++rep) {
-        BuildParams none = bp;
-        none.builder = BuilderKind::Naive;
-        engine.setBuildParams(none);
-        engine.update();
-        engine.setBuildParams(bp);
-        engine.update();
-        if (rep == 0 || engine.buildStats().seconds < s.seconds) s = engine.buildStats();
-      }
-      LaunchParams itemLaunch = launch;
-      if (item.resident >= 0) itemLaunch.resident = item.resident;
-      engine.setLaunchParams(itemLaunch);
-      double b6[6];
-      v.worldBounds(b6);
-      Image img;
-      engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
-      // Auto: its measuring frames (one per candidate) are not timed; then what it chose is.
-      for (int i = 0; i < 16 && engine.exploring(); ++i)
-        engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);
-      if (bp.builder == BuilderKind::Auto) {
-        engine.update();  // builds the kept structure when it was not the last one measured
-        s = engine.buildStats();
-        std::printf("%s\n", s.choice.c_str());
-      }
-      double total = 0, totalDevice = 0, cpuTotal = 0;
-      for (int f = 0; f < frames; ++f) {
-        const double c0 = processCpuSeconds();
-        engine.render(orbitCamera(b6, 360.0 * f / frames, 15, 1, false, double(w) / h), w, h, img);
-        cpuTotal += processCpuSeconds() - c0;
-        total += engine.frameStats().seconds;
-        totalDevice += engine.frameStats().deviceSeconds;
-      }
-      const double fps = frames / total;
-      // CUDA: frame rate of the render kernel alone (CUDA events), without the host copy.
-      const double kernelFps = totalDevice > 0 ? frames / totalDevice : fps;
-      const double frameCpu = cpuTotal / frames;
-      // One more frame with sample counting (not timed): samples/frame and samples/s.
-      RenderParams counted = rp;
-      counted.countSamples = true;
-      engine.setRenderParams(counted);
-      engine.render(orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, img);
-      const double samples = double(engine.frameStats().samples);
-      const double gsps = samples * kernelFps * 1e-9;
-      // Logical voxel traffic of trilinear sampling: 8 voxels per sample (mostly cache hits).
-      const double voxelGBs = gsps * 8.0 * double(voxelSize(v.type));
-      if (s.builder == BuilderKind::Naive && naiveFps == 0) naiveFps = kernelFps;
-      std::string dims = std::to_string(v.dims.x) + "x" + std::to_string(v.dims.y) + "x" + std::to_string(v.dims.z);
+      const BenchRow r = measureItem(engine, v, b, o, w, h, frames, buildReps, launch);
+      const BuildStats& s = r.s;
+      const BuildParams& bp = r.bp;
+      if (s.builder == BuilderKind::Naive && naiveFps == 0) naiveFps = r.kernelFps;
+      const std::string dims = dimsText(v.dims);
       std::string name = spec.substr(spec.find_last_of('/') + 1);
-      // The variant as asked for; when the engine fell back (e.g. a GPU builder on the CPU), say so.
-      std::string label = b;
-      if (s.builder != bp.builder) label += std::string("->") + builderName(s.builder);
-      const char* filter = rp.filter == FilterMode::Hardware ? "hardware" : "exact";
-      std::printf("%-16s %-30s %-6s %10.3f %11.3f %8.2f %9.2f %9.1f %9lld %6d %9lld %8s %8.3f\n", name.c_str(), label.c_str(),
-                  engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, fps, kernelFps, frameCpu * 1e3, (long long)s.nodes,
-                  s.height, (long long)s.leaves,
-                  naiveFps > 0 ? (std::to_string(kernelFps / naiveFps).substr(0, 5) + "x").c_str() : "-", gsps);
+      std::printf("%-16s %-30s %-6s %10.3f %11.3f %8.2f %9.2f %9.1f %9lld %6d %9lld %8s %8.3f\n", name.c_str(), r.label.c_str(),
+                  engine.backendName(), s.seconds * 1e3, s.classifySeconds * 1e3, r.fps, r.kernelFps, r.frameCpu * 1e3,
+                  (long long)s.nodes, s.height, (long long)s.leaves,
+                  naiveFps > 0 ? (std::to_string(r.kernelFps / naiveFps).substr(0, 5) + "x").c_str() : "-", r.gsps);
       std::fflush(stdout);
-      // Hybrid always builds the shallow tree (paper 3.3).
-      const char* leaf = bp.leaf == LeafCriterion::Shallow || s.builder == BuilderKind::Hybrid ? "shallow" : "deep";
       if (!firstJson) json << ",\n";
       firstJson = false;
-      json << "  {\"dataset\": \"" << name << "\", \"dims\": \"" << dims << "\", \"variant\": \"" << label
+      json << "  {\"dataset\": \"" << name << "\", \"dims\": \"" << dims << "\", \"variant\": \"" << r.label
            << "\", \"builder\": \"" << builderName(s.builder) << "\", \"backend\": \"" << engine.backendName()
-           << "\", \"built_on\": \"" << s.builtOn << "\", \"leaf\": \"" << leaf << "\", \"mls\": " << bp.maxLeafSize
-           << ", \"bins\": " << bp.bins << ", \"brick\": " << bp.brick << ", \"filter\": \"" << filter
-           << "\", \"build_s\": " << s.seconds << ", \"build_cold_s\": " << cold << ", \"classify_s\": " << s.classifySeconds
-           << ", \"fps\": " << fps << ", \"kernel_fps\": " << kernelFps << ", \"frame_cpu_s\": " << frameCpu << ", \"nodes\": " << s.nodes
-           << ", \"height\": " << s.height << ", \"leaves\": " << s.leaves << ", \"samples_per_frame\": " << samples
-           << ", \"gsamples_per_s\": " << gsps << ", \"voxel_gbytes_per_s\": " << voxelGBs
-           << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w << ", \"height_px\": " << h
-           << ", \"frames\": " << frames << "}";
+           << "\", \"built_on\": \"" << s.builtOn << "\", \"leaf\": \"" << r.leaf << "\", \"mls\": " << bp.maxLeafSize
+           << ", \"bins\": " << bp.bins << ", \"brick\": " << bp.brick << ", \"filter\": \"" << r.filter
+           << "\", \"build_s\": " << s.seconds << ", \"build_cold_s\": " << r.cold << ", \"classify_s\": " << s.classifySeconds
+           << ", \"fps\": " << r.fps << ", \"kernel_fps\": " << r.kernelFps << ", \"frame_cpu_s\": " << r.frameCpu
+           << ", \"nodes\": " << s.nodes << ", \"height\": " << s.height << ", \"leaves\": " << s.leaves
+           << ", \"samples_per_frame\": " << r.samples << ", \"gsamples_per_s\": " << r.gsps
+           << ", \"voxel_gbytes_per_s\": " << r.voxelGBs << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
+           << ", \"height_px\": " << h << ", \"frames\": " << frames << "}";
       if (csv.is_open())
-        csv << name << "," << dims << "," << label << "," << builderName(s.builder) << "," << engine.backendName() << ","
-            << leaf << "," << bp.maxLeafSize << "," << bp.bins << "," << bp.brick << "," << s.seconds << ","
-            << s.classifySeconds << "," << fps << "," << s.nodes << "," << s.height << "," << s.leaves << ","
-            << s.occupancy << "," << filter << "," << kernelFps << "," << cold << "," << s.builtOn << "," << samples
-            << "," << gsps << "," << voxelGBs << "," << frameCpu << "\n";
+        csv << name << "," << dims << "," << r.label << "," << builderName(s.builder) << "," << engine.backendName() << ","
+            << r.leaf << "," << bp.maxLeafSize << "," << bp.bins << "," << bp.brick << "," << s.seconds << ","
+            << s.classifySeconds << "," << r.fps << "," << s.nodes << "," << s.height << "," << s.leaves << ","
+            << s.occupancy << "," << r.filter << "," << r.kernelFps << "," << r.cold << "," << s.builtOn << "," << r.samples
+            << "," << r.gsps << "," << r.voxelGBs << "," << r.frameCpu << "\n";
     }
   }
   json << "\n]\n";
@@ -316,6 +372,230 @@ int cmdBench(const Options& o) {
     js << json.str();
   }
   return 0;
+}
+
+// ---- bench --paper: the paper's whole benchmark (Zellmann, Table 2 and Figs. 3-4) ----------------
+
+/// A column group of the paper's table (shared/paper/paper_results.csv: <key>_build, <key>_fps),
+/// or one of ours (no paper numbers), and the bench item that measures it.
+struct PaperVariant {
+  const char* key;
+  const char* item;
+  bool paper;  ///< the paper measured it
+};
+
+const std::vector<PaperVariant>& paperVariants() {
+  // The paper's GPU k-d trees (4 bins) are built here with KdTreeGPUFast:bins4, which builds the
+  // tree of the paper's KdTreeGPU method (KdTreeSplit.h) in milliseconds instead of minutes; on
+  // the CPU backend a GPU builder falls back to KdTreeCPU (the label says "->KdTreeCPU").
+  static const std::vector<PaperVariant> v = {
+      {"naive", "naive", true},
+      {"lbvh", "lbvh", true},
+      {"cpu_shallow", "kdtree-cpu:shallow", true},
+      {"cpu_mls32", "kdtree-cpu:deep:mls32", true},
+      {"cpu_mls128", "kdtree-cpu:deep:mls128", true},
+      {"gpu_shallow", "kdtree-gpu-fast:shallow:bins4", true},
+      {"gpu_mls32", "kdtree-gpu-fast:deep:mls32:bins4", true},
+      {"gpu_mls128", "kdtree-gpu-fast:deep:mls128:bins4", true},
+      {"hybrid", "hybrid", true},
+      {"grid", "grid", false},
+      {"distance_grid", "distance-grid", false},
+      {"kdtree_gpu_fast", "kdtree-gpu-fast:deep:mls128:bins0", false},
+      {"kdtree_empty", "kdtree-gpu-fast:empty:bins0", false},
+      {"auto", "auto", false},
+  };
+  return v;
+}
+
+/// Progress on stderr: a bar redrawn in place on a terminal, one line per step otherwise.
+class Progress {
+ public:
+  explicit Progress(int total) : total_(total), tty_(isatty(2) != 0), t0_(Clock::now()) {}
+  void step(int done, const std::string& what) {
+    const double el = since(t0_);
+    const double eta = done > 0 ? el / done * (total_ - done) : 0;
+    const int width = 30, fill = total_ > 0 ? width * done / total_ : width;
+    std::fprintf(stderr, "%s[%s%s] %d/%d %5.0f s, eta %5.0f s  %-50.50s%s", tty_ ? "\r" : "", std::string(size_t(fill), '#').c_str(),
+                 std::string(size_t(width - fill), '.').c_str(), done, total_, el, eta, what.c_str(), tty_ ? "" : "\n");
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (tty_) std::fputc('\n', stderr);
+  }
+
+ private:
+  int total_;
+  bool tty_;
+  Clock::time_point t0_;
+};
+
+int cmdBenchPaper(const Options& o) {
+  if (!o.positional.empty()) throw std::invalid_argument("bench --paper generates its volumes: no VOLUME arguments");
+  const double scale = o.getDouble("--scale", 1.0, 1e-3, 1.0);
+  const int frames = int(o.getInt("--frames", 8, 1, 1000000));
+  const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
+  const double timeLimit = o.getDouble("--time-limit", 0, 0, 1e9);  // 0: none
+  const uint64_t cap = maxVolumeBytes(o);
+  const LaunchParams launch = launchParams(o);
+  int w = 1024, h = 1024;
+  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+
+  // Data sets and variants: all, or the subsets named (unknown names are errors).
+  std::vector<PaperDataset> sets;
+  const std::vector<std::string> wantSets = split(o.get("--datasets", ""), ',');
+  for (const std::string& n : wantSets) {
+    auto it = std::find_if(paperDatasets().begin(), paperDatasets().end(), [&](const PaperDataset& d) { return n == d.name; });
+    if (it == paperDatasets().end()) {
+      std::string known;
+      for (const PaperDataset& d : paperDatasets()) known += std::string(known.empty() ? "" : " ") + d.name;
+      throw std::invalid_argument("--datasets: '" + n + "' is not one of " + known);
+    }
+    sets.push_back(*it);
+  }
+  if (wantSets.empty()) sets = paperDatasets();
+  // --builders: the table's keys (naive, lbvh, cpu_shallow, cpu_mls32, ..., hybrid; ours: grid,
+  // distance_grid, kdtree_gpu_fast, kdtree_empty, auto) or any bench item (its own key).
+  std::vector<PaperVariant> vars;
+  std::vector<std::string> owned;  // storage for items given as raw specs
+  const std::vector<std::string> wantVars = split(o.get("--builders", ""), ',');
+  owned.reserve(wantVars.size());
+  for (const std::string& n : wantVars) {
+    auto it = std::find_if(paperVariants().begin(), paperVariants().end(), [&](const PaperVariant& v) { return n == v.key; });
+    if (it != paperVariants().end()) {
+      vars.push_back(*it);
+    } else {
+      (void)buildParams(o, benchItem(n).spec);  // a bad spec fails here, before any work
+      owned.push_back(n);
+      vars.push_back(PaperVariant{owned.back().c_str(), owned.back().c_str(), false});
+    }
+  }
+  if (wantVars.empty()) vars = paperVariants();
+  // Naive first: every row's ratio is against it.
+  std::stable_partition(vars.begin(), vars.end(), [](const PaperVariant& v) { return std::string(v.key) == "naive"; });
+
+  std::ofstream csv;
+  if (o.has("--csv")) {
+    csv.open(o.get("--csv", ""));
+    if (!csv) throw std::runtime_error("cannot write " + o.get("--csv", ""));
+    csv << "dataset,paper_dims,dims,scale,variant,item,builder,backend,built_on,leaf,mls,bins,brick,build_s,build_cold_s,"
+           "classify_s,fps,kernel_fps,frame_cpu_s,nodes,height,leaves,brick_occupancy,voxel_occupancy_pct,"
+           "paper_occupancy_pct,samples_per_frame,vs_naive_kernel,width,height_px,frames,status\n";
+  }
+  std::ostringstream json;
+  json << "{\n  \"protocol\": {\"width\": " << w << ", \"height\": " << h << ", \"frames\": " << frames
+       << ", \"scale\": " << scale << ", \"tf\": \"" << o.get("--tf", "ramp") << "\", \"ert\": " << o.get("--ert", "2")
+       << ", \"camera\": \"orthographic, rotating about the volume (azimuth 360 f / frames, elevation 15)\"},\n  \"rows\": [\n";
+  bool firstJson = true;
+
+  Progress progress(int(sets.size() * vars.size()));
+  int done = 0, measured = 0, failed = 0;
+  const auto t0 = Clock::now();
+  std::printf("%-18s %-14s %-16s %-40s %-6s %9s %9s %9s %8s %6s %8s\n", "dataset", "dims", "variant", "item", "backend",
+              "build_ms", "fps", "kern_fps", "nodes", "height", "vs_naive");
+  for (const PaperDataset& ds : sets) {
+    const vec3l dims{std::max<int64_t>(8, std::llround(double(ds.dims.x) * scale)),
+                     std::max<int64_t>(8, std::llround(double(ds.dims.y) * scale)),
+                     std::max<int64_t>(8, std::llround(double(ds.dims.z) * scale))};
+    auto skipAll = [&](const std::string& why) {
+      for (const PaperVariant& pv : vars) {
+        if (csv.is_open())
+          csv << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale << "," << pv.key << "," << pv.item
+              << ",,,,,,,,,,,,,,,,,,," << ds.occupancyPct << ",,,,,," << why << "\n";
+        progress.step(++done, std::string(ds.name) + " " + pv.key + ": " + why);
+      }
+    };
+    if (timeLimit > 0 && since(t0) > timeLimit) {
+      skipAll("skipped: time limit");
+      continue;
+    }
+    Volume v;
+    try {
+      checkGeneratorSize(ds.shape, dims, cap);
+      progress.step(done, std::string("generating ") + ds.name + " " + dimsText(dims));
+      v = generateVolume(ds.shape, dims, 1);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "\n  note: %s %s skipped: %s\n", ds.name, dimsText(dims).c_str(), e.what());
+      skipAll("skipped: volume too large");
+      continue;
+    }
+    const TransferFunction tf = makeTF(o, v);
+    const double voxelOcc = 100.0 * visibleVoxelFraction(v, tf);
+    double naiveKernel = 0;
+    std::unique_ptr<Engine> engine;
+    try {
+      engine = std::make_unique<Engine>(backendKind(o));
+      engine->setLogger([](const std::string& m) { std::fprintf(stderr, "\n  note: %s\n", m.c_str()); });
+      engine->setVolume(v);
+      engine->setTransferFunction(tf);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "\n  note: %s: %s\n", ds.name, e.what());
+      skipAll(std::string("skipped: ") + e.what());
+      continue;
+    }
+    for (const PaperVariant& pv : vars) {
+      progress.step(done, std::string(ds.name) + " " + pv.key);
+      std::string status = "ok";
+      BenchRow r;
+      if (timeLimit > 0 && since(t0) > timeLimit) {
+        status = "skipped: time limit";
+      } else {
+        try {
+          r = measureItem(*engine, v, pv.item, o, w, h, frames, buildReps, launch);
+        } catch (const std::exception& e) {
+          status = std::string("failed: ") + e.what();
+          for (char& c : status)
+            if (c == ',' || c == '\n' || c == '"') c = ' ';
+        }
+      }
+      ++done;
+      measured += status == "ok";
+      failed += status.rfind("failed", 0) == 0;
+      if (status != "ok") {
+        if (csv.is_open())
+          csv << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale << "," << pv.key << ","
+              << pv.item << ",,,,,,,,,,,,,,,,,,," << ds.occupancyPct << ",,,,,," << status << "\n";
+        progress.step(done, std::string(ds.name) + " " + pv.key + ": " + status);
+        continue;
+      }
+      const BuildStats& s = r.s;
+      if (std::string(pv.key) == "naive") naiveKernel = r.kernelFps;
+      const double vsNaive = naiveKernel > 0 ? r.kernelFps / naiveKernel : 0;
+      std::printf("%-18s %-14s %-16s %-40s %-6s %9.3f %9.2f %9.2f %8lld %6d %7.3fx\n", ds.name, dimsText(dims).c_str(), pv.key,
+                  r.label.c_str(), engine->backendName(), s.seconds * 1e3, r.fps, r.kernelFps, (long long)s.nodes, s.height,
+                  vsNaive);
+      std::fflush(stdout);
+      if (csv.is_open()) {
+        csv << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale << "," << pv.key << "," << r.label
+            << "," << builderName(s.builder) << "," << engine->backendName() << "," << s.builtOn << "," << r.leaf << ","
+            << r.bp.maxLeafSize << "," << r.bp.bins << "," << r.bp.brick << "," << s.seconds << "," << r.cold << ","
+            << s.classifySeconds << "," << r.fps << "," << r.kernelFps << "," << r.frameCpu << "," << s.nodes << ","
+            << s.height << "," << s.leaves << "," << s.occupancy << "," << voxelOcc << "," << ds.occupancyPct << ","
+            << r.samples << "," << vsNaive << "," << w << "," << h << "," << frames << ",ok\n";
+        csv.flush();
+      }
+      if (!firstJson) json << ",\n";
+      firstJson = false;
+      json << "    {\"dataset\": \"" << ds.name << "\", \"paper_dims\": \"" << dimsText(ds.dims) << "\", \"dims\": \""
+           << dimsText(dims) << "\", \"variant\": \"" << pv.key << "\", \"item\": \"" << r.label << "\", \"builder\": \""
+           << builderName(s.builder) << "\", \"backend\": \"" << engine->backendName() << "\", \"built_on\": \"" << s.builtOn
+           << "\", \"leaf\": \"" << r.leaf << "\", \"mls\": " << r.bp.maxLeafSize << ", \"bins\": " << r.bp.bins
+           << ", \"build_s\": " << s.seconds << ", \"build_cold_s\": " << r.cold << ", \"classify_s\": " << s.classifySeconds
+           << ", \"fps\": " << r.fps << ", \"kernel_fps\": " << r.kernelFps << ", \"nodes\": " << s.nodes
+           << ", \"height\": " << s.height << ", \"leaves\": " << s.leaves << ", \"brick_occupancy\": " << s.occupancy
+           << ", \"voxel_occupancy_pct\": " << voxelOcc << ", \"paper_occupancy_pct\": " << ds.occupancyPct
+           << ", \"samples_per_frame\": " << r.samples << ", \"vs_naive_kernel\": " << vsNaive
+           << (s.choice.empty() ? std::string() : ", \"choice\": \"" + jsonEscape(s.choice) + "\"") << "}";
+      progress.step(done, std::string(ds.name) + " " + pv.key + " done");
+    }
+  }
+  progress.finish();
+  json << "\n  ]\n}\n";
+  if (o.has("--json")) {
+    std::ofstream js(o.get("--json", ""));
+    js << json.str();
+  }
+  std::printf("bench --paper: %d items, %d measured, %d failed, in %.1f s\n", done, measured, failed, since(t0));
+  return failed ? 4 : 0;
 }
 
 // The speed/accuracy trade: image error against a reference at 1/8 of the smallest spacing
@@ -341,34 +621,49 @@ int cmdAccuracy(const Options& o) {
   engine.render(cam, w, h, reference);
   std::printf("reference: sample distance %g (1/8 voxel), exact filtering, no ERT, backend %s\n",
               ref.sampleDistance, engine.backendName());
-  std::printf("%-10s %-9s %-5s %10s %10s %8s %9s %9s\n", "dt/voxel", "filter", "ert", "max_diff", "psnr_db", "ssim",
-              "fps", "Msmp/frm");
+  std::printf("%-10s %-9s %-5s %-6s %10s %10s %8s %9s %9s %9s\n", "dt/voxel", "filter", "ert", "jitter", "max_diff",
+              "psnr_db", "ssim", "fps", "kern_fps", "Msmp/frm");
+  std::ofstream csv;
+  if (o.has("--csv")) {
+    csv.open(o.get("--csv", ""));
+    if (!csv) throw std::runtime_error("cannot write " + o.get("--csv", ""));
+    csv << "dataset,backend,builder,dt_voxel,filter,ert,jitter,max_diff,psnr_db,ssim,fps,kernel_fps,msamples\n";
+  }
   std::vector<FilterMode> filters{FilterMode::Exact};
   if (std::string(engine.backendName()) == "cuda") filters.push_back(FilterMode::Hardware);
-  for (double f : {0.25, 0.5, 1.0, 2.0}) {
+  for (double f : {0.25, 0.5, 1.0, 2.0, 4.0}) {
     for (FilterMode fm : filters) {
       for (bool ert : {false, true}) {
-        RenderParams rp;
-        rp.sampleDistance = f * minSpacing;
-        rp.filter = fm;
-        rp.ertThreshold = ert ? 0.99 : 2.0;
-        engine.setRenderParams(rp);
-        Image img;
-        engine.render(cam, w, h, img);  // warm-up
-        double t = 0;
-        const int frames = 3;
-        for (int i = 0; i < frames; ++i) {
+        for (bool jitter : {false, true}) {
+          RenderParams rp;
+          rp.sampleDistance = f * minSpacing;
+          rp.filter = fm;
+          rp.ertThreshold = ert ? 0.99 : 2.0;
+          rp.jitter = jitter;
+          engine.setRenderParams(rp);
+          Image img;
+          engine.render(cam, w, h, img);  // warm-up
+          double t = 0, tk = 0;
+          const int frames = 3;
+          for (int i = 0; i < frames; ++i) {
+            engine.render(cam, w, h, img);
+            t += engine.frameStats().seconds;
+            tk += engine.frameStats().deviceSeconds > 0 ? engine.frameStats().deviceSeconds : engine.frameStats().seconds;
+          }
+          rp.countSamples = true;
+          engine.setRenderParams(rp);
           engine.render(cam, w, h, img);
-          t += engine.frameStats().seconds;
+          ImageDiff d = compareImages(reference, img);
+          const double s = ssim(reference, img), ms = double(engine.frameStats().samples) * 1e-6;
+          const char* fname = fm == FilterMode::Exact ? "exact" : "hardware";
+          std::printf("%-10.2f %-9s %-5s %-6s %10.4f %10.2f %8.4f %9.2f %9.2f %9.2f\n", f, fname, ert ? "0.99" : "off",
+                      jitter ? "on" : "off", d.maxAbs, d.psnr, s, frames / t, frames / tk, ms);
+          std::fflush(stdout);
+          if (csv.is_open())
+            csv << o.positional[0] << ',' << engine.backendName() << ',' << builderName(engine.buildStats().builder) << ','
+                << f << ',' << fname << ',' << (ert ? "0.99" : "off") << ',' << (jitter ? "on" : "off") << ','
+                << d.maxAbs << ',' << d.psnr << ',' << s << ',' << frames / t << ',' << frames / tk << ',' << ms << '\n';
         }
-        rp.countSamples = true;
-        engine.setRenderParams(rp);
-        engine.render(cam, w, h, img);
-        ImageDiff d = compareImages(reference, img);
-        std::printf("%-10.2f %-9s %-5s %10.4f %10.2f %8.4f %9.2f %9.2f\n", f, fm == FilterMode::Exact ? "exact" : "hardware",
-                    ert ? "0.99" : "off", d.maxAbs, d.psnr, ssim(reference, img), frames / t,
-                    double(engine.frameStats().samples) * 1e-6);
-        std::fflush(stdout);
       }
     }
   }

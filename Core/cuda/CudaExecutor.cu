@@ -42,14 +42,14 @@ struct RenderMinBlocks<TextureSampler> {
 // launch is persistent: a fixed number of resident blocks take tiles in row-major order from the
 // counter until none are left, which bounds the warps in flight (the volume's cache working set)
 // and balances blocks whose rays cost very different amounts.
-template <class Sampler, int Traversal>
+template <class Sampler, int Traversal, bool Plain>
 __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::value)
     renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out,
                  unsigned* tileCounter) {
   const unsigned tilesX = (unsigned(f.width) + blockDim.x - 1) / blockDim.x;
   auto tile = [&](unsigned tx, unsigned ty) {
     const int x = int(tx * blockDim.x + threadIdx.x), y = int(ty * blockDim.y + threadIdx.y);
-    if (x < f.width && y < f.height) out[int64_t(y) * f.width + x] = renderPixel<Sampler, Traversal>(f, s, x, y);
+    if (x < f.width && y < f.height) out[int64_t(y) * f.width + x] = renderPixel<Sampler, Traversal, Plain>(f, s, x, y);
   };
   if (!tileCounter) {
     tile(blockIdx.x, blockIdx.y);
@@ -70,15 +70,21 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
 template <class Sampler>
 using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*);
 
-template <class Sampler>
+template <class Sampler, bool Plain>
 RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
   switch (t) {
-    case TraversalKind::Naive: return renderKernel<Sampler, int(TraversalKind::Naive)>;
-    case TraversalKind::Grid: return renderKernel<Sampler, int(TraversalKind::Grid)>;
-    case TraversalKind::Tree: return renderKernel<Sampler, int(TraversalKind::Tree)>;
-    case TraversalKind::Hybrid: return renderKernel<Sampler, int(TraversalKind::Hybrid)>;
+    case TraversalKind::Naive: return renderKernel<Sampler, int(TraversalKind::Naive), Plain>;
+    case TraversalKind::Grid: return renderKernel<Sampler, int(TraversalKind::Grid), Plain>;
+    case TraversalKind::Tree: return renderKernel<Sampler, int(TraversalKind::Tree), Plain>;
+    case TraversalKind::Hybrid: return renderKernel<Sampler, int(TraversalKind::Hybrid), Plain>;
   }
-  return renderKernel<Sampler, int(TraversalKind::Naive)>;
+  return renderKernel<Sampler, int(TraversalKind::Naive), Plain>;
+}
+
+/// The kernel for this frame: its traversal, and the composite-only build for plain frames.
+template <class Sampler>
+RenderKernelPtr<Sampler> renderKernelFor(const FrameView& f) {
+  return isPlainFrame(f) ? renderKernelFor<Sampler, true>(f.traversal) : renderKernelFor<Sampler, false>(f.traversal);
 }
 
 bool validBlock(const LaunchParams& p) {
@@ -190,7 +196,7 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
                            : 0;
   if (launch_.resident >= 0) residentBlocks = launch_.resident;
   else if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks = std::max(0, std::atoi(r));
-  RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f.traversal);
+  RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f);
   const int carveout = launch_.carveout >= 0 && launch_.carveout <= 100 ? launch_.carveout : env_.carveout;
   if (carveout >= 0) SS_CUDA_CHECK(cudaFuncSetAttribute(k, cudaFuncAttributePreferredSharedMemoryCarveout, carveout));
   if (residentBlocks <= 0) {

@@ -44,6 +44,15 @@ struct ClipToRegion {
   }
 };
 
+/// 1 for an occupied brick box inside the region, else 0 (leaf criterion Empty's counts).
+struct OccupiedInRegion {
+  box3i region;
+  SS_FUNC int operator()(const box3i& b) const {
+    const box3i c = ClipToRegion{region}(b);
+    return c.lo.x <= c.hi.x ? 1 : 0;
+  }
+};
+
 // ---- KdTreeGPU (paper 3.2.2) -----------------------------------------------------------------
 
 // One thread per Morton index of the padded 2^k cube: the brick's clamped cell box when it is
@@ -83,6 +92,25 @@ struct ReductionTight {
     SS_CUDA_CHECK(cudaStreamSynchronize(stream));
     ++reductions;
     return *ws->h_result;
+  }
+
+  /// Occupied bricks in the brick box [lo, hi): one more reduction over its Morton range (leaf
+  /// criterion Empty; KdTreeSplit.h).
+  int64_t count(vec3i lo, vec3i hi) {
+    if (lo.x >= hi.x || lo.y >= hi.y || lo.z >= hi.z) return 0;
+    const box3i region = brickCellBox(box3i{lo, hi}, g->brick, g->cellDims);
+    const uint64_t mlo = mortonEncode3(lo.x, lo.y, lo.z);
+    const uint64_t mhi = mortonEncode3(hi.x - 1, hi.y - 1, hi.z - 1);
+    auto it = thrust::make_transform_iterator(ws->mortonBoxes.get() + mlo, OccupiedInRegion{region});
+    size_t bytes = 0;
+    SS_CUDA_CHECK(cub::DeviceReduce::Sum(nullptr, bytes, it, ws->count.get(), int64_t(mhi - mlo + 1), stream));
+    void* temp = ws->countTemp.ensure(bytes);
+    SS_CUDA_CHECK(cub::DeviceReduce::Sum(temp, bytes, it, ws->count.get(), int64_t(mhi - mlo + 1), stream));
+    int h = 0;
+    SS_CUDA_CHECK(cudaMemcpyAsync(&h, ws->count.get(), sizeof(int), cudaMemcpyDeviceToHost, stream));
+    SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+    ++reductions;
+    return h;
   }
 };
 
@@ -214,7 +242,7 @@ __global__ void levelDecideSweepKernel(const box3i* boxes, int n, int levelStart
     d.split = 1;
     detail::kdPlaneCost(box, axis, detail::kdCandidatePlane(box, axis, bestK, p), svt, d.left, d.right);
   } else {
-    d = detail::kdMlsSplit(box, axis, p, svt);
+    d = detail::kdLeafSplit(box, axis, p, svt);
   }
   storeDecision(i, levelStart, box, d, nodes, flags, childBoxes);
 }
@@ -235,7 +263,8 @@ __global__ void levelEmitKernel(int n, int levelStart, const int* flags, const i
 
 detail::KdSplitParams splitParams(const KdParams& p, int brick, int64_t rootVol) {
   detail::KdSplitParams s;
-  s.deep = p.leaf == LeafCriterion::Deep ? 1 : 0;
+  s.deep = p.leaf != LeafCriterion::Shallow ? 1 : 0;
+  s.empty = p.leaf == LeafCriterion::Empty ? 1 : 0;
   s.mls = p.maxLeafSize;
   BuildParams checked;  // direct callers (the tests) too: the one check, Builders.cpp's validate
   checked.bins = p.bins;
@@ -265,6 +294,7 @@ void buildKdTreeGpu(const BrickGridView& g, const KdParams& p, KdTreeGpuWorkspac
   const int64_t count = int64_t(1) << (3 * bits);
   ws.mortonBoxes.reserve(size_t(count));
   ws.result.reserve(1);
+  ws.count.reserve(1);
   if (!ws.h_result) SS_CUDA_CHECK(cudaMallocHost(&ws.h_result, sizeof(box3i)));
   mortonBoxesKernel<<<blocksFor(count, kThreads), kThreads, 0, stream>>>(g.d_occ, g.dims, g.brick, g.cellDims,
                                                                          count, ws.mortonBoxes.get());

@@ -24,7 +24,8 @@ struct KdParams {
 struct KdTreeGpuWorkspace {
   DeviceBuffer<box3i> mortonBoxes;  ///< brick boxes in Morton order, padded to a 2^k cube
   DeviceBuffer<box3i> result;
-  TempStorage temp;
+  DeviceBuffer<int> count;  ///< leaf criterion Empty's brick counts
+  TempStorage temp, countTemp;
   box3i* h_result = nullptr;  ///< pinned
   ~KdTreeGpuWorkspace();
 };

@@ -9,6 +9,7 @@
 #include "TransferFunction.h"
 #include "Types.h"
 #include "Volume.h"
+#include "VolumePiece.h"
 
 #include <functional>
 #include <memory>
@@ -46,6 +47,11 @@ class Engine {
   void setTransferFunction(const TransferFunction& tf);
   void setBuildParams(const BuildParams& p);
   void setRenderParams(const RenderParams& p);
+  /// The volume is one piece of a larger one (MPI; VolumePiece.h): rays, planes and the sample
+  /// lattice become the whole volume's and only the owned cells are drawn. A default
+  /// VolumePiece (wholeDims 0) renders the volume as a whole. Checked against the volume at
+  /// render time: a piece that does not fit it is said once and ignored.
+  void setPiece(const VolumePiece& p);
   const BuildParams& buildParams() const;
   const RenderParams& renderParams() const;
 

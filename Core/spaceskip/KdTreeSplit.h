@@ -10,6 +10,15 @@
 // bins == 0 is the sweep (Vidal's plane sweep, every step-th brick boundary): KdTreeCPU always
 // runs it, so a GPU tree with bins 0 is the KdTreeCPU tree of the same leaf criterion and MLS,
 // node for node (the layout order aside). Header-only and host+device (SS_FUNC).
+//
+// Leaf criterion Empty (ours, the paper's open problem, 4.3/4.4): Deep's halting and cost, but a
+// node the cost leaves as a leaf is not cut by size (MLS) but by what it holds: it stays a leaf,
+// however large, when at most 1/kKdEmptyLeafDiv of its bricks are empty (homogeneous space, the
+// Richtmyer-Meshkov case, is never over-split), else it is split at its empty/non-empty boundary:
+// the brick-raster plane, over all three axes, with the largest between-class variance of the
+// brick occupancy (Otsu: (oL nR - oR nL)^2 / (nL nR) for occupied bricks o and bricks n of the two
+// sides), which escapes the greedy cost's local optimum (the Xmas-tree leaf). MLS is ignored.
+// Needs `tight.count(lo, hi)`: occupied bricks in a brick box (SvtView has it).
 #pragma once
 #include "Math.h"
 
@@ -17,12 +26,16 @@
 
 namespace spaceskip::detail {
 
+/// Leaf criterion Empty: a stalled node stays a leaf when empty bricks <= bricks / this.
+constexpr int kKdEmptyLeafDiv = 8;
+
 struct KdSplitParams {
-  int deep;         ///< 1: Deep halting, 0: Shallow
+  int deep;         ///< 1: Deep halting (Deep, Empty), 0: Shallow
   int mls;          ///< 0: none, else max leaf edge in cells
   int bins;         ///< candidate planes = bins - 1 (>= 2); 0: sweep (kdCandidateCount)
   int brick;        ///< raster the planes snap to (cells)
   int64_t rootVol;  ///< volume of the root's tight box (cells)
+  int empty;        ///< 1: leaf criterion Empty (occupancy-driven leaves, MLS ignored), 0: MLS rule
 };
 
 struct KdDecision {
@@ -112,6 +125,68 @@ SS_FUNC KdDecision kdMlsSplit(const box3i& box, int axis, const KdSplitParams& p
   return d;
 }
 
+/// Leaf criterion Empty: the split of a would-be leaf (d.split = 0: it stays a leaf). See the
+/// header comment. Ties: the first axis (x, y, z), then the first plane in increasing order; when
+/// every plane scores 0 (the occupancy looks the same on both sides everywhere) the middle of the
+/// longest axis. Scores are compared in double from exact integers (no FMA can contract them),
+/// so the CPU and the GPU choose alike.
+#ifdef __CUDACC__
+#pragma nv_exec_check_disable
+#endif
+template <class Tight>
+SS_FUNC KdDecision kdEmptySplit(const box3i& box, const KdSplitParams& p, Tight& tight) {
+  KdDecision d;
+  d.split = 0;
+  d.left = d.right = box;
+  if (kdHalts(box, p)) return d;  // Deep's halting holds
+  const int B = p.brick;
+  const vec3i lo{box.lo.x / B, box.lo.y / B, box.lo.z / B};
+  const vec3i hi{(box.hi.x + B - 1) / B, (box.hi.y + B - 1) / B, (box.hi.z + B - 1) / B};
+  const int64_t n = int64_t(hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z);
+  const int64_t o = int64_t(tight.count(lo, hi));
+  if (n <= 1 || (n - o) * kKdEmptyLeafDiv <= n) return d;  // (nearly) homogeneous: a leaf
+  const int step = kdSweepStep(B);
+  double best = 0;
+  int bestAxis = -1, bestPos = 0;
+  for (int a = 0; a < 3; ++a) {
+    const int64_t slab = n / (hi[a] - lo[a]);  // bricks per unit slab along a
+    for (int k = lo[a] + step; k < hi[a]; k += step) {
+      vec3i h2 = hi;
+      h2[a] = k;
+      const int64_t nl = slab * (k - lo[a]), nr = n - nl;
+      const int64_t ol = int64_t(tight.count(lo, h2)), orr = o - ol;
+      const double diff = double(ol * nr - orr * nl);
+      const double score = diff * diff / (double(nl) * double(nr));
+      if (score > best) {
+        best = score;
+        bestAxis = a;
+        bestPos = k;
+      }
+    }
+  }
+  if (bestAxis < 0) {  // no plane tells the two sides apart: halve the longest axis
+    bestAxis = longestAxis(box);
+    if (hi[bestAxis] - lo[bestAxis] < 2) return d;
+    bestPos = lo[bestAxis] + (hi[bestAxis] - lo[bestAxis]) / 2;
+  }
+  box3i l = box, r = box;
+  l.hi[bestAxis] = bestPos * B;
+  r.lo[bestAxis] = bestPos * B;
+  d.split = 1;
+  d.left = tight(l);
+  d.right = tight(r);
+  return d;
+}
+
+/// The split of a node the cost function leaves as a leaf: Empty's rule or MLS's.
+#ifdef __CUDACC__
+#pragma nv_exec_check_disable
+#endif
+template <class Tight>
+SS_FUNC KdDecision kdLeafSplit(const box3i& box, int axis, const KdSplitParams& p, Tight& tight) {
+  return p.empty ? kdEmptySplit(box, p, tight) : kdMlsSplit(box, axis, p, tight);
+}
+
 /// `box` is the node's tight box (cells); `tight(region)` returns the tight box of the
 /// occupied bricks inside `region` (empty box when none; SvtView in SummedVolumeTable.h). The
 /// least cost wins; on ties the first plane in increasing order. KdTreeGPUFast evaluates the
@@ -141,7 +216,7 @@ SS_FUNC KdDecision decideKdSplit(const box3i& box, const KdSplitParams& p, Tight
     }
     if (d.split) return d;
   }
-  return kdMlsSplit(box, axis, p, tight);
+  return kdLeafSplit(box, axis, p, tight);
 }
 
 }  // namespace spaceskip::detail

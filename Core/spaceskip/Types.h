@@ -30,7 +30,9 @@ enum class BuilderKind : int {
   DistanceGrid,   ///< ours: the Grid DDA leaping through empty space with a distance field
   Auto            ///< measures a few structures (Naive among them) one frame each, keeps the fastest
 };
-enum class LeafCriterion : int { Shallow, Deep };
+/// Empty (ours): Deep, but a leaf is kept or split by its empty space, not its size
+/// (KdTreeSplit.h, kdEmptySplit); MLS is ignored.
+enum class LeafCriterion : int { Shallow, Deep, Empty };
 enum class BackendKind : int { Auto, CPU, CUDA };
 enum class FilterMode : int { Exact, Hardware };
 
@@ -50,9 +52,13 @@ struct BuildParams {
   /// Engine::setBuildParams throws std::invalid_argument for 1 and negative values.
   int bins = 4;
   int brick = 8;        ///< macro-cell edge in cells (classification granularity)
+  /// Builder Auto, progressive refinement: after an edit that changes the occupancy, when the
+  /// kept structure took longer than this to build, the first frame is drawn with Grid (no build
+  /// beyond classification) and the kept structure is rebuilt for the frame after. < 0: never.
+  double autoQuickBuildSeconds = 1e-3;
   bool operator==(const BuildParams& o) const {
     return builder == o.builder && leaf == o.leaf && maxLeafSize == o.maxLeafSize &&
-           bins == o.bins && brick == o.brick;
+           bins == o.bins && brick == o.brick && autoQuickBuildSeconds == o.autoQuickBuildSeconds;
   }
   bool operator!=(const BuildParams& o) const { return !(*this == o); }
 };

@@ -3,11 +3,13 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <stdexcept>
 #include <utility>
@@ -278,15 +280,15 @@ Volume rm(vec3l dims, unsigned seed) {
   return v;
 }
 
-// Branching tubes from a random walk (a vessel tree stand-in, ~1% occupied).
-Volume vessels(vec3l dims, unsigned seed) {
+// Branching tubes from a random walk (a vessel tree stand-in, ~1% occupied); radii x `thick`.
+Volume vessels(vec3l dims, unsigned seed, double thick = 1.0) {
   Volume v;
   v.allocate(dims, VoxelType::UInt8);
   unsigned char* d = v.mutableData();
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n(0, 1);
   struct Seg { double p[3], dir[3], r; int depth; };
-  std::vector<Seg> todo{{{0.5, 0.5, 0.05}, {0, 0, 1}, 0.03, 0}};
+  std::vector<Seg> todo{{{0.5, 0.5, 0.05}, {0, 0, 1}, 0.03 * thick, 0}};
   const double scale = double(std::min({dims.x, dims.y, dims.z}));
   while (!todo.empty()) {
     Seg s = todo.back();
@@ -327,9 +329,376 @@ Volume vessels(vec3l dims, unsigned seed) {
   return v;
 }
 
+
+// ---- The paper's other data sets (Zellmann, Fig. 1): stand-ins with its dims and occupancy ----
+// Every stand-in is uint8 with background 0, a 255 voxel and every other non-zero voxel >= 32,
+// so under the "ramp" preset over the volume's range (the bench's TF: transparent below 10% of
+// the range) exactly the non-zero voxels are visible: the paper's occupancy ("percentage of
+// voxels that are visible given a certain transfer function"). Shapes are defined on the unit
+// cube (per-axis scaling to the dims; lengths in units of the smallest dim), so the occupancy
+// holds at any resolution (TestGenerators.cpp measures it at a small size).
+
+/// A primitive rasterized into the volume (max of values): a capsule (segment a-b, radius r0 at
+/// a to r1 at b, value vc at the axis to ve at the surface) or an ellipsoid shell (centre a, radii
+/// b, thickness r0), all in voxels. `speckle` in (0,1]: only that fraction of the voxels inside
+/// (a per-voxel hash) is set: needles, porous tissue.
+struct Prim {
+  enum Kind { Capsule, Shell } kind = Capsule;
+  double a[3] = {0, 0, 0}, b[3] = {0, 0, 0};
+  double r0 = 1, r1 = 1;
+  double vc = 255, ve = 160;
+  double speckle = 1;
+  unsigned seed = 0;
+  int64_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // voxel bounds (inclusive lo, exclusive hi)
+
+  void bound(vec3l dims) {
+    for (int k = 0; k < 3; ++k) {
+      double l, h;
+      if (kind == Capsule) {
+        const double r = std::max(r0, r1) + 1;
+        l = std::min(a[k], b[k]) - r;
+        h = std::max(a[k], b[k]) + r;
+      } else {
+        l = a[k] - b[k] - r0 - 1;
+        h = a[k] + b[k] + r0 + 1;
+      }
+      const int64_t n = k == 0 ? dims.x : k == 1 ? dims.y : dims.z;
+      lo[k] = std::clamp<int64_t>(int64_t(std::floor(l)), 0, n);
+      hi[k] = std::clamp<int64_t>(int64_t(std::ceil(h)) + 1, 0, n);
+    }
+  }
+  /// Value at voxel centre (x, y, z) (voxel units), 0 outside.
+  double value(double x, double y, double z) const {
+    double f;  // 0 at the core, 1 at the surface, > 1 outside
+    if (kind == Capsule) {
+      const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      const double p[3] = {x - a[0], y - a[1], z - a[2]};
+      const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      const double t = dd > 0 ? std::clamp((p[0] * d[0] + p[1] * d[1] + p[2] * d[2]) / dd, 0.0, 1.0) : 0.0;
+      const double q[3] = {p[0] - t * d[0], p[1] - t * d[1], p[2] - t * d[2]};
+      const double r = r0 + t * (r1 - r0);
+      f = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]) / std::max(r, 0.5);
+    } else {
+      const double q[3] = {(x - a[0]) / b[0], (y - a[1]) / b[1], (z - a[2]) / b[2]};
+      const double rn = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+      const double rmin = std::min({b[0], b[1], b[2]});
+      f = std::fabs(rn - 1.0) * rmin / std::max(0.5 * r0, 0.5);  // distance to the surface / half thickness
+    }
+    if (f > 1) return 0;
+    if (speckle < 1 && hash3(int64_t(x), int64_t(y), int64_t(z), seed) >= speckle) return 0;
+    return vc + (ve - vc) * f;
+  }
+};
+
+/// Rasterizes the primitives (max of their values, each value clamped to [32, 255]): parallel
+/// over z, each slice visiting only the primitives whose bounds hold it.
+void rasterize(Volume& v, std::vector<Prim>& prims) {
+  for (Prim& p : prims) p.bound(v.dims);
+  std::vector<std::vector<int>> byZ(size_t(v.dims.z));
+  for (size_t i = 0; i < prims.size(); ++i)
+    for (int64_t z = prims[i].lo[2]; z < prims[i].hi[2]; ++z) byZ[size_t(z)].push_back(int(i));
+  unsigned char* d = v.mutableData();
+  const int64_t nx = v.dims.x, ny = v.dims.y;
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, v.dims.z), [&](const tbb::blocked_range<int64_t>& r) {
+    for (int64_t z = r.begin(); z != r.end(); ++z)
+      for (int i : byZ[size_t(z)]) {
+        const Prim& p = prims[size_t(i)];
+        for (int64_t y = p.lo[1]; y < p.hi[1]; ++y)
+          for (int64_t x = p.lo[0]; x < p.hi[0]; ++x) {
+            const double val = p.value(x + 0.5, y + 0.5, z + 0.5);
+            if (val <= 0) continue;
+            const auto c = (unsigned char)std::lround(std::clamp(val, 32.0, 255.0));
+            unsigned char& t = d[x + nx * (y + ny * z)];
+            t = std::max(t, c);
+          }
+      }
+  });
+}
+
+/// Unit-cube point -> voxel coordinates.
+struct Frame {
+  vec3l dims;
+  double S;  ///< the smallest dim: lengths are in its units
+  explicit Frame(vec3l d) : dims(d), S(double(std::min({d.x, d.y, d.z}))) {}
+  void at(double u, double v, double w, double* o) const {
+    o[0] = u * double(dims.x);
+    o[1] = v * double(dims.y);
+    o[2] = w * double(dims.z);
+  }
+  Prim capsule(const double* a, const double* b, double r0, double r1, double vc = 255, double ve = 160) const {
+    Prim p;
+    at(a[0], a[1], a[2], p.a);
+    at(b[0], b[1], b[2], p.b);
+    p.r0 = r0 * S;
+    p.r1 = r1 * S;
+    p.vc = vc;
+    p.ve = ve;
+    return p;
+  }
+};
+
+/// Raises the brightest voxel to 255 unless one is (so every stand-in spans [0, 255] and the
+/// ramp's threshold sits at 25.5, below every non-zero voxel).
+void markMax(Volume& v) {
+  unsigned char* d = v.mutableData();
+  const int64_t n = v.voxelCount();
+  const auto m = std::max_element(d, d + n);
+  if (*m == 0) d[n / 2] = 255;  // an empty shape still gets its range
+  else *m = 255;
+}
+
+// Aneurism (256^3, 1.01%): the vessel tree and a saccular aneurism (a ball) on its trunk.
+Volume aneurism(vec3l dims, unsigned seed) {
+  Volume v = vessels(dims, seed, 2.12);
+  const Frame f(dims);
+  const double c[3] = {0.56, 0.5, 0.3};
+  std::vector<Prim> sac{f.capsule(c, c, 0.055, 0.055, 255, 200)};
+  rasterize(v, sac);
+  markMax(v);
+  return v;
+}
+
+// Xmas tree (512x499x512, 2.90%; height along y): a trunk, 15 tiers of 9 drooping branches
+// out to the cone's surface, twigs, needle foliage (speckled tubes) and baubles at the tips. The
+// cone's inside is empty between the branches and every branch reaches the hull, so no plane
+// removes empty space from the whole tree: the paper's local optimum (Fig. 2, top).
+Volume xmasTree(vec3l dims, unsigned seed) {
+  Volume v;
+  v.allocate(dims, VoxelType::UInt8);
+  const Frame f(dims);
+  std::vector<Prim> prims;
+  const double base[3] = {0.5, 0.02, 0.5}, top[3] = {0.5, 0.97, 0.5};
+  prims.push_back(f.capsule(base, top, 0.022, 0.006, 255, 200));
+  const int tiers = 15, perTier = 9;
+  for (int i = 0; i < tiers; ++i) {
+    const double h = 0.12 + 0.8 * i / (tiers - 1);
+    const double R = 0.46 * (1.0 - (h - 0.08) / 0.95);
+    for (int j = 0; j < perTier; ++j) {
+      const double th = 6.283185307179586 * (j + 0.5 * (i & 1) + 0.3 * urand(seed, uint64_t(i * 16 + j), 1)) / perTier;
+      const double a[3] = {0.5, h, 0.5};
+      const double b[3] = {0.5 + R * std::cos(th), h - 0.05 - 0.04 * urand(seed, uint64_t(i * 16 + j), 2),
+                           0.5 + R * std::sin(th)};
+      prims.push_back(f.capsule(a, b, 0.006, 0.003, 230, 150));
+      Prim fol = f.capsule(a, b, 0.010, 0.026, 120, 60);  // needles: speckled, widening outwards
+      fol.speckle = 0.68;
+      fol.seed = seed + 17;
+      prims.push_back(fol);
+      for (int k = 1; k <= 4; ++k) {  // twigs
+        const double t = 0.25 + 0.17 * k;
+        const double m[3] = {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])};
+        const double side = (k & 1) ? 1.0 : -1.0;
+        const double e[3] = {m[0] + 0.12 * R * (std::cos(th) - side * std::sin(th)), m[1] - 0.02,
+                             m[2] + 0.12 * R * (std::sin(th) + side * std::cos(th))};
+        prims.push_back(f.capsule(m, e, 0.004, 0.003, 200, 140));
+      }
+      if ((i + j) % 2 == 0) prims.push_back(f.capsule(b, b, 0.014, 0.014, 255, 220));  // bauble
+    }
+  }
+  rasterize(v, prims);
+  markMax(v);
+  return v;
+}
+
+// Magnetic reconnection (512^3, 16.6%): smooth turbulent flux structures, value noise above a
+// threshold (blobs and sheets strewn through the whole box, empty space interleaved).
+Volume magnetic(vec3l dims, unsigned seed) {
+  Volume v;
+  v.allocate(dims, VoxelType::UInt8);
+  constexpr double t = 0.613;  // fbm above this in ~16.6% of the box (TestGenerators)
+  fill(v, [&](int64_t x, int64_t y, int64_t z) -> unsigned char {
+    const double px = (x + 0.5) / dims.x, py = (y + 0.5) / dims.y, pz = (z + 0.5) / dims.z;
+    // Sheared coordinates: structures stretched along x like reconnecting field lines.
+    const double n = fbm(4 * px + 2 * py, 10 * py, 10 * pz + 1.5 * px, seed + 31);
+    if (n <= t) return 0;
+    return (unsigned char)std::lround(std::min(255.0, 40.0 + 215.0 * (n - t) / (1.0 - t)));
+  });
+  markMax(v);
+  return v;
+}
+
+// Stag beetle (832x832x494, 4.04%; body along y, up along z): the exoskeleton as ellipsoid
+// shells (abdomen, thorax, head), two mandibles, six three-segment legs and two antennae.
+Volume stagBeetle(vec3l dims, unsigned seed) {
+  (void)seed;
+  Volume v;
+  v.allocate(dims, VoxelType::UInt8);
+  const Frame f(dims);
+  std::vector<Prim> prims;
+  auto shell = [&](double u, double w, double z, double rx, double ry, double rz, double thick) {
+    Prim p;
+    p.kind = Prim::Shell;
+    f.at(u, w, z, p.a);
+    p.b[0] = rx * double(dims.x);
+    p.b[1] = ry * double(dims.y);
+    p.b[2] = rz * double(dims.z);
+    p.r0 = thick * f.S;
+    p.vc = 255;
+    p.ve = 170;
+    prims.push_back(p);
+  };
+  constexpr double th = 0.0425;  // shell thickness (units of the smallest dim), calibrated
+  shell(0.5, 0.34, 0.42, 0.19, 0.22, 0.30, th);   // abdomen (elytra)
+  shell(0.5, 0.60, 0.45, 0.15, 0.07, 0.24, th);   // thorax
+  shell(0.5, 0.72, 0.45, 0.12, 0.055, 0.18, th);  // head
+  for (int s : {-1, 1}) {
+    // Mandibles: three segments curving forward and in.
+    const double m0[3] = {0.5 + s * 0.07, 0.77, 0.45}, m1[3] = {0.5 + s * 0.13, 0.86, 0.47},
+                 m2[3] = {0.5 + s * 0.11, 0.94, 0.49}, m3[3] = {0.5 + s * 0.04, 0.985, 0.5};
+    prims.push_back(f.capsule(m0, m1, 0.03, 0.026, 255, 180));
+    prims.push_back(f.capsule(m1, m2, 0.026, 0.02, 255, 180));
+    prims.push_back(f.capsule(m2, m3, 0.02, 0.01, 255, 180));
+    const double a0[3] = {0.5 + s * 0.09, 0.75, 0.55}, a1[3] = {0.5 + s * 0.2, 0.82, 0.62};
+    prims.push_back(f.capsule(a0, a1, 0.006, 0.005, 230, 160));  // antenna
+    for (int l = 0; l < 3; ++l) {
+      const double y = 0.56 - 0.1 * l;
+      const double p0[3] = {0.5 + s * 0.12, y, 0.32}, p1[3] = {0.5 + s * 0.26, y + 0.03 * (1 - l), 0.42},
+                   p2[3] = {0.5 + s * 0.36, y + 0.05 * (1 - l), 0.18}, p3[3] = {0.5 + s * 0.44, y + 0.07 * (1 - l), 0.03};
+      prims.push_back(f.capsule(p0, p1, 0.018, 0.015, 240, 160));
+      prims.push_back(f.capsule(p1, p2, 0.015, 0.011, 240, 160));
+      prims.push_back(f.capsule(p2, p3, 0.011, 0.007, 240, 160));
+    }
+  }
+  rasterize(v, prims);
+  markMax(v);
+  return v;
+}
+
+// Kingsnake (1024x1024x795, 0.39%): the skeleton of a coiled snake, a spine on a three-turn
+// spiral in the xy plane with vertebrae (balls) and a pair of ribs (arcs of three segments) at
+// each, thin structures over a large, mostly empty box.
+Volume kingsnake(vec3l dims, unsigned seed) {
+  (void)seed;
+  Volume v;
+  v.allocate(dims, VoxelType::UInt8);
+  const Frame f(dims);
+  std::vector<Prim> prims;
+  constexpr double rv = 0.0118, rr = 0.0052, body = 0.035;  // vertebra, rib radius, body radius
+  const double turns = 3.0, r0 = 0.08, r1 = 0.42;
+  double arc = 0;
+  double prev[3] = {0, 0, 0};
+  const int steps = 20000;
+  for (int i = 0; i <= steps; ++i) {
+    const double t = double(i) / steps, ang = 6.283185307179586 * turns * t, r = r0 + (r1 - r0) * t;
+    const double p[3] = {0.5 + r * std::cos(ang), 0.5 + r * std::sin(ang),
+                         0.35 + 0.04 * std::sin(5 * ang) + (t < 0.04 ? 3.0 * (0.04 - t) : 0.0)};
+    if (i > 0) arc += std::hypot(p[0] - prev[0], p[1] - prev[1], p[2] - prev[2]);
+    std::copy(p, p + 3, prev);
+    if (i > 0 && arc < 0.011) continue;
+    arc = 0;
+    prims.push_back(f.capsule(p, p, rv, rv, 255, 200));
+    // Ribs: around the body in the plane normal to the spiral's tangent (radial, z).
+    const double nx = std::cos(ang), ny = std::sin(ang);
+    for (int s : {-1, 1}) {
+      double q[3] = {p[0], p[1], p[2]};
+      for (int k = 1; k <= 3; ++k) {
+        const double phi = 3.14159265 * 0.5 * k / 3.0;  // from the top round the side and down
+        const double e[3] = {p[0] + s * body * std::sin(phi) * nx, p[1] + s * body * std::sin(phi) * ny,
+                             p[2] + body * (std::cos(phi) - 1.0) * 0.9};
+        prims.push_back(f.capsule(q, e, rr, rr * 0.8, 230, 150));
+        std::copy(e, e + 3, q);
+      }
+    }
+  }
+  rasterize(v, prims);
+  markMax(v);
+  return v;
+}
+
+// Richtmyer-Meshkov (2048x2048x1920, 50.6%; the mixing direction along z): the paper's two large
+// regions, a totally homogeneous heavy fluid at the bottom and empty space at the top, with a
+// turbulent mixing layer between them (bubbles and spikes of varied values) around a perturbed
+// interface h(x, y). The homogeneous region is where MLS over-splits (Fig. 2, bottom).
+Volume richtmyerMeshkov(vec3l dims, unsigned seed) {
+  Volume v;
+  v.allocate(dims, VoxelType::UInt8);
+  unsigned char* d = v.mutableData();
+  const int64_t nx = dims.x, ny = dims.y, nz = dims.z;
+  std::vector<double> h(size_t(nx * ny));
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, ny), [&](const tbb::blocked_range<int64_t>& r) {
+    for (int64_t y = r.begin(); y != r.end(); ++y)
+      for (int64_t x = 0; x < nx; ++x) {
+        const double px = (x + 0.5) / nx, py = (y + 0.5) / ny;
+        h[size_t(x + nx * y)] = 0.5 + 0.035 * std::sin(6.283185307179586 * 3 * px) * std::sin(6.283185307179586 * 2 * py) +
+                                0.06 * (fbm(5 * px, 5 * py, 0.5, seed) - 0.5);
+      }
+  });
+  constexpr double w = 0.1, shift = 0.006;  // mixing half-width; shift calibrates the occupancy
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, nz), [&](const tbb::blocked_range<int64_t>& r) {
+    for (int64_t z = r.begin(); z != r.end(); ++z) {
+      const double pz = (z + 0.5) / nz;
+      for (int64_t y = 0; y < ny; ++y)
+        for (int64_t x = 0; x < nx; ++x) {
+          const double hc = h[size_t(x + nx * y)] + shift;
+          unsigned char val = 0;
+          if (pz < hc - w) val = 200;  // homogeneous heavy fluid
+          else if (pz < hc + w) {
+            const double heavy = (hc + w - pz) / (2 * w);  // 1 at the bottom of the layer, 0 at its top
+            const double px = (x + 0.5) / nx, py = (y + 0.5) / ny;
+            const double n = 0.65 * valueNoise(28 * px, 28 * py, 28 * pz, seed + 5) +
+                             0.35 * valueNoise(71 * px, 71 * py, 71 * pz, seed + 6);
+            const double m = 0.5 + 1.6 * (n - 0.5);  // spread towards [0, 1]
+            if (m < heavy) val = (unsigned char)std::lround(std::clamp(60.0 + 195.0 * (heavy - m) / 0.35, 60.0, 255.0));
+          }
+          d[x + nx * (y + ny * z)] = val;
+        }
+    }
+  });
+  markMax(v);
+  return v;
+}
+
 }  // namespace
 
-std::vector<std::string> generatorShapes() { return {"menger", "nbody", "shell", "noise", "rm", "vessels"}; }
+double visibleVoxelFraction(const Volume& v, const TransferFunction& tf) {
+  if (tf.table.empty() || v.voxelCount() == 0) return 0;
+  const double lo = tf.rangeMin, hi = tf.rangeMax;
+  const double scale = hi > lo ? double(tf.table.size() - 1) / (hi - lo) : 0.0;
+  const int64_t n = v.voxelCount();
+  return dispatchVoxelType(v.type, [&](auto voxel) {
+    using T = decltype(voxel);
+    const T* p = reinterpret_cast<const T*>(v.data);
+    const int64_t visible = tbb::parallel_reduce(
+        tbb::blocked_range<int64_t>(0, n), int64_t(0),
+        [&](const tbb::blocked_range<int64_t>& r, int64_t acc) {
+          for (int64_t i = r.begin(); i != r.end(); ++i) {
+            const double s = double(p[i]);
+            if (!(s == s)) continue;  // NaN: transparent
+            // Linear interpolation of the table's opacity, as a sample at the voxel sees it.
+            const double f = std::clamp((s - lo) * scale, 0.0, double(tf.table.size() - 1));
+            const size_t i0 = size_t(f);
+            const size_t i1 = std::min(i0 + 1, tf.table.size() - 1);
+            const double a = tf.table[i0].w + (f - double(i0)) * (tf.table[i1].w - tf.table[i0].w);
+            acc += a > 0;
+          }
+          return acc;
+        },
+        std::plus<int64_t>());
+    return double(visible) / double(n);
+  });
+}
+
+const std::vector<PaperDataset>& paperDatasets() {
+  // shared/paper/paper_results.csv: name, dims, occupancy (% of voxels); our generator for each.
+  static const std::vector<PaperDataset> sets = {
+      {"aneurism", "aneurism", {256, 256, 256}, 1.01},
+      {"xmas_tree", "xmas_tree", {512, 499, 512}, 2.90},
+      {"magnetic", "magnetic", {512, 512, 512}, 16.6},
+      {"stag_beetle", "stag_beetle", {832, 832, 494}, 4.04},
+      {"kingsnake", "kingsnake", {1024, 1024, 795}, 0.39},
+      {"menger_sponge", "menger", {1024, 1024, 1024}, 40.7},
+      {"richtmyer_meshkov", "richtmyer_meshkov", {2048, 2048, 1920}, 50.6},
+      {"nbody_256", "nbody", {256, 256, 256}, 0.15},
+      {"nbody_512", "nbody", {512, 512, 512}, 0.15},
+      {"nbody_1024", "nbody", {1024, 1024, 1024}, 0.15},
+      {"nbody_2048", "nbody", {2048, 2048, 2048}, 0.15},
+  };
+  return sets;
+}
+
+std::vector<std::string> generatorShapes() {
+  return {"menger", "nbody", "shell", "noise", "rm", "vessels", "aneurism", "xmas_tree", "magnetic", "stag_beetle",
+          "kingsnake", "richtmyer_meshkov"};
+}
 
 Volume generateVolume(const std::string& shape, vec3l dims, unsigned seed) {
   if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0) throw std::invalid_argument("dims must be positive");
@@ -339,7 +708,15 @@ Volume generateVolume(const std::string& shape, vec3l dims, unsigned seed) {
   if (shape == "noise") return noise(dims, seed);
   if (shape == "rm") return rm(dims, seed);
   if (shape == "vessels") return vessels(dims, seed);
-  throw std::invalid_argument("unknown shape '" + shape + "' (menger, nbody, shell, noise, rm, vessels)");
+  if (shape == "aneurism") return aneurism(dims, seed);
+  if (shape == "xmas_tree") return xmasTree(dims, seed);
+  if (shape == "magnetic") return magnetic(dims, seed);
+  if (shape == "stag_beetle") return stagBeetle(dims, seed);
+  if (shape == "kingsnake") return kingsnake(dims, seed);
+  if (shape == "richtmyer_meshkov") return richtmyerMeshkov(dims, seed);
+  std::string known;
+  for (const std::string& g : generatorShapes()) known += (known.empty() ? "" : ", ") + g;
+  throw std::invalid_argument("unknown shape '" + shape + "' (" + known + ")");
 }
 
 }  // namespace spaceskip

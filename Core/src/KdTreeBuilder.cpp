@@ -29,7 +29,8 @@ class KdTreeBuild {
   KdTreeBuild(const OccupancyGrid& occ, const BuildParams& p, bool parallel)
       : occ_(occ), parallel_(parallel), svt_(occ) {
     // KdTreeCPU always sweeps (bins 0) and ignores p.bins.
-    sp_.deep = p.leaf == LeafCriterion::Deep ? 1 : 0;
+    sp_.deep = p.leaf != LeafCriterion::Shallow ? 1 : 0;
+    sp_.empty = p.leaf == LeafCriterion::Empty ? 1 : 0;
     sp_.mls = p.maxLeafSize;
     sp_.bins = 0;
     sp_.brick = occ.brick;

@@ -2,8 +2,20 @@
 #include "vtkSpaceSkipVolumeRepresentation.h"
 
 #include "vtkColorTransferFunction.h"
+#include "vtkCommunicator.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkMath.h"
+#include "vtkMultiProcessController.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkOutlineSource.h"
+#include "vtkPointData.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPartitionedDataSet.h"
 #include "vtkScalarsToColors.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
 #include "vtkVolumeProperty.h"
@@ -39,6 +51,161 @@ void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
   const bool indep = prop->GetIndependentComponents() != 0;
   this->SpaceSkipMapper->SetVectorMode(indep ? ctf->GetVectorMode() : vtkScalarsToColors::COMPONENT);
   this->SpaceSkipMapper->SetVectorComponent(indep ? ctf->GetVectorComponent() : 0);
+  // In pieces: the whole data's range of what the mapper draws (its transfer-function table
+  // spans the data's range; each piece's own range would give each rank another table).
+  const int k = static_cast<int>(this->WholeRanges.size() / 2) - 1; // components
+  double range[2] = { 1, 0 };                                         // none: the piece's own
+  if (k >= 1)
+  {
+    const int mode = this->SpaceSkipMapper->GetVectorMode();
+    const int c = k > 1 && mode == vtkScalarsToColors::MAGNITUDE
+      ? k
+      : std::min(std::max(this->SpaceSkipMapper->GetVectorComponent(), 0), k - 1);
+    range[0] = this->WholeRanges[2 * c];
+    range[1] = this->WholeRanges[2 * c + 1];
+  }
+  this->SpaceSkipMapper->SetWholeScalarRange(range);
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (!this->Superclass::RequestUpdateExtent(request, inputVector, outputVector))
+  {
+    return 0;
+  }
+  // Pieces share their face points, so a trilinear sample in a piece's own cells reads its own
+  // voxels; shading's central differences read one voxel further: one ghost layer.
+  using SDDP = vtkStreamingDemandDrivenPipeline;
+  for (int i = 0; i < inputVector[0]->GetNumberOfInformationObjects(); ++i)
+  {
+    vtkInformation* info = inputVector[0]->GetInformationObject(i);
+    const int pieces = info->Has(SDDP::UPDATE_NUMBER_OF_PIECES())
+      ? info->Get(SDDP::UPDATE_NUMBER_OF_PIECES())
+      : 1;
+    if (pieces > 1)
+    {
+      const int levels = info->Has(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
+        ? info->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
+        : 0;
+      info->Set(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS(), std::max(levels, 1));
+    }
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::RequestData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (inputVector[0]->GetNumberOfInformationObjects() == 1 && vtkPartitionedDataSet::GetData(inputVector[0], 0))
+  {
+    return this->RequestPartitionedData(request, inputVector, outputVector);
+  }
+  // The base class crops the ghost cells away (and keeps the cropped bounds for the ordered
+  // compositing's partition): the mapper gets the piece with its ghost layers instead.
+  const int ok = this->Superclass::RequestData(request, inputVector, outputVector);
+  vtkImageData* input = inputVector[0]->GetNumberOfInformationObjects() == 1
+    ? vtkImageData::GetData(inputVector[0], 0)
+    : nullptr;
+  if (input && input->HasAnyGhostCells() && !this->UseSeparateOpacityArray)
+  {
+    auto cache = vtkSmartPointer<vtkImageData>::New();
+    cache->ShallowCopy(input);
+    this->VolumeMapper->SetInputData(cache);
+    this->Cache = cache;
+  }
+  this->SpaceSkipMapper->SetWholeExtent(this->WholeExtent);
+
+  // The colour array's range over all ranks (collective: every rank runs RequestData).
+  this->WholeRanges.clear();
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
+  const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
+    ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  if (!controller || controller->GetNumberOfProcesses() < 2 || !name || !name[0])
+  {
+    return ok;
+  }
+  vtkDataArray* array = input ? input->GetPointData()->GetArray(name) : nullptr;
+  int local = array ? array->GetNumberOfComponents() : 0, k = 0;
+  controller->AllReduce(&local, &k, 1, vtkCommunicator::MAX_OP);
+  if (k < 1)
+  {
+    return ok;
+  }
+  std::vector<double> lo(static_cast<size_t>(k + 1), VTK_DOUBLE_MAX);
+  std::vector<double> hi(static_cast<size_t>(k + 1), VTK_DOUBLE_MIN);
+  if (array && local == k)
+  {
+    // As the mapper reads them: native single-component types as they are, the rest as float.
+    const int t = array->GetDataType();
+    const bool native = k == 1 &&
+      (t == VTK_UNSIGNED_CHAR || t == VTK_CHAR || t == VTK_SIGNED_CHAR || t == VTK_UNSIGNED_SHORT ||
+        t == VTK_SHORT || t == VTK_FLOAT || t == VTK_DOUBLE);
+    for (int c = 0; c <= k; ++c)
+    {
+      double r[2];
+      array->GetFiniteRange(r, c == k ? -1 : c);
+      if (r[0] <= r[1])
+      {
+        lo[c] = native ? r[0] : static_cast<double>(static_cast<float>(r[0]));
+        hi[c] = native ? r[1] : static_cast<double>(static_cast<float>(r[1]));
+      }
+    }
+  }
+  std::vector<double> wlo(lo.size()), whi(hi.size());
+  controller->AllReduce(lo.data(), wlo.data(), static_cast<vtkIdType>(lo.size()), vtkCommunicator::MIN_OP);
+  controller->AllReduce(hi.data(), whi.data(), static_cast<vtkIdType>(hi.size()), vtkCommunicator::MAX_OP);
+  this->WholeRanges.resize(2 * lo.size());
+  for (size_t c = 0; c < lo.size(); ++c)
+  {
+    this->WholeRanges[2 * c] = wlo[c];
+    this->WholeRanges[2 * c + 1] = whi[c];
+  }
+  return ok;
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPartitionedDataSet* input = vtkPartitionedDataSet::GetData(inputVector[0], 0);
+  // What vtkImageVolumeRepresentation::RequestData does for partitioned input with
+  // vtkMultiBlockVolumeMapper, plus the outline (drawn where the data is not) and the data size.
+  vtkMath::UninitializeBounds(this->DataBounds);
+  this->DataSize = 0;
+  this->WholeExtent[0] = this->WholeExtent[2] = this->WholeExtent[4] = 0;
+  this->WholeExtent[1] = this->WholeExtent[3] = this->WholeExtent[5] = -1;
+  vtkNew<vtkPartitionedDataSet> cache;
+  unsigned int n = 0;
+  for (unsigned int i = 0; i < input->GetNumberOfPartitions(); ++i)
+  {
+    vtkDataSet* partition = input->GetPartition(i);
+    if (!partition)
+    {
+      continue;
+    }
+    if (this->UseSeparateOpacityArray)
+    {
+      this->AppendOpacityComponent(partition);
+    }
+    // Other types stay in: the mapper says once that it skips them.
+    cache->SetPartition(n++, partition);
+  }
+  cache->GetBounds(this->DataBounds);
+  if (vtkMath::AreBoundsInitialized(this->DataBounds))
+  {
+    this->OutlineSource->SetBounds(this->DataBounds);
+    this->OutlineSource->Update();
+  }
+  this->DataSize = cache->GetActualMemorySize();
+  this->Actor->SetEnableLOD(0);
+  this->Cache = cache;
+  // Skips vtkImageVolumeRepresentation::RequestData (it would refuse the partitions).
+  return this->vtkVolumeRepresentation::RequestData(request, inputVector, outputVector);
 }
 
 //------------------------------------------------------------------------------

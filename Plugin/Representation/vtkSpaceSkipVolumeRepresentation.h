@@ -8,8 +8,10 @@
  * (each rank renders its own piece; ParaView composites the pieces in visibility order).
  * The setters forward to the mapper; the getters report its last build and frame.
  *
- * Limits: vtkImageData input only (a vtkPartitionedDataSet or vtkRectilinearGrid is refused by the
- * base class or by the mapper with a warning); 1-component point scalars.
+ * Input: vtkImageData, and the vtkPartitionedDataSet of vtkImageData that ParaView makes of
+ * partitioned, multiblock and partitioned-collection image data (the base class keeps those for
+ * vtkMultiBlockVolumeMapper; the mapper draws each block with its own hierarchy). Rectilinear
+ * grids are refused by the mapper with a warning.
  */
 #ifndef vtkSpaceSkipVolumeRepresentation_h
 #define vtkSpaceSkipVolumeRepresentation_h
@@ -18,6 +20,7 @@
 #include "vtkSpaceSkipRepresentationModule.h" // for export macro
 
 #include <string> // for std::string
+#include <vector> // for std::vector
 
 class vtkSpaceSkippingVolumeMapper;
 
@@ -84,6 +87,23 @@ protected:
   /// The base class hands the colour map's Magnitude/Component choice only to VTK's own
   /// mappers; this passes it to ours as well.
   void UpdateMapperParameters() override;
+
+  ///@{
+  /// In pieces (MPI): one ghost layer is requested and kept (the base class crops it away), the
+  /// whole extent and the whole data's scalar range go to the mapper, which samples the whole
+  /// image's lattice and draws its own cells only; the pieces then composite to the serial image.
+  int RequestUpdateExtent(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+  int RequestData(vtkInformation* request, vtkInformationVector** inputVector,
+    vtkInformationVector* outputVector) override;
+  /// Finite ranges of the colour array over all ranks (lo, hi per component, then the
+  /// magnitude's); empty in a serial run.
+  std::vector<double> WholeRanges;
+  ///@}
+  /// vtkPartitionedDataSet input, which the base class renders only with
+  /// vtkMultiBlockVolumeMapper: the same cache of partitions for our mapper (it accepts composite
+  /// input), with the outline and data size of the whole.
+  int RequestPartitionedData(vtkInformation*, vtkInformationVector**, vtkInformationVector*);
 
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;

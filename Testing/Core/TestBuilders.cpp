@@ -94,7 +94,48 @@ struct RefKd {
         }
       }
     }
-    if (!found && p.maxLeafSize > 0 && len[axis] > p.maxLeafSize && b.hi[axis] - b.lo[axis] >= 2) {
+    if (!found && !halt && p.leaf == LeafCriterion::Empty) {
+      // Empty's rule, brute force: a leaf when <= 1/8 of its bricks are empty, else the plane of
+      // largest between-class variance of the brick occupancy over all three axes.
+      auto bricks = [&](const box3i& r) {
+        int64_t o = 0;
+        for (int z = r.lo.z; z < r.hi.z; ++z)
+          for (int y = r.lo.y; y < r.hi.y; ++y)
+            for (int x = r.lo.x; x < r.hi.x; ++x) o += g.at(x, y, z) ? 1 : 0;
+        return o;
+      };
+      const int64_t n = int64_t(b.hi.x - b.lo.x) * (b.hi.y - b.lo.y) * (b.hi.z - b.lo.z), o = bricks(b);
+      if (n > 1 && 8 * (n - o) > n) {
+        double bestScore = 0;
+        int ba = -1, bp = 0;
+        for (int a = 0; a < 3; ++a)
+          for (int pl = b.lo[a] + step; pl < b.hi[a]; pl += step) {
+            box3i l = b;
+            l.hi[a] = pl;
+            const int64_t nl = int64_t(l.hi.x - l.lo.x) * (l.hi.y - l.lo.y) * (l.hi.z - l.lo.z), nr = n - nl;
+            const int64_t ol = bricks(l), orr = o - ol;
+            const double diff = double(ol * nr - orr * nl), score = diff * diff / (double(nl) * double(nr));
+            if (score > bestScore) {
+              bestScore = score;
+              ba = a;
+              bp = pl;
+            }
+          }
+        if (ba < 0 && b.hi[axis] - b.lo[axis] >= 2) {
+          ba = axis;
+          bp = b.lo[axis] + (b.hi[axis] - b.lo[axis]) / 2;
+        }
+        if (ba >= 0) {
+          box3i l = b, r = b;
+          l.hi[ba] = r.lo[ba] = bp;
+          bl = tight(l);
+          br = tight(r);
+          found = true;
+        }
+      }
+    }
+    if (!found && p.leaf != LeafCriterion::Empty && p.maxLeafSize > 0 && len[axis] > p.maxLeafSize &&
+        b.hi[axis] - b.lo[axis] >= 2) {
       box3i l = b, r = b;
       l.hi[axis] = r.lo[axis] = b.lo[axis] + (b.hi[axis] - b.lo[axis]) / 2;
       bl = tight(l);
@@ -134,7 +175,8 @@ void expectSameTree(const Tree& a, const Tree& b, const std::string& what) {
 std::vector<BuildParams> allCpuVariants(int brick = 8) {
   std::vector<BuildParams> v = {kd(LeafCriterion::Shallow, 0, brick), kd(LeafCriterion::Deep, 0, brick),
                                 kd(LeafCriterion::Deep, 32, brick), kd(LeafCriterion::Deep, 128, brick),
-                                kd(LeafCriterion::Shallow, 32, brick)};
+                                kd(LeafCriterion::Shallow, 32, brick), kd(LeafCriterion::Empty, 0, brick),
+                                kd(LeafCriterion::Empty, 32, brick)};
   BuildParams h = kd(LeafCriterion::Deep, 0, brick);
   h.builder = BuilderKind::Hybrid;
   v.push_back(h);
@@ -145,7 +187,8 @@ std::vector<BuildParams> allCpuVariants(int brick = 8) {
 }
 
 std::string describe(const BuildParams& p) {
-  return std::string(builderName(p.builder)) + (p.leaf == LeafCriterion::Shallow ? ":shallow" : ":deep") +
+  return std::string(builderName(p.builder)) +
+         (p.leaf == LeafCriterion::Shallow ? ":shallow" : p.leaf == LeafCriterion::Empty ? ":empty" : ":deep") +
          ":mls" + std::to_string(p.maxLeafSize) + ":brick" + std::to_string(p.brick);
 }
 

@@ -93,7 +93,7 @@ BuildParams params(BuilderKind k, LeafCriterion leaf = LeafCriterion::Deep, int 
 }
 
 std::string describe(const BuildParams& p) {
-  return std::string(builderName(p.builder)) + (p.leaf == LeafCriterion::Deep ? " deep" : " shallow") + " mls " +
+  return std::string(builderName(p.builder)) + (p.leaf == LeafCriterion::Deep ? " deep" : p.leaf == LeafCriterion::Empty ? " empty" : " shallow") + " mls " +
          std::to_string(p.maxLeafSize) + " bins " + std::to_string(p.bins);
 }
 
@@ -406,6 +406,8 @@ TEST(CudaTrees, InvariantsHold) {
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 16, 8),
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Shallow, 0, 0),
       params(BuilderKind::KdTreeGPUFast, LeafCriterion::Deep, 32, 0),
+      params(BuilderKind::KdTreeGPUFast, LeafCriterion::Empty),
+      params(BuilderKind::KdTreeGPUFast, LeafCriterion::Empty, 0, 0),
   };
   for (auto& [v, preset] : cases) {
     TransferFunction tf = tfFor(v, preset);
@@ -436,7 +438,7 @@ TEST(CudaTrees, FastKdTreeEqualsPaperKdTree) {
     TransferFunction tf = tfFor(v, shape == std::string("vessels") ? "coolwarm" : "ramp");
     for (auto [leaf, mls, bins] : {std::tuple{LeafCriterion::Shallow, 0, 4}, std::tuple{LeafCriterion::Deep, 0, 4},
                                     std::tuple{LeafCriterion::Deep, 32, 4}, std::tuple{LeafCriterion::Deep, 128, 4},
-                                    std::tuple{LeafCriterion::Deep, 32, 16}}) {
+                                    std::tuple{LeafCriterion::Deep, 32, 16}, std::tuple{LeafCriterion::Empty, 0, 4}}) {
       Built a = run(v, tf, params(BuilderKind::KdTreeGPU, leaf, mls, bins), BackendKind::CUDA, 0, 0, false,
                     FilterMode::Exact, 8);
       Built b = run(v, tf, params(BuilderKind::KdTreeGPUFast, leaf, mls, bins), BackendKind::CUDA, 0, 0, false,
@@ -479,7 +481,8 @@ TEST(CudaTrees, SweepKdTreeEqualsKdTreeCpu) {
                         {"menger", {81, 81, 81}, 8, "ramp", true},     {"vessels", {128, 128, 128}, 4, "coolwarm", false},
                         {"shell", {70, 61, 66}, 8, "band", true},      {"nbody", {150, 140, 130}, 16, "ramp", true}};
   const std::tuple<LeafCriterion, int> variants[] = {{LeafCriterion::Shallow, 0}, {LeafCriterion::Deep, 0},
-                                                     {LeafCriterion::Deep, 32}, {LeafCriterion::Deep, 128}};
+                                                     {LeafCriterion::Deep, 32}, {LeafCriterion::Deep, 128},
+                                                     {LeafCriterion::Empty, 0}};
   auto key = [](const Node& n) {
     return std::make_tuple(n.box.lo.x, n.box.lo.y, n.box.lo.z, n.box.hi.x, n.box.hi.y, n.box.hi.z, n.child < 0);
   };

@@ -39,6 +39,15 @@ struct HostTight {
     if (t.empty()) return box3i{region.lo, region.lo};
     return brickCellBox(t, g.brick, g.cellDims);
   }
+  /// Occupied bricks in [lo, hi) (brick coordinates): leaf criterion Empty's query.
+  int64_t count(vec3i lo, vec3i hi) const {
+    if (svt) return svt->count(box3i{lo, hi});
+    int64_t o = 0;
+    for (int z = lo.z; z < hi.z; ++z)
+      for (int y = lo.y; y < hi.y; ++y)
+        for (int x = lo.x; x < hi.x; ++x) o += g.at(x, y, z) ? 1 : 0;
+    return o;
+  }
 };
 
 /// Host recursion over the shared decision, in KdTreeCPU's layout (root at 0, each split node's
@@ -64,7 +73,8 @@ struct SharedDecisionTree {
   Tree build() {
     const box3i root = tight(box3i{vec3i{0, 0, 0}, g.cellDims});
     if (root.empty()) return t;
-    sp.deep = p.leaf == LeafCriterion::Deep ? 1 : 0;
+    sp.deep = p.leaf != LeafCriterion::Shallow ? 1 : 0;
+    sp.empty = p.leaf == LeafCriterion::Empty ? 1 : 0;
     sp.mls = p.maxLeafSize;
     sp.bins = p.bins;
     sp.brick = g.brick;
@@ -88,7 +98,7 @@ BuildParams kd(LeafCriterion leaf, int mls, int bins, int brick) {
 }
 
 std::string describe(const BuildParams& p) {
-  return std::string(p.leaf == LeafCriterion::Shallow ? "shallow" : "deep") + ":mls" + std::to_string(p.maxLeafSize) +
+  return std::string(p.leaf == LeafCriterion::Shallow ? "shallow" : p.leaf == LeafCriterion::Empty ? "empty" : "deep") + ":mls" + std::to_string(p.maxLeafSize) +
          ":bins" + std::to_string(p.bins) + ":brick" + std::to_string(p.brick);
 }
 
@@ -120,7 +130,8 @@ using test::randomTF;
 std::vector<BuildParams> sweepVariants(int brick) {
   return {kd(LeafCriterion::Shallow, 0, 0, brick), kd(LeafCriterion::Deep, 0, 0, brick),
           kd(LeafCriterion::Deep, 32, 0, brick), kd(LeafCriterion::Deep, 128, 0, brick),
-          kd(LeafCriterion::Shallow, 32, 0, brick), kd(LeafCriterion::Deep, 4, 0, brick)};
+          kd(LeafCriterion::Shallow, 32, 0, brick), kd(LeafCriterion::Deep, 4, 0, brick),
+          kd(LeafCriterion::Empty, 0, 0, brick)};
 }
 
 }  // namespace

@@ -1,6 +1,17 @@
-"""`mpiexec -n 2 pvbatch` renders the same image as a serial pvbatch run: each rank renders its
-piece of the volume, ParaView (IceT) composites the pieces in visibility order.
-Usage: pvpython test_parallel.py MPIEXEC PVBATCH [builder]"""
+"""`mpiexec -n 2` and `-n 3 pvbatch` render the serial pvbatch image: each rank renders its piece
+of the volume (with one ghost layer) on the whole volume's sample lattice, drawing only its own
+cells; ParaView (IceT) composites the pieces in visibility order. The scene is the bundled MNI152
+head with a translucent transfer function, seen obliquely, so the planes where the pieces meet
+(y for 2 ranks; y, then x in the upper half for 3) cut visible tissue.
+Each rank's piece is exact (Testing/Core/TestPieces.cpp composites pieces in float: within
+1e-3 of the whole volume's image); what remains is IceT's compositing in 8 bits per channel,
+front + floor(back * (255 - alpha) / 255), after each piece was rounded to 8 bits: a blend of n
+pieces can be off by up to about n/255 in rare pixels (README, Parallel). Checked: max |diff| <= n/255, and
+pixels off by more than 1/255 at most 0.1 % (2 ranks) / 1 % (3 ranks); seams (a piece sampling
+off the serial lattice, or missing its neighbour's voxels) give far more (ParaView's own Volume
+representation: 1.2 % / 3.3 % here).
+Usage: pvpython test_parallel.py MPIEXEC PVBATCH [builder [ranks...]]
+  builder "stock": ParaView's own Volume representation, reported only (no limit checked)."""
 import os
 import re
 import subprocess
@@ -15,24 +26,27 @@ xretry_marks = ("bad X server connection",
 
 mpiexec, pvbatch = sys.argv[1], sys.argv[2]
 builder = sys.argv[3] if len(sys.argv) > 3 else "Grid"
+ranks = [int(r) for r in sys.argv[4:]] or [2, 3]
+# |diff| > 1/255 allowed on at most this fraction of the pixels, per number of ranks
+off_by_two = {2: 0.001, 3: 0.01}
+check = builder != "stock"
 scene = os.path.join(os.path.dirname(os.path.abspath(__file__)), "parallel_scene.py")
 ok = ssptest.Checker()
-serial = ssptest.temp_path("parallel_serial_%s.png" % builder)
-mpi = ssptest.temp_path("parallel_mpi2_%s.png" % builder)
-for f in (serial, mpi):
-    if os.path.exists(f):
-        os.remove(f)
 
 
-def run(cmd):
+def run(cmd, timeout):
     print("$ " + " ".join(cmd))
     # timeout: a Python exception on one rank leaves the others waiting forever.
     # pvpython itself may have initialised MPI (as a singleton): its OMPI_/PMIX_ variables
     # would make the child mpiexec think it runs inside a job.
     env = {k: v for k, v in os.environ.items()
            if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "PRTE_", "HYDRA_", "PMI_"))}
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=120,
-                       env=env)
+    try:
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                           timeout=timeout, env=env)
+    except subprocess.TimeoutExpired:
+        print("timed out after %d s" % timeout)
+        return -1, ""
     out = p.stdout.decode(errors="replace")
     info = [l for l in out.splitlines() if "SPACESKIP_PARALLEL" in l]
     print("\n".join(info) if p.returncode == 0 else out[-6000:])
@@ -42,27 +56,47 @@ def run(cmd):
     return p.returncode, "\n".join(info)
 
 
-rc, _ = run([pvbatch, scene, serial, builder])
+def image(name):
+    path = ssptest.temp_path(name)
+    if os.path.exists(path):
+        os.remove(path)
+    return path
+
+
+serial = image("parallel_serial_%s.png" % builder)
+rc, _ = run([pvbatch, scene, serial, builder], 150)
 ok.check(rc == 0 and os.path.exists(serial), "serial pvbatch rendered (rc %d)" % rc)
+a = ssptest.read_png(serial) if os.path.exists(serial) else None
+if a is not None:
+    ok.check(ssptest.lit_fraction(a) > 0.1, "the serial image shows the volume (%.1f%% lit)"
+             % (100 * ssptest.lit_fraction(a)))
 env_args = []
-for name in ("DISPLAY", "PYTHONPATH", "SPACESKIP_PLUGIN", "SPACESKIP_DATA", "SPACESKIP_TEMP",
-             "SPACESKIP_BASELINES"):
+for name in ("DISPLAY", "PYTHONPATH", "SPACESKIP_PIECE_BIAS", "SPACESKIP_PLUGIN", "SPACESKIP_DATA", "SPACESKIP_TEMP",
+             "SPACESKIP_BASELINES", "SPACESKIP_PIECE_BIAS", "SPACESKIP_PARALLEL_ERT"):
     if name in os.environ:
         env_args += ["-x", name]
-rc, info = run(["timeout", "90", mpiexec, "--allow-run-as-root", "--oversubscribe", "-n", "2"]
-               + env_args + [pvbatch, scene, mpi, builder])
-ok.check(rc == 0 and os.path.exists(mpi), "mpiexec -n 2 pvbatch rendered (rc %d)" % rc)
-m = re.search(r"ranks=(\d+) process_id_range=\(([-\d.]+), ([-\d.]+)\)", info)
-ok.check(m is not None and m.group(1) == "2" and float(m.group(2)) == 0.0
-         and float(m.group(3)) == 1.0, "the volume was split over 2 ranks (%s)"
-         % (m.group(0) if m else "no report"))
-if os.path.exists(serial) and os.path.exists(mpi):
-    a, b = ssptest.read_png(serial), ssptest.read_png(mpi)
-    ok.check(ssptest.lit_fraction(b) > 0.05, "the parallel image shows the volume (%.1f%% lit)"
-             % (100 * ssptest.lit_fraction(b)))
+for n in ranks:
+    mpi = image("parallel_mpi%d_%s.png" % (n, builder))
+    rc, info = run(["timeout", "150", mpiexec, "--allow-run-as-root", "--oversubscribe",
+                    "-n", str(n)] + env_args + [pvbatch, scene, mpi, builder], 170)
+    ok.check(rc == 0 and os.path.exists(mpi), "mpiexec -n %d pvbatch rendered (rc %d)" % (n, rc))
+    m = re.search(r"ranks=(\d+) process_id_range=\(([-\d.]+), ([-\d.]+)\)", info)
+    ok.check(m is not None and m.group(1) == str(n) and float(m.group(2)) == 0.0
+             and float(m.group(3)) == n - 1, "the volume was split over %d ranks (%s)"
+             % (n, m.group(0) if m else "no report"))
+    if a is None or not os.path.exists(mpi):
+        continue
+    b = ssptest.read_png(mpi)
     p = ssptest.psnr(a, b)
     diff = abs(a - b).max(axis=2)
-    print("serial vs 2 ranks (%s): PSNR %.2f dB, max |diff| %d/255, %.3f%% of pixels differ "
-          "by more than 2" % (builder, p, diff.max(), 100.0 * (diff > 2).mean()))
-    ok.check(p >= 40.0, "2 ranks == serial (PSNR %.2f >= 40 dB)" % p)
+    print("SPACESKIP_PARALLEL_RESULT %s serial vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
+          "%.3f%% of pixels differ by more than 1, %.3f%% by any" % (
+              builder, n, p, diff.max(), 100.0 * (diff > 1).mean(), 100.0 * (diff > 0).mean()))
+    if check:
+        ok.check(diff.max() <= n, "%d ranks == serial within %d/255 (max %d/255, PSNR %.2f dB)"
+                 % (n, n, diff.max(), p))
+        frac = float((diff > 1).mean())
+        limit = off_by_two.get(n, 0.01)
+        ok.check(frac <= limit, "%d ranks: %.3f%% of the pixels off by more than 1/255 (at most "
+                 "%.1f%%: IceT's 8-bit rounding, no seam)" % (n, 100 * frac, 100 * limit))
 ok.done()

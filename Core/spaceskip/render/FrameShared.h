@@ -33,6 +33,20 @@ struct TreeView {
   int numNodes;
 };
 
+/// A volume rendered in pieces (one per MPI rank): the rays, the box, the planes and the sample
+/// lattice are those of the whole volume (FrameView::worldToIndex maps to the whole volume's
+/// index space; RayGen.h), so every piece samples where the serial render would; a piece draws
+/// the samples in its owned cells only, half-open, so a sample on a shared face is drawn once.
+/// The piece's own voxels, grid and tree are indexed from `pieceLo`. Inactive (serial): the
+/// piece is the whole volume and nothing here is read.
+struct LatticeView {
+  int active = 0;
+  vec3f pieceLo{0, 0, 0};  ///< the piece's voxel (0,0,0) in whole-volume indices (integers)
+  vec3f ownLo{0, 0, 0};    ///< the cells the piece draws, [ownLo, ownHi), whole-volume indices
+  vec3f ownHi{0, 0, 0};
+  float followBias = 0.f;  ///< added to the colour where a piece lies behind (VolumePiece)
+};
+
 /// Most iso values the isosurface blend mode takes (they travel in the FrameView).
 constexpr int kMaxIsoValues = 16;
 
@@ -53,7 +67,7 @@ struct FrameView {
   float invViewProj[16];   ///< NDC -> world, column-major
   float worldToIndex[12];  ///< world -> index space, row-major 3x4 affine
   int width, height;
-  vec3f boxHi;             ///< index-space volume box is [0, boxHi)
+  vec3f boxHi;             ///< index-space volume box is [0, boxHi) (the whole volume's: lattice)
   float dt;                ///< sample distance in world units
   float ertThreshold;      ///< early ray termination when alpha >= this; > 1 disables
   int jitter;              ///< 1: per-pixel random start offset in [0, dt)
@@ -85,6 +99,7 @@ struct FrameView {
   LightView lights[kMaxLights];
   float slicePlane[4];      ///< slice blend mode: the index-space plane s.p + s[3] = 0
   int sliceAsVTK;           ///< slice: sample where vtkGPUVolumeRayCastMapper does (RenderParams)
+  LatticeView lattice;      ///< rendering one piece of a larger volume (MPI); inactive: serial
 };
 
 }  // namespace spaceskip

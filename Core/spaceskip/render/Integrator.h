@@ -67,7 +67,14 @@ struct ArraySampler {
 /// far interval end must never wrap (a tiny step once overflowed int and drew nothing). It also
 /// keeps each blend mode's running state, from which `active` decides which bricks can still
 /// matter.
-template <class Sampler>
+/// A plain frame: composite blending, no shading, no clipping planes, no cropping. The GPU
+/// compiles its kernels for plain frames separately (renderPixel's `Plain`): without the code of
+/// the other modes the kernel needs far fewer registers, so more warps hide the voxel fetches.
+SS_FUNC bool isPlainFrame(const FrameView& f) {
+  return f.blend == BlendMode::Composite && !f.shade && f.cut.numClipPlanes == 0 && !f.cut.cropping;
+}
+
+template <class Sampler, bool Plain = false>
 struct IntervalMarcher {
   const FrameView* f;
   const Sampler* s;
@@ -84,6 +91,7 @@ struct IntervalMarcher {
 
   /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
   SS_FUNC bool active(float lo, float hi) const {
+    if (Plain) return true;
     switch (f->blend) {
       case BlendMode::MaximumIntensity: return count == 0 || hi > extreme;
       case BlendMode::MinimumIntensity: return count == 0 || lo < extreme;
@@ -196,7 +204,7 @@ struct IntervalMarcher {
 
   /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
   SS_FUNC bool composite(vec4f c, vec3f p) {
-    if (f->shade) {
+    if (!Plain && f->shade) {
       vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p);
       c.x = rgb.x;
       c.y = rgb.y;
@@ -258,31 +266,93 @@ struct IntervalMarcher {
     }
   }
 
-  SS_FUNC bool operator()(float a, float b) {
+  /// The samples of interval [a, b) not taken yet: k in [kBegin, kEnd). Marks them as taken.
+  SS_FUNC void range(float a, float b, int64_t& kBegin, int64_t& kEnd) {
     const float dt = f->dt;
-    int64_t kBegin = int64_t(ceilf((a - t0) / dt));
-    int64_t kEnd = int64_t(ceilf((b - t0) / dt));
+    kBegin = int64_t(ceilf((a - t0) / dt));
+    kEnd = int64_t(ceilf((b - t0) / dt));
     if (kBegin < nextK) kBegin = nextK;
-    const bool comp = f->blend == BlendMode::Composite;
-    for (int64_t k = kBegin; k < kEnd; ++k) {
-      float t = t0 + float(k) * dt;
-      const vec3f p = ray.org + ray.dir * t;
-      bool go;
-      if (comp) {
-        vec4f c = lookup(f->tf, s->sample(p));
-        go = c.w > 0.f ? composite(c, p) : true;
+    if (kEnd > nextK) nextK = kEnd;
+  }
+
+  /// Sample k of the ray; false: terminate.
+  SS_FUNC bool take(int64_t k) {
+    const float t = t0 + float(k) * f->dt;
+    const vec3f p = ray.org + ray.dir * t;
+    ++samples;
+    if (Plain || f->blend == BlendMode::Composite) {
+      const vec4f c = lookup(f->tf, s->sample(p));
+      return c.w > 0.f ? composite(c, p) : true;
+    }
+    return blendSample(s->sample(p), p);
+  }
+
+  /// Every sample of [a, b) in one loop (Naive, and the last step of cropping's edge cases).
+  SS_FUNC bool operator()(float a, float b) {
+    int64_t k, kEnd;
+    range(a, b, k, kEnd);
+    for (; k < kEnd; ++k)
+      if (!take(k)) return false;
+    return true;
+  }
+
+  /// Walks a traversal iterator (Traversal.h) the way a CPU core likes it: consecutive
+  /// intervals are merged into runs and each run is marched in one tight loop (the samples are
+  /// the same: intervals that touch share their end points). With value ranges every interval
+  /// is marched before the next brick is decided. false: terminated.
+  template <class Iter>
+  SS_FUNC bool marchRuns(Iter& it) {
+    const bool eachOnItsOwn = f->grid.vmin != nullptr;
+    float ra = 0.f, rb = 0.f;
+    bool have = false;
+    for (;;) {
+      float a, b;
+      const Step st = it.next(*this, a, b);
+      if (st == Step::Done) break;
+      if (st != Step::Interval) continue;
+      if (have && a == rb) {
+        rb = b;
       } else {
-        go = blendSample(s->sample(p), p);
+        if (have && !(*this)(ra, rb)) return false;
+        ra = a;
+        rb = b;
+        have = true;
       }
-      if (!go) {
-        samples += unsigned(k + 1 - kBegin);
-        nextK = k + 1;
-        return false;
+      if (eachOnItsOwn) {
+        have = false;
+        if (!(*this)(ra, rb)) return false;
       }
     }
-    if (kEnd > kBegin) samples += unsigned(kEnd - kBegin);
-    if (kEnd > nextK) nextK = kEnd;
-    return true;
+    return have ? (*this)(ra, rb) : true;
+  }
+
+  /// The iterator's driver for this processor: on a GPU one traversal step or one sample per
+  /// loop iteration (march), on a CPU whole runs (marchRuns). Same samples either way.
+  template <class Iter>
+  SS_FUNC bool walk(Iter& it) {
+#ifdef __CUDA_ARCH__
+    return march(it);
+#else
+    return marchRuns(it);
+#endif
+  }
+
+  /// Walks a traversal iterator (Traversal.h), one traversal step or one sample per iteration,
+  /// so neighbouring rays of a warp advance together. false: terminated.
+  template <class Iter>
+  SS_FUNC bool march(Iter& it) {
+    int64_t k = 0, kEnd = 0;
+    for (;;) {
+      if (k < kEnd) {
+        if (!take(k)) return false;
+        ++k;
+        continue;
+      }
+      float a, b;
+      const Step st = it.next(*this, a, b);
+      if (st == Step::Done) return true;
+      if (st == Step::Interval) range(a, b, k, kEnd);
+    }
   }
 
   /// The pixel's premultiplied RGBA once the march is over.
@@ -308,37 +378,26 @@ struct IntervalMarcher {
   }
 };
 
-template <class Sampler>
-struct HybridLeaf {
-  IntervalMarcher<Sampler>* m;
-  vec3f inv;
-  SS_FUNC bool operator()(int, float a, float b) {
-    return traverseGrid(m->f->grid, m->ray, inv, a, b, *m);
-  }
-};
-
-template <class Sampler>
-struct TreeLeaf {
-  IntervalMarcher<Sampler>* m;
-  SS_FUNC bool operator()(int, float a, float b) { return (*m)(a, b); }
-};
-
 /// Premultiplied RGBA of pixel (px, py); row 0 is the bottom row (OpenGL convention).
 /// `Traversal` >= 0 fixes the traversal at compile time (the CUDA kernels, one per traversal);
 /// -1 reads f.traversal.
-template <class Sampler, int Traversal = -1>
+/// `Plain` (only for frames where isPlainFrame holds) compiles the composite path alone.
+template <class Sampler, int Traversal = -1, bool Plain = false>
 SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) {
   const PrimaryRay p = primaryRay(f, px, py);
   const Ray& r = p.r;
+  const Ray rl = pieceRay(f, r);  // voxels, grid and tree (a piece's own index space; RayGen.h)
   const vec3f inv = p.inv;
   const vec3f nearW = p.nearW, dirW = p.dirW;
   const float tEnter = p.tEnter, tExit = p.tExit;
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = 0;
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
+  float ownA = 0.f, ownB = 0.f;  // a piece of the volume (MPI): where this ray is its own
+  if (f.lattice.active && !ownedInterval(f, r, inv, ownA, ownB)) return vec4f{0, 0, 0, 0};
 
-  IntervalMarcher<Sampler> m{&f, &s, r, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
+  IntervalMarcher<Sampler, Plain> m{&f, &s, rl, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
                              0.f, 0u, -1};
-  if (f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
+  if (!Plain && f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
     const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
     const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
     m.lightW = head ? toEye : normalize(f.lightDir);
@@ -346,10 +405,16 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   }
   m.orgW = nearW;
   m.dirW = dirW;
-  if (f.blend == BlendMode::Slice) {  // no marching: the sample on the plane, if drawn
+  if (!Plain && f.blend == BlendMode::Slice) {  // no marching: the sample on the plane, if drawn
     float a = tEnter, b = tExit;
     if (f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {
-      auto slice = [&](float a0, float b0) -> bool { return m.slice(a0, b0); };
+      auto slice = [&](float a0, float b0) -> bool {
+        if (f.lattice.active) {  // a piece (MPI) draws the plane where the ray is its own
+          a0 = ss_max(a0, ownA);
+          b0 = ss_min(b0, ownB);
+        }
+        return m.slice(a0, b0);
+      };
       if (f.cut.cropping) forEachCroppedInterval(f.cut, r, a, b, slice);
       else slice(a, b);
     }
@@ -364,28 +429,39 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   float lead = f.firstSample * f.dt +
                      (f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f);
   bool anchored = false;
-  auto march = [&](float a, float b) -> bool {
+  auto march = [&](float a, float b) -> bool {  // [a, b): a drawn part of the whole ray
     if (!anchored) {
       m.t0 = a + lead;
       anchored = true;
     }
+    if (f.lattice.active) {  // anchored on the whole ray above; draws its owned part only
+      a = ss_max(a, ownA);
+      b = ss_min(b, ownB);
+      if (!(a < b)) return true;
+    }
     switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
       case TraversalKind::Naive: return m(a, b);
-      case TraversalKind::Grid: return traverseGrid(f.grid, r, inv, a, b, m);
+      case TraversalKind::Grid: {
+        GridIter it;
+        it.init(f.grid, rl, inv, a, b);
+        return m.walk(it);
+      }
       case TraversalKind::Tree: {
-        TreeLeaf<Sampler> leaf{&m};
-        return traverseTree(f.tree, r, inv, a, b, leaf);
+        TreeIter it;
+        it.init(f.tree, rl, inv, a, b);
+        return m.walk(it);
       }
       case TraversalKind::Hybrid: {
-        HybridLeaf<Sampler> leaf{&m, inv};
-        return traverseTree(f.tree, r, inv, a, b, leaf);
+        HybridIter it;
+        it.init(f.tree, f.grid, rl, inv, a, b);
+        return m.walk(it);
       }
     }
     return true;
   };
   float a = tEnter, b = tExit;
-  if (f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {
-    if (f.cut.cropping) {
+  if (Plain || f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {
+    if (!Plain && f.cut.cropping) {
       // VTK starts cropped rays on the face of the first drawn region itself, not one step in
       // (measured against vtkGPUVolumeRayCastMapper: sub-volume 43.5 dB this way, 38.9 dB one
       // step in, 40.7 dB on the box's lattice).
@@ -396,13 +472,13 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
       // sample is still taken (clamped to the box), as vtkGPUVolumeRayCastMapper does; every
       // traversal alike.
       m.t0 = a + lead;
-      m(m.t0, m.t0 + f.dt);
+      if (!f.lattice.active || ownsClampedSample(f, r.org + r.dir * m.t0)) m(m.t0, m.t0 + f.dt);
     } else {
       march(a, b);
     }
   }
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
-  return m.result();
+  return f.lattice.active ? pieceResult(f, m.result(), ownB, tExit) : m.result();
 }
 
 }  // namespace spaceskip

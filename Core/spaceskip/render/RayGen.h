@@ -61,6 +61,48 @@ SS_FUNC PrimaryRay primaryRay(const FrameView& f, int px, int py) {
   return p;
 }
 
+// -- Rendering one piece of a larger volume (FrameView::lattice, MPI) -------------------------
+// The ray, its box, the planes and the sample lattice t = t0 + k*dt are the whole volume's, the
+// same on every rank as in the serial render; a piece draws the samples inside its owned cells.
+
+/// The ray in the piece's own index space, where its voxels, grid and tree live: the same ray
+/// moved by the piece's offset (t is shared). Serial: `r` itself.
+SS_FUNC Ray pieceRay(const FrameView& f, const Ray& r) {
+  return f.lattice.active ? Ray{r.org - f.lattice.pieceLo, r.dir} : r;
+}
+
+/// The part [a, b) of the ray inside the piece's owned cells; false when empty. Every rank
+/// evaluates the same float expression for a face two pieces share, so their intervals meet at
+/// the same t and each sample of the lattice is drawn by exactly one of them.
+SS_FUNC bool ownedInterval(const FrameView& f, const Ray& r, vec3f inv, float& a, float& b) {
+  intersectBox(r, inv, f.lattice.ownLo, f.lattice.ownHi, a, b);
+  return a < b;
+}
+
+/// A piece's pixel as it goes to the compositor: where the ray goes on into another piece
+/// behind this one (its owned part ends before the box's exit), the colour is raised by
+/// followBias (VolumePiece::followBias: rounding for an 8-bit compositor that truncates).
+SS_FUNC vec4f pieceResult(const FrameView& f, vec4f c, float ownB, float tExit) {
+  if (f.lattice.followBias != 0.f && c.w > 0.f && ownB < tExit) {
+    c.x += f.lattice.followBias;
+    c.y += f.lattice.followBias;
+    c.z += f.lattice.followBias;
+  }
+  return c;
+}
+
+/// Does the piece draw a sample at whole-volume position p lying outside the box (a ray's first
+/// sample one step in, past where the ray leaves the box: the sampler clamps it to the box)?
+/// The owner of the clamped position does; faces of the whole box belong to the piece there.
+SS_FUNC bool ownsClampedSample(const FrameView& f, vec3f p) {
+  const LatticeView& l = f.lattice;
+  for (int a = 0; a < 3; ++a) {
+    const float x = ss_clamp(p[a], 0.f, f.boxHi[a]);
+    if (!(x >= l.ownLo[a] && (x < l.ownHi[a] || (x == f.boxHi[a] && l.ownHi[a] == f.boxHi[a])))) return false;
+  }
+  return true;
+}
+
 /// Clips [tmin, tmax] to the convex intersection of the clipping half-spaces; false if empty.
 SS_FUNC bool clipToPlanes(const CropClip& cc, const Ray& r, float& tmin, float& tmax) {
   for (int i = 0; i < cc.numClipPlanes; ++i) {

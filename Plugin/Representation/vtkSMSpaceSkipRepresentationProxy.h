@@ -1,0 +1,42 @@
+// The server-manager proxy of "Space Skipping Volume": its statistics come from the render server.
+/**
+ * @class vtkSMSpaceSkipRepresentationProxy
+ * @brief vtkSMRepresentationProxy whose statistics properties read the representation that
+ * renders.
+ *
+ * ParaView pulls information properties (vtkSMProxy::UpdatePropertyInformation ->
+ * vtkSMSessionClient::PullState) from one location, the client first when the proxy exists
+ * there; the client's representation never renders a volume in client/server mode, so its
+ * statistics stay "none"/0. After the usual pull, this proxy gathers a
+ * vtkSpaceSkipStatisticsInformation from the render server (rank 0) and sets the statistics
+ * properties from it. In the built-in session (GUI, pvpython, pvbatch) the render server is the
+ * same process and the values are the ones the pull read.
+ * Created for the XML element `<SpaceSkipRepresentationProxy>` (SpaceSkipRepresentation.xml).
+ */
+#ifndef vtkSMSpaceSkipRepresentationProxy_h
+#define vtkSMSpaceSkipRepresentationProxy_h
+
+#include "vtkSMRepresentationProxy.h"
+#include "vtkSpaceSkipRepresentationModule.h" // for export macro
+
+class VTKSPACESKIPREPRESENTATION_EXPORT vtkSMSpaceSkipRepresentationProxy
+  : public vtkSMRepresentationProxy
+{
+public:
+  static vtkSMSpaceSkipRepresentationProxy* New();
+  vtkTypeMacro(vtkSMSpaceSkipRepresentationProxy, vtkSMRepresentationProxy);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+protected:
+  vtkSMSpaceSkipRepresentationProxy();
+  ~vtkSMSpaceSkipRepresentationProxy() override;
+
+  /// The usual pull, then the statistics from the render server.
+  void UpdatePropertyInformationInternal(vtkSMProperty* prop = nullptr) override;
+
+private:
+  vtkSMSpaceSkipRepresentationProxy(const vtkSMSpaceSkipRepresentationProxy&) = delete;
+  void operator=(const vtkSMSpaceSkipRepresentationProxy&) = delete;
+};
+
+#endif

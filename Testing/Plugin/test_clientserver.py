@@ -1,0 +1,134 @@
+"""Client/server: a pvserver started here on a free localhost port, pvpython connected to it with
+the plugin loaded on both sides. The server renders the Space Skipping Volume; the client reads
+the server's statistics (vtkSMSpaceSkipRepresentationProxy gathers them from the render server;
+the client's own copy of the representation never renders and stays at "none"/0), and the image
+matches the built-in session's baseline.
+
+Usage: pvpython test_clientserver.py PVSERVER
+The server is started under `timeout` and killed at the end, whatever happened.
+"""
+import os
+import select
+import socket
+import subprocess
+import sys
+import time
+
+from paraview.simple import *
+from paraview import servermanager, simple
+import ssptest
+
+SERVER_SECONDS = 240  # the server's own time limit (ctest's is larger)
+
+
+def free_port():
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    s.bind(("localhost", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def start_server(pvserver, port):
+    server = subprocess.Popen(
+        ["timeout", "-s", "KILL", str(SERVER_SECONDS), pvserver, "--server-port=%d" % port],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    # Wait (bounded) for its first line, "Waiting for client..." (the lines after it may stay in
+    # the pipe's buffer); Connect() below retries until the server accepts.
+    deadline = time.time() + 60
+    lines = []
+    while time.time() < deadline:
+        ready, _, _ = select.select([server.stdout], [], [], 1.0)
+        if ready:
+            line = server.stdout.readline()
+            if not line:
+                break
+            lines.append(line.rstrip())
+            if "Waiting for client" in line:
+                return server
+        if server.poll() is not None:
+            break
+    stop_server(server)
+    raise RuntimeError("pvserver did not start listening on port %d: %s" % (port, lines))
+
+
+def stop_server(server):
+    if server.poll() is None:
+        try:
+            os.killpg(server.pid, 9)  # timeout and pvserver: the session started above
+        except ProcessLookupError:
+            pass
+    try:
+        out, _ = server.communicate(timeout=30)
+        if out:
+            print("pvserver output:\n" + out)
+    except subprocess.TimeoutExpired:
+        print("pvserver did not exit")
+
+
+ok = ssptest.Checker()
+pvserver = sys.argv[1]
+port = free_port()
+server = start_server(pvserver, port)
+try:
+    connection = Connect("localhost", port, timeout=60)
+    ok.check(connection is not None, "connected to pvserver on localhost:%d" % port)
+    if connection is None:
+        raise RuntimeError("no connection")
+    ok.check(servermanager.ActiveConnection.IsRemote(), "the session is remote")
+    # The plugin on the server (representation, mapper) and on the client (proxy class, XML).
+    LoadPlugin(ssptest.env("SPACESKIP_PLUGIN"), remote=True, ns=globals())
+    LoadPlugin(ssptest.env("SPACESKIP_PLUGIN"), remote=False, ns=globals())
+    simple._DisableFirstRenderCameraReset()
+
+    # The scene of test_render.py (its baseline), KdTreeCPU: a k-d tree with nodes to count.
+    reader, view, disp = ssptest.make_scene(builder="KdTreeCPU", backend="CPU")
+    img = ssptest.render_to(view, "clientserver_kdtree.png")
+    a = ssptest.read_png(img)
+    lit = ssptest.lit_fraction(a)
+    ok.check(0.05 < lit < 0.9, "the volume covers %.1f%% of the image" % (100 * lit))
+    try:
+        ssptest.compare_to_baseline(img, "SpaceSkipRender.png", 40.0)
+        ok.check(True, "the server's image matches the built-in session's baseline")
+    except AssertionError as e:
+        ok.check(False, str(e))
+
+    # The statistics, as the Properties panel and scripts read them.
+    disp.UpdatePropertyInformation()
+    s = ssptest.stats(disp)
+    print("statistics read by the client:", s)
+    ok.check(s["BuilderUsed"] == "KdTreeCPU", "BuilderUsed is the server's KdTreeCPU (%r)"
+             % s["BuilderUsed"])
+    ok.check(s["BackendUsed"] == "cpu", "BackendUsed is the server's cpu (%r)" % s["BackendUsed"])
+    ok.check(s["NodeCount"] > 0 and s["LeafCount"] > 0 and s["TreeHeight"] > 0,
+             "nodes %s, leaves %s, height %s" % (s["NodeCount"], s["LeafCount"], s["TreeHeight"]))
+    ok.check(s["FrameCount"] >= 1 and s["BuildCount"] >= 1,
+             "frames %s, builds %s" % (s["FrameCount"], s["BuildCount"]))
+    ok.check(s["LastRenderSeconds"] > 0 and s["SampleDistanceUsed"] > 0,
+             "last frame %.4f s, sample distance %s" % (s["LastRenderSeconds"],
+                                                       s["SampleDistanceUsed"]))
+    ok.check(0.0 < s["Occupancy"] < 1.0, "occupancy %.3f" % s["Occupancy"])
+    # One property at a time (the panel's path) reads the server's value as well.
+    sub = disp.SMProxy.GetProperty("NodeCount").GetParent()
+    ok.check(sub is not None and sub.GetClassName() == "vtkSMSpaceSkipRepresentationProxy",
+             "the representation's proxy is vtkSMSpaceSkipRepresentationProxy (%s)"
+             % (sub and sub.GetClassName()))
+    if sub is not None:
+        sub.UpdatePropertyInformation(sub.GetProperty("NodeCount"))
+        ok.check(disp.GetPropertyValue("NodeCount") == s["NodeCount"],
+                 "single-property update keeps the server's NodeCount")
+
+    # Another frame and builder: the statistics follow the server.
+    frames = s["FrameCount"]
+    disp.Builder = "Grid"
+    ssptest.render_to(view, "clientserver_grid.png")
+    s2 = ssptest.stats(disp)
+    ok.check(s2["BuilderUsed"] == "Grid" and s2["FrameCount"] > frames,
+             "after a Grid frame: builder %r, frames %s > %s" % (s2["BuilderUsed"],
+                                                                 s2["FrameCount"], frames))
+    Disconnect()
+except Exception as e:  # reported as a failed check; the server goes below
+    ok.check(False, "client/server run raised %s: %s" % (type(e).__name__, e))
+finally:
+    stop_server(server)
+ok.done()
