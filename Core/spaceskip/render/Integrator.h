@@ -188,9 +188,12 @@ struct IntervalMarcher {
     if (f->sliceAsVTK) {
       // VTK 9.2 takes the plane point's texture coordinate over the box (0..1 from the first to
       // the last point) and samples the texture of N+1 texels there: index i(N+1)/N - 1/2.
+      // A piece (MPI) does it in the whole volume's index space, as the serial image.
       const vec3f N = f->boxHi;
-      p = vec3f{N.x > 0.f ? p.x * (N.x + 1.f) / N.x - 0.5f : p.x, N.y > 0.f ? p.y * (N.y + 1.f) / N.y - 0.5f : p.y,
-                N.z > 0.f ? p.z * (N.z + 1.f) / N.z - 0.5f : p.z};
+      const vec3f o = f->lattice.active ? f->lattice.pieceLo : vec3f{0, 0, 0};
+      const vec3f q = p + o;
+      p = vec3f{N.x > 0.f ? q.x * (N.x + 1.f) / N.x - 0.5f : q.x, N.y > 0.f ? q.y * (N.y + 1.f) / N.y - 0.5f : q.y,
+                N.z > 0.f ? q.z * (N.z + 1.f) / N.z - 0.5f : q.z} - o;
     }
     vec4f c = lookup(f->tf, s->sample(p));
     if (f->shade && c.w > 0.f) {
