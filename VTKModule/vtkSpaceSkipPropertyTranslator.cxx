@@ -4,6 +4,7 @@
 
 #include "vtkColorTransferFunction.h"
 #include "vtkContourValues.h"
+#include "vtkImplicitFunction.h"
 #include "vtkLight.h"
 #include "vtkLightCollection.h"
 #include "vtkMatrix3x3.h"
@@ -142,10 +143,8 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
   unsupported(vol->GetProperty()->GetInterpolationType() == VTK_NEAREST_INTERPOLATION,
     this->WarnedNearest,
     "nearest interpolation is not supported; rendering with trilinear interpolation");
-  unsupported(blendMode == vtkVolumeMapper::SLICE_BLEND ||
-      blendMode < vtkVolumeMapper::COMPOSITE_BLEND || blendMode > vtkVolumeMapper::SLICE_BLEND,
-    this->WarnedBlend,
-    "the slice blend mode is not supported; rendering with composite blending");
+  unsupported(blendMode < vtkVolumeMapper::COMPOSITE_BLEND || blendMode > vtkVolumeMapper::SLICE_BLEND,
+    this->WarnedBlend, "unknown blend mode; rendering with composite blending");
 
   spaceskip::BuildParams bp;
   bp.builder = static_cast<spaceskip::BuilderKind>(mapper->GetBuilder());
@@ -193,16 +192,15 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
 }
 
 //------------------------------------------------------------------------------
-// Blend mode, iso values and shading from the mapper, the volume property and the renderer's
-// lights, as vtkGPUVolumeRayCastMapper reads them. Lights: a headlight (VTK's default) or one
-// directional light; anything else is lit by a headlight, said once.
+// Blend mode, iso values, the slice plane and shading from the mapper, the volume property and
+// the renderer's lights, as vtkGPUVolumeRayCastMapper reads them.
 void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams& rp,
   vtkSpaceSkippingVolumeMapper* mapper, int mode, vtkRenderer* ren, vtkVolume* vol,
   const double scalarRange[2], const WarnFunction& warnOnce)
 {
-  rp.blend = mode >= vtkVolumeMapper::COMPOSITE_BLEND && mode <= vtkVolumeMapper::ISOSURFACE_BLEND
+  rp.blend = mode >= vtkVolumeMapper::COMPOSITE_BLEND && mode <= vtkVolumeMapper::SLICE_BLEND
     ? static_cast<spaceskip::BlendMode>(mode)
-    : spaceskip::BlendMode::Composite; // slice: warned above
+    : spaceskip::BlendMode::Composite; // warned above
   rp.isoValues.clear();
   vtkVolumeProperty* prop = vol->GetProperty();
   if (rp.blend == spaceskip::BlendMode::Isosurface)
@@ -219,18 +217,28 @@ void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams&
   rp.averageRange[0] = avg[0];
   rp.averageRange[1] = avg[1];
 
+  if (rp.blend == spaceskip::BlendMode::Slice)
+  {
+    this->SetSlicePlane(rp, mapper, vol, warnOnce);
+  }
+
   rp.shade = prop->GetShade(0) != 0;
   rp.ambient = prop->GetAmbient(0);
   rp.diffuse = prop->GetDiffuse(0);
   rp.specular = prop->GetSpecular(0);
   rp.specularPower = prop->GetSpecularPower(0);
   rp.lightDirection[0] = rp.lightDirection[1] = rp.lightDirection[2] = 0; // headlight
+  rp.useLights = false;
+  rp.lights.clear();
+  rp.twoSidedLighting = ren->GetTwoSidedLighting() != 0;
   if (!rp.shade)
   {
     return;
   }
-  vtkLight* only = nullptr;
-  int on = 0;
+  // vtkOpenGLGPUVolumeRayCastMapper: one switched-on headlight of intensity 1 is its "default
+  // lighting" (the headlight model); anything else (ParaView's light kit, several lights, a
+  // directional or positional light, no light) is shaded with the list of switched-on lights.
+  std::vector<vtkLight*> on;
   vtkLightCollection* lights = ren->GetLights();
   vtkCollectionSimpleIterator it;
   lights->InitTraversal(it);
@@ -238,33 +246,99 @@ void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams&
   {
     if (l->GetSwitch())
     {
-      ++on;
-      only = l;
+      on.push_back(l);
     }
   }
-  if (on == 1 && !only->LightTypeIsHeadlight() && !only->GetPositional())
+  if (on.size() == 1 && on[0]->GetIntensity() == 1.0 && on[0]->LightTypeIsHeadlight())
   {
-    // A directional light, from world into the volume's physical space (its matrix's inverse).
-    double p[3], f[3];
-    only->GetTransformedPosition(p);
-    only->GetTransformedFocalPoint(f);
-    vtkNew<vtkMatrix4x4> inv;
-    vtkMatrix4x4::Invert(vol->GetMatrix(), inv);
-    const double w[4] = { p[0] - f[0], p[1] - f[1], p[2] - f[2], 0.0 };
+    return; // the headlight model
+  }
+  rp.useLights = true;
+  if (on.size() > size_t(spaceskip::kMaxLights) && !this->WarnedLight)
+  {
+    warnOnce("shading with " + std::to_string(on.size()) + " lights: only the first " +
+      std::to_string(spaceskip::kMaxLights) + " are used");
+    this->WarnedLight = true;
+  }
+  if (on.size() > size_t(spaceskip::kMaxLights))
+  {
+    on.resize(size_t(spaceskip::kMaxLights));
+  }
+  // World -> the volume's physical frame (the engine's world): points through the inverse of the
+  // volume's matrix.
+  vtkNew<vtkMatrix4x4> inv;
+  vtkMatrix4x4::Invert(vol->GetMatrix(), inv);
+  auto toData = [&](const double* w, double* out) {
+    const double p[4] = { w[0], w[1], w[2], 1.0 };
     double o[4];
-    inv->MultiplyPoint(w, o);
-    std::copy(o, o + 3, rp.lightDirection);
-  }
-  else if (on != 1 && !this->WarnedLight)
+    inv->MultiplyPoint(p, o);
+    for (int k = 0; k < 3; ++k)
+    {
+      out[k] = o[k] / o[3];
+    }
+  };
+  for (vtkLight* l : on)
   {
-    warnOnce("shading with " + std::to_string(on) + " lights: only a headlight or a single "
-      "directional light is supported; shading with a headlight");
-    this->WarnedLight = true;
+    spaceskip::Light c;
+    c.positional = l->GetPositional() != 0;
+    toData(l->GetTransformedPosition(), c.position);
+    toData(l->GetTransformedFocalPoint(), c.focalPoint);
+    const double intensity = l->GetIntensity();
+    for (int k = 0; k < 3; ++k)
+    {
+      c.ambient[k] = l->GetAmbientColor()[k] * intensity;
+      c.diffuse[k] = l->GetDiffuseColor()[k] * intensity;
+      c.specular[k] = l->GetSpecularColor()[k] * intensity;
+      c.attenuation[k] = l->GetAttenuationValues()[k];
+    }
+    c.coneAngle = l->GetConeAngle();
+    c.exponent = l->GetExponent();
+    rp.lights.push_back(c);
   }
-  else if (on == 1 && only->GetPositional() && !this->WarnedLight)
+}
+
+//------------------------------------------------------------------------------
+// The slice plane of the slice blend mode: the property's slice function, a vtkPlane in world
+// coordinates (as vtkGPUVolumeRayCastMapper reads its origin and normal), into the volume's
+// physical frame; anything else: one warning and the plane through the data's centre, normal z.
+void vtkSpaceSkipPropertyTranslator::SetSlicePlane(spaceskip::RenderParams& rp,
+  vtkSpaceSkippingVolumeMapper* mapper, vtkVolume* vol, const WarnFunction& warnOnce)
+{
+  vtkImplicitFunction* func = vol->GetProperty()->GetSliceFunction();
+  vtkPlane* plane = vtkPlane::SafeDownCast(func);
+  if (!plane)
   {
-    warnOnce("positional lights are not supported; shading with a headlight");
-    this->WarnedLight = true;
+    if (!this->WarnedSlice)
+    {
+      warnOnce(std::string("slice blend mode: ") +
+        (func ? std::string("the slice function is a ") + func->GetClassName() + ", not a vtkPlane"
+              : std::string("the volume property has no slice function (a vtkPlane)")) +
+        "; slicing through the centre of the volume, normal to z");
+      this->WarnedSlice = true;
+    }
+    const double* b = mapper->GetBounds();
+    for (int k = 0; k < 3; ++k)
+    {
+      rp.sliceOrigin[k] = 0.5 * (b[2 * k] + b[2 * k + 1]);
+      rp.sliceNormal[k] = k == 2 ? 1.0 : 0.0;
+    }
+    return;
+  }
+  // A plane n.(X - o) = 0 in world; X = A x + t: (A^T n).(x - A^-1 (o - t)) = 0.
+  double n[3], o[3];
+  plane->GetNormal(n);
+  plane->GetOrigin(o);
+  vtkMatrix4x4* A = vol->GetMatrix();
+  vtkNew<vtkMatrix4x4> inv;
+  vtkMatrix4x4::Invert(A, inv);
+  const double ow[4] = { o[0], o[1], o[2], 1.0 };
+  double od[4];
+  inv->MultiplyPoint(ow, od);
+  for (int k = 0; k < 3; ++k)
+  {
+    rp.sliceNormal[k] =
+      n[0] * A->GetElement(0, k) + n[1] * A->GetElement(1, k) + n[2] * A->GetElement(2, k);
+    rp.sliceOrigin[k] = od[k] / od[3];
   }
 }
 

@@ -40,8 +40,9 @@ public:
   /**
    * Gives the engine the mapper's build parameters and its render parameters (blend mode
    * `blendMode`, iso values, shading and lights, cropping, clipping planes, jitter, early ray
-   * termination). Features it lacks (nearest interpolation, the slice blend mode, lights other
-   * than a headlight or one directional light) are said once each through `warnOnce`.
+   * termination, the slice plane). What it lacks or cuts (nearest interpolation, more than
+   * spaceskip::kMaxLights lights, a slice function that is not a vtkPlane) is said once each
+   * through `warnOnce`.
    */
   void UpdateParameters(spaceskip::Engine& engine, vtkSpaceSkippingVolumeMapper* mapper,
     int blendMode, vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
@@ -60,6 +61,8 @@ private:
   void SetBlendAndShading(spaceskip::RenderParams& rp, vtkSpaceSkippingVolumeMapper* mapper,
     int mode, vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
     const WarnFunction& warnOnce);
+  void SetSlicePlane(spaceskip::RenderParams& rp, vtkSpaceSkippingVolumeMapper* mapper,
+    vtkVolume* vol, const WarnFunction& warnOnce);
 
   // What the engine was last given; compared by identity and MTime to redo only what changed.
   const void* PropertyKey = nullptr;
@@ -77,6 +80,7 @@ private:
   bool WarnedNearest = false;
   bool WarnedBlend = false;
   bool WarnedLight = false;
+  bool WarnedSlice = false;
 };
 
 #endif

@@ -5,10 +5,11 @@
  * A drop-in for vtkSmartVolumeMapper: point scalars of one component (unsigned/signed char,
  * unsigned/signed short, float, double; int/unsigned int/long are converted to float with a
  * warning), the volume property's colour and scalar-opacity functions and its
- * ScalarOpacityUnitDistance, its Shade/Ambient/Diffuse/Specular/SpecularPower (VTK's headlight or
- * one directional light) and IsoSurfaceValues, and every blend mode of vtkVolumeMapper but slice
- * (composite, maximum/minimum/average intensity with AverageIPScalarRange, additive,
- * isosurface), with vtkGPUVolumeRayCastMapper's semantics. The hierarchy over the occupied macro cells is built by `Builder`
+ * ScalarOpacityUnitDistance, its Shade/Ambient/Diffuse/Specular/SpecularPower (with the
+ * renderer's lights: VTK's headlight, or up to 8 directional/positional lights such as
+ * vtkLightKit's) and IsoSurfaceValues, and every blend mode of vtkVolumeMapper (composite,
+ * maximum/minimum/average intensity with AverageIPScalarRange, additive, isosurface, slice with
+ * the property's SliceFunction plane), with vtkGPUVolumeRayCastMapper's semantics. The hierarchy over the occupied macro cells is built by `Builder`
  * (the builders of Morrical/Zellmann et al.); a colour-only transfer-function edit only updates
  * the lookup table, an opacity edit re-classifies and rebuilds only when the occupied cells changed.
  * The image is marched by the CUDA backend when a device is usable (Backend Auto), else by the

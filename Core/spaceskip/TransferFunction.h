@@ -15,7 +15,8 @@ enum class BlendMode : int {
   MinimumIntensity = 2,  ///< the smallest sample, mapped through colour and opacity
   AverageIntensity = 3,  ///< grey: mean of opacity * normalised scalar over samples in a range
   Additive = 4,          ///< grey: sum of opacity * normalised scalar, clamped to 1
-  Isosurface = 5         ///< composite of the iso values the ray crosses
+  Isosurface = 5,        ///< composite of the iso values the ray crosses
+  Slice = 6              ///< the sample where the ray meets a plane (RenderParams::slicePlane*)
 };
 
 /// A control point: scalar value -> colour and opacity (opacity per unit distance).

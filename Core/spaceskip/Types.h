@@ -63,6 +63,22 @@ struct BuildParams {
   bool operator!=(const BuildParams& o) const { return !(*this == o); }
 };
 
+/// Most lights shading takes (RenderParams::lights; more: the first ones, with one warning).
+constexpr int kMaxLights = 8;
+
+/// A light as vtkGPUVolumeRayCastMapper reads a vtkLight, in the volume's world frame.
+struct Light {
+  bool positional = false;                ///< false: directional, from position towards focalPoint
+  double position[3] = {0, 0, 1};
+  double focalPoint[3] = {0, 0, 0};
+  double ambient[3] = {0, 0, 0};          ///< colour * intensity (vtkLight's default ambient is black)
+  double diffuse[3] = {1, 1, 1};
+  double specular[3] = {1, 1, 1};
+  double attenuation[3] = {1, 0, 0};      ///< positional: constant, linear, quadratic
+  double coneAngle = 30;                  ///< positional: a spot light when <= 90 degrees
+  double exponent = 1;                    ///< positional spot: falloff exponent
+};
+
 struct RenderParams {
   double sampleDistance = 0;   ///< world units; <= 0: half the smallest spacing
   double ertThreshold = 2.0;   ///< early ray termination at this alpha; > 1 disables
@@ -101,6 +117,25 @@ struct RenderParams {
   /// World direction from the volume towards a directional white light; (0,0,0): a headlight
   /// (VTK's default light: at the camera, so every ray is lit along itself).
   double lightDirection[3] = {0, 0, 0};
+
+  // Lights other than VTK's default headlight (what vtkGPUVolumeRayCastMapper does with a
+  // renderer's lights unless there is exactly one headlight of intensity 1, e.g. ParaView's light
+  // kit): when `useLights`, shading sums over `lights` (the first kMaxLights), VTK's model, and
+  // `lightDirection` is not used; no light at all shades black, as VTK does.
+  bool useLights = false;
+  std::vector<Light> lights;
+  bool twoSidedLighting = true;  ///< vtkRenderer's TwoSidedLighting: back faces lit as front ones
+
+  // Slice blend mode: the plane through sliceOrigin with normal sliceNormal, in the volume's
+  // world frame (as vtkPlane's origin and normal; a zero or non-finite normal: the plane through
+  // the box centre normal to z, with one warning).
+  double sliceOrigin[3] = {0, 0, 0};
+  double sliceNormal[3] = {0, 0, 1};
+  /// true: read the slice's sample where vtkGPUVolumeRayCastMapper (VTK 9.2 to 9.4) reads it: at
+  /// the plane point's texture coordinate without its half-texel adjustment, i.e. index
+  /// i (N+1)/N - 1/2 per axis (N cells), up to half a voxel off the plane (ParaView's images);
+  /// false: at the plane point itself.
+  bool sliceAsVTK = true;
 };
 /// At most this many clipping planes (VTK's mappers take six).
 constexpr int kMaxClipPlanes = 6;

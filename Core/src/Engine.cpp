@@ -528,6 +528,71 @@ void Engine::update() {
 }
 
 namespace {
+/// The light list (RenderParams::lights) into the frame, in its origin-relative world space.
+template <class Impl>
+void fillLights(Impl& d, FrameView& f) {
+  const RenderParams& r = d.render;
+  f.useLights = r.useLights ? 1 : 0;
+  f.twoSided = r.twoSidedLighting ? 1 : 0;
+  f.numLights = 0;
+  f.lightAmbient = vec3f{0, 0, 0};
+  if (!r.useLights) return;
+  if (r.lights.size() > size_t(kMaxLights))
+    d.warn("shading with " + std::to_string(r.lights.size()) + " lights: using the first " +
+           std::to_string(kMaxLights));
+  for (const Light& l : r.lights) {
+    if (f.numLights == kMaxLights) break;
+    double dir[3], len = 0;
+    for (int k = 0; k < 3; ++k) {
+      dir[k] = l.focalPoint[k] - l.position[k];
+      len += dir[k] * dir[k];
+    }
+    len = std::sqrt(len);
+    if (!(len > 0) || !std::isfinite(len)) {
+      d.warn("a light whose position equals its focal point (or is not finite) is ignored");
+      continue;
+    }
+    LightView& v = f.lights[f.numLights++];
+    v.dir = vec3f{float(dir[0] / len), float(dir[1] / len), float(dir[2] / len)};
+    v.pos = vec3f{float(l.position[0] - d.volume.origin[0]), float(l.position[1] - d.volume.origin[1]),
+                  float(l.position[2] - d.volume.origin[2])};
+    v.diffuse = vec3f{float(l.diffuse[0]), float(l.diffuse[1]), float(l.diffuse[2])};
+    v.specular = vec3f{float(l.specular[0]), float(l.specular[1]), float(l.specular[2])};
+    v.atten = vec3f{float(l.attenuation[0]), float(l.attenuation[1]), float(l.attenuation[2])};
+    v.positional = l.positional ? 1 : 0;
+    v.cosCone = l.coneAngle <= 90.0 ? float(std::cos(l.coneAngle * 3.14159265358979323846 / 180.0)) : -2.f;
+    v.exponent = float(l.exponent);
+    f.lightAmbient = f.lightAmbient + vec3f{float(l.ambient[0]), float(l.ambient[1]), float(l.ambient[2])};
+  }
+}
+
+/// The slice plane (RenderParams::sliceOrigin/sliceNormal, world) in index space: n.(X - o) = 0
+/// with X = origin + A i becomes (A^T n).i + n.(origin - o) = 0.
+template <class Impl>
+void fillSlice(Impl& d, FrameView& f) {
+  const RenderParams& r = d.render;
+  const Volume& vol = d.volume;
+  double n[3] = {r.sliceNormal[0], r.sliceNormal[1], r.sliceNormal[2]};
+  double o[3] = {r.sliceOrigin[0], r.sliceOrigin[1], r.sliceOrigin[2]};
+  const double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+  const bool bad = !(nn > 0) || !std::isfinite(nn) || !std::isfinite(o[0] + o[1] + o[2]);
+  if (bad) {
+    if (r.blend == BlendMode::Slice)
+      d.warn("slice blend mode: the slice plane has a zero or non-finite normal or origin; slicing "
+             "through the centre of the volume, normal to z");
+    double b[6];
+    vol.worldBounds(b);
+    for (int k = 0; k < 3; ++k) o[k] = 0.5 * (b[2 * k] + b[2 * k + 1]);
+    n[0] = n[1] = 0;
+    n[2] = 1;
+  }
+  const mat4 indexToWorld = vol.indexToWorld();
+  const double* L = indexToWorld.m;  // column-major: index axis k is column k
+  for (int k = 0; k < 3; ++k) f.slicePlane[k] = float(n[0] * L[k * 4] + n[1] * L[k * 4 + 1] + n[2] * L[k * 4 + 2]);
+  f.sliceAsVTK = r.sliceAsVTK ? 1 : 0;
+  f.slicePlane[3] = float(n[0] * (vol.origin[0] - o[0]) + n[1] * (vol.origin[1] - o[1]) + n[2] * (vol.origin[2] - o[2]));
+}
+
 /// The blend-mode and shading part of the frame from the render parameters.
 template <class Impl>
 void fillBlend(Impl& d, FrameView& f) {
@@ -555,12 +620,15 @@ void fillBlend(Impl& d, FrameView& f) {
   }
   f.numIso = int(iso.size());
   for (int i = 0; i < f.numIso; ++i) f.iso[i] = float(scaled(iso[size_t(i)]));
-  f.shade = r.shade && (r.blend == BlendMode::Composite || r.blend == BlendMode::Isosurface) ? 1 : 0;
+  f.shade = r.shade && (r.blend == BlendMode::Composite || r.blend == BlendMode::Isosurface ||
+                        r.blend == BlendMode::Slice) ? 1 : 0;
   f.ambient = float(r.ambient);
   f.diffuse = float(r.diffuse);
   f.specular = float(r.specular);
   f.specularPower = float(r.specularPower);
   f.lightDir = vec3f{float(r.lightDirection[0]), float(r.lightDirection[1]), float(r.lightDirection[2])};
+  fillLights(d, f);
+  fillSlice(d, f);
 }
 
 /// Dependent components (render/Components.h): the opacity channel's table mapping, the direct

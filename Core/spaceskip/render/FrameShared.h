@@ -50,6 +50,18 @@ struct LatticeView {
 /// Most iso values the isosurface blend mode takes (they travel in the FrameView).
 constexpr int kMaxIsoValues = 16;
 
+/// A light of the light list (RenderParams::lights) in the frame's origin-relative world space.
+struct LightView {
+  vec3f dir;       ///< unit direction the light travels (position -> focal point); spot axis
+  vec3f pos;       ///< positional: position
+  vec3f diffuse;   ///< colour * intensity
+  vec3f specular;  ///< colour * intensity
+  vec3f atten;     ///< positional: constant, linear, quadratic attenuation
+  float cosCone;   ///< positional: cos(cone angle) when a spot (cone <= 90 degrees), else -2
+  float exponent;  ///< positional spot: falloff exponent
+  int positional;
+};
+
 /// Everything a pixel needs, plain data (device pointers on the GPU).
 struct FrameView {
   float invViewProj[16];   ///< NDC -> world, column-major
@@ -78,6 +90,15 @@ struct FrameView {
   float ambient, diffuse, specular, specularPower;
   vec3f lightDir;           ///< world direction towards the light; (0,0,0): headlight
   vec3f eyeW;               ///< camera position in world space (the headlight; parallel views too)
+  // Lights (shading): 1: VTK's light-list model over lights[0, numLights) (0 lights: black);
+  // 0: the headlight model with lightDir.
+  int useLights;
+  int numLights;
+  int twoSided;             ///< two-sided lighting (vtkRenderer's TwoSidedLighting)
+  vec3f lightAmbient;       ///< sum of the lights' ambient colours * intensities
+  LightView lights[kMaxLights];
+  float slicePlane[4];      ///< slice blend mode: the index-space plane s.p + s[3] = 0
+  int sliceAsVTK;           ///< slice: sample where vtkGPUVolumeRayCastMapper does (RenderParams)
   LatticeView lattice;      ///< rendering one piece of a larger volume (MPI); inactive: serial
   // Dependent components (Volume::components 2 or 4; render/Components.h). Unused with 1.
   float alphaLo, alphaScale;    ///< opacity channel -> table entry: (v - alphaLo) * alphaScale

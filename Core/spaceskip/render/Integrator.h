@@ -93,6 +93,7 @@ struct IntervalMarcher {
   float extreme;     ///< MIP/MinIP: running max/min; average/additive: running sum
   unsigned count;    ///< MIP/MinIP: samples seen; average: samples counted
   int isoIndex;      ///< isosurface: the iso interval of the last sample, -1 before the first
+  vec3f orgW{0, 0, 0}, dirW{0, 0, 0};  ///< the ray in world space (light list, positional lights)
 
   /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
   SS_FUNC bool active(float lo, float hi) const {
@@ -121,6 +122,7 @@ struct IntervalMarcher {
     vec3f n{M[0] * gx + M[4] * gy + M[8] * gz, M[1] * gx + M[5] * gy + M[9] * gz, M[2] * gx + M[6] * gy + M[10] * gz};
     const float len = length(n);
     n = len > 0.f ? n * (1.f / len) : vec3f{0, 0, 0};
+    if (f->useLights) return shadeLights(rgb, n, p);
     const float nl = -dot(n, lightW);  // VTK: the gradient points inwards, hence -l
     const vec3f r = normalize(n * (2.f * nl) + lightW);
     const float vr = ss_max(-dot(r, viewW), 0.f);
@@ -128,6 +130,85 @@ struct IntervalMarcher {
     const float k = f->ambient + f->diffuse * fabsf(nl);
     return vec3f{ss_clamp(k * rgb.x + spec, 0.f, 1.f), ss_clamp(k * rgb.y + spec, 0.f, 1.f),
                  ss_clamp(k * rgb.z + spec, 0.f, 1.f)};
+  }
+
+  /// World position (origin-relative) of index-space sample p on this ray: the ray's parameter
+  /// is the world distance from orgW along dirW (primaryRay).
+  SS_FUNC vec3f worldAt(vec3f p) const {
+    const float t = dot(p - ray.org, ray.dir) / dot(ray.dir, ray.dir);
+    return orgW + dirW * t;
+  }
+
+  /// Phong over the light list as vtkGPUVolumeRayCastMapper does it when its lighting is not the
+  /// single default headlight (VTK 9.2, ComputeLightingDeclaration; e.g. ParaView's light kit):
+  /// unit normal n (towards larger values), per light its direction of travel, two-sided
+  /// diffuse when asked, specular from -reflect; positional lights with attenuation and spot
+  /// cone; ambient = the lights' ambient colours (not the sample's colour); clamped to [0, 1]
+  /// as VTK's computeColor does.
+  SS_FUNC vec3f shadeLights(vec3f rgb, vec3f n, vec3f p) const {
+    const vec3f pw = worldAt(p);
+    const vec3f v = normalize(pw - f->eyeW);  // eye -> sample (VTK: -viewDirection)
+    vec3f dif{0, 0, 0}, spe{0, 0, 0};
+    for (int i = 0; i < f->numLights; ++i) {
+      const LightView& L = f->lights[i];
+      vec3f ld = L.dir;
+      float att = 1.f;
+      if (L.positional) {
+        const vec3f d = pw - L.pos;
+        const float dist = length(d);
+        ld = dist > 0.f ? d * (1.f / dist) : L.dir;
+        att = 1.f / (L.atten.x + L.atten.y * dist + L.atten.z * dist * dist);
+        if (L.cosCone > -2.f) {
+          const float coneDot = dot(ld, L.dir);
+          att = coneDot >= L.cosCone ? att * powf(coneDot, L.exponent) : 0.f;
+        }
+      }
+      float nl = dot(n, ld);
+      if (nl < 0.f && f->twoSided) nl = -nl;
+      if (nl > 0.f) {
+        dif = dif + L.diffuse * ss_max(0.f, att * nl);
+        const vec3f r = normalize(n * (2.f * nl) - ld);
+        float rv = dot(v, r);
+        if (L.positional && rv < 0.f && f->twoSided) rv = -rv;
+        if (rv > 0.f) spe = spe + L.specular * (att * powf(rv, f->specularPower));
+      }
+    }
+    const vec3f a = f->lightAmbient;
+    return vec3f{ss_clamp(f->ambient * a.x + f->diffuse * dif.x * rgb.x + f->specular * spe.x, 0.f, 1.f),
+                 ss_clamp(f->ambient * a.y + f->diffuse * dif.y * rgb.y + f->specular * spe.y, 0.f, 1.f),
+                 ss_clamp(f->ambient * a.z + f->diffuse * dif.z * rgb.z + f->specular * spe.z, 0.f, 1.f)};
+  }
+
+  /// Slice blend mode (vtkVolumeShaderComposer, VTK 9.2): the ray's value is its one sample where
+  /// it meets the plane, through the transfer functions (raw opacity, shaded when shading is on),
+  /// when that point lies in [a, b), a drawn part of the ray; no marching. false: done. With
+  /// sliceAsVTK the sample is read where VTK's shader reads it (its unadjusted texture
+  /// coordinates: up to half a voxel off the plane), else at the plane point itself.
+  SS_FUNC bool slice(float a, float b) {
+    const float* P = f->slicePlane;
+    const float den = P[0] * ray.dir.x + P[1] * ray.dir.y + P[2] * ray.dir.z;
+    if (den == 0.f) return true;  // parallel to the plane: never meets it
+    const float t = -(P[0] * ray.org.x + P[1] * ray.org.y + P[2] * ray.org.z + P[3]) / den;
+    if (!(t >= a && t < b)) return true;
+    vec3f p = ray.org + ray.dir * t;
+    if (f->sliceAsVTK) {
+      // VTK 9.2 takes the plane point's texture coordinate over the box (0..1 from the first to
+      // the last point) and samples the texture of N+1 texels there: index i(N+1)/N - 1/2.
+      // A piece (MPI) does it in the whole volume's index space, as the serial image.
+      const vec3f N = f->boxHi;
+      const vec3f o = f->lattice.active ? f->lattice.pieceLo : vec3f{0, 0, 0};
+      const vec3f q = p + o;
+      p = vec3f{N.x > 0.f ? q.x * (N.x + 1.f) / N.x - 0.5f : q.x, N.y > 0.f ? q.y * (N.y + 1.f) / N.y - 0.5f : q.y,
+                N.z > 0.f ? q.z * (N.z + 1.f) / N.z - 0.5f : q.z} - o;
+    }
+    vec4f c = lookup(f->tf, s->sample(p));
+    if (f->shade && c.w > 0.f) {
+      const vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p);
+      c = vec4f{rgb.x, rgb.y, rgb.z, c.w};
+    }
+    acc = vec4f{c.x * c.w, c.y * c.w, c.z * c.w, c.w};
+    ++samples;
+    return false;
   }
 
   /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
@@ -330,6 +411,24 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
     const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
     m.lightW = head ? toEye : normalize(f.lightDir);
     m.viewW = toEye;
+  }
+  m.orgW = nearW;
+  m.dirW = dirW;
+  if (!Plain && f.blend == BlendMode::Slice) {  // no marching: the sample on the plane, if drawn
+    float a = tEnter, b = tExit;
+    if (f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {
+      auto slice = [&](float a0, float b0) -> bool {
+        if (f.lattice.active) {  // a piece (MPI) draws the plane where the ray is its own
+          a0 = ss_max(a0, ownA);
+          b0 = ss_min(b0, ownB);
+        }
+        return m.slice(a0, b0);
+      };
+      if (f.cut.cropping) forEachCroppedInterval(f.cut, r, a, b, slice);
+      else slice(a, b);
+    }
+    if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
+    return m.result();
   }
   // The sample lattice is anchored where the ray enters the drawn part of the volume (the box,
   // cut by the clipping planes, and the first drawn cropping region), as VTK's mapper does by

@@ -15,6 +15,8 @@
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
+#include "vtkPlane.h"
+
 #include "SpaceSkipTestHelpers.h"
 
 #include <functional>
@@ -172,9 +174,16 @@ int TestSpaceSkippingVolumeBadInput(int, char*[])
           p->SetInterpolationTypeToNearest();
         },
         "nearest interpolation is not supported" },
-      { "slice blend mode",
+      { "slice blend mode without a slice function",
         [](vtkSpaceSkippingVolumeMapper* m, vtkVolumeProperty*) { m->SetBlendModeToSlice(); },
-        "the slice blend mode is not supported" },
+        "no slice function" },
+      { "slice blend mode with a vtkPlane",
+        [](vtkSpaceSkippingVolumeMapper* m, vtkVolumeProperty* p) {
+          m->SetBlendModeToSlice();
+          vtkNew<vtkPlane> plane;
+          p->SetSliceFunction(plane);
+        },
+        nullptr },
       // Supported since issue 12: no message at all.
       { "shading (headlight)",
         [](vtkSpaceSkippingVolumeMapper*, vtkVolumeProperty* p) { p->ShadeOn(); }, nullptr },
