@@ -59,7 +59,8 @@ for exe in $exes; do
   cp "$build/$exe" "$v/bin/"
 done
 # Core's GoogleTest binary (CUDA tests included): run and sanitized on the device without a build.
-[ -x "$build/Testing/spaceskip_core_tests" ] && cp "$build/Testing/spaceskip_core_tests" "$v/bin/"
+# BUNDLE_NO_CORE_TESTS=1 leaves it out (carry it separately, e.g. xz'd under build-bench/).
+[ "${BUNDLE_NO_CORE_TESTS:-0}" = 1 ] || { [ -x "$build/Testing/spaceskip_core_tests" ] && cp "$build/Testing/spaceskip_core_tests" "$v/bin/"; }
 cp -L "$build/lib/libvtkSpaceSkip.so" "$v/lib/"
 copy_libs "$v/lib" "$v/bin/"* "$build/lib/libvtkSpaceSkip.so"
 # glvnd's libEGL, dlopen()ed by the window benchmark's --egl mode (NVIDIA's headless EGL).
