@@ -119,6 +119,8 @@ struct Engine::Impl {
   static constexpr double kAutoReexplore = 0.1;
   /// The kept structure gives way when its running frame time exceeds another's by this factor.
   static constexpr double kAutoSwitch = 1.2;
+  /// A structure is kept over Naive only when its measured frame is this much faster.
+  static constexpr double kAutoMargin = 1.05;
 
   std::vector<BuildParams> autoCandidates() const {
     auto with = [&](BuilderKind k, int mls) {
@@ -199,6 +201,13 @@ struct Engine::Impl {
     int best = 0;
     for (size_t i = 1; i < a.seconds.size(); ++i)
       if (a.seconds[i] < a.seconds[size_t(best)]) best = int(i);
+    // Never slower than Naive: one measured frame each is noisy, so a structure must beat Naive
+    // by kAutoMargin to be kept (on dense noise, 256^3, one frame each once put Grid 4% ahead of
+    // Naive and the next frames 11% behind it).
+    for (size_t i = 0; i < a.candidates.size(); ++i)
+      if (a.candidates[i].builder == BuilderKind::Naive && int(i) != best &&
+          a.seconds[size_t(best)] * kAutoMargin > a.seconds[i])
+        best = int(i);
     a.exploring = false;
     a.occupancy = backend->occupiedFraction();
     if (best != a.current) buildDirty = true;
