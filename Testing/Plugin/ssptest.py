@@ -171,6 +171,34 @@ def compare_to_baseline(path, baseline_name, min_psnr=40.0):
     return value
 
 
+class WarningCapture:
+    """Collects the VTK warnings and errors of the client/builtin process until stop() (a
+    vtkStringOutputWindow in place of ParaView's). pvpython routes print() through the same output
+    window, so stop() replays everything captured on stdout and returns the warning and error
+    messages alone (header line and message line of each)."""
+
+    def __init__(self):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
+        self.previous = vtkOutputWindow.GetInstance()
+        self.window = vtkStringOutputWindow()
+        vtkOutputWindow.SetInstance(self.window)
+
+    def stop(self):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow
+        vtkOutputWindow.SetInstance(self.previous)
+        text = self.window.GetOutput()
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        lines = text.splitlines()
+        found = []
+        for i, line in enumerate(lines):
+            if line.startswith(("Warning: In ", "ERROR: In ", "Generic Warning", "Generic Error")):
+                found.append(line)
+                if i + 1 < len(lines):
+                    found.append(lines[i + 1])
+        return "\n".join(found)
+
+
 class Checker:
     """Collects failures so one run reports all of them; exit code 1 when any failed."""
 
