@@ -160,4 +160,26 @@ for name in ["Grid", "KdTreeCPU", "DistanceGrid"]:
     disp.Builder = name
     p = ssptest.psnr(kit[0], ssptest.read_png(ssptest.render_to(view, "slicelights_kit_%s.png" % name)))
     ok.check(p >= 50.0, "%s keeps Naive's light-kit image (PSNR %.2f dB)" % (name, p))
+
+# A saved state brings the plane back to the Space Skipping Volume (its SliceFunction refers to the
+# Volume's Plane proxy, saved with the display).
+disp.Builder = "Naive"
+disp.BlendMode = "Slice"
+disp.SliceFunction.Origin = [c[0] - 9.0, c[1] + 5.0, c[2] - 4.0]
+disp.SliceFunction.Normal = [0.3, 0.5, 0.81]
+before = ssptest.read_png(ssptest.render_to(view, "slicelights_state_before.png"))
+state = ssptest.temp_path("slicelights_state.pvsm")
+SaveState(state)
+ResetSession()
+ssptest.load_plugin()
+warnings = ssptest.WarningCapture()
+LoadState(state)
+view = GetActiveViewOrCreate("RenderView")
+disp = GetDisplayProperties(FindSource("ImageReader1"), view)
+after = ssptest.read_png(ssptest.render_to(view, "slicelights_state_after.png"))
+log = warnings.stop()
+p = ssptest.psnr(before, after)
+ok.check(disp.Representation == "Space Skipping Volume" and p >= 50.0 and "slice" not in log,
+         "state saved and loaded: same slice (PSNR %.2f dB), no slice warning (%s)"
+         % (p, log.strip()[:160] or "none"))
 ok.done()
