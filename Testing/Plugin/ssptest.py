@@ -171,6 +171,27 @@ def compare_to_baseline(path, baseline_name, min_psnr=40.0):
     return value
 
 
+def groups_shown_for(disp, labels=("Volume Rendering", "Cropping Parameters"),
+                     representation="Space Skipping Volume"):
+    """{label: True/False} for the display's property groups `labels`: whether their Properties
+    panel decorators list Representation == `representation` (vtkSMSpaceSkipRepresentationProxy
+    adds it beside ParaView's "Volume")."""
+    def has(e):
+        if (e.GetName() == "PropertyWidgetDecorator" and e.GetAttribute("type") == "GenericDecorator"
+                and e.GetAttribute("property") == "Representation"
+                and e.GetAttribute("value") == representation):
+            return True
+        return any(has(e.GetNestedElement(i)) for i in range(e.GetNumberOfNestedElements()))
+
+    px = disp.SMProxy
+    found = {}
+    for i in range(px.GetNumberOfPropertyGroups()):
+        g = px.GetPropertyGroup(i)
+        if g.GetXMLLabel() in labels:
+            found[g.GetXMLLabel()] = g.GetHints() is not None and has(g.GetHints())
+    return found
+
+
 class WarningCapture:
     """Collects the VTK warnings and errors of the client/builtin process until stop() (a
     vtkStringOutputWindow in place of ParaView's). pvpython routes print() through the same output

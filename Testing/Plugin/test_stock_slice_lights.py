@@ -53,6 +53,11 @@ def changes(what, a, b, max_psnr=30.0):
 disp.Shade = 0
 disp.BlendMode = "Composite"
 composite = both("composite")
+# The Properties panel shows the stock Volume Rendering group (Blend Mode, Slice Type, Shade, Use
+# Cropping) and the cropping box for our representation too (ParaView 5.11 names only "Volume").
+shown = ssptest.groups_shown_for(disp)
+ok.check(shown == {"Volume Rendering": True, "Cropping Parameters": True},
+         "the panel's stock volume groups are shown for Space Skipping Volume (%s)" % shown)
 
 # Shading with the light kit and with the headlight alone.
 disp.Shade = 1
