@@ -1,6 +1,7 @@
 // spaceskip: command-line renderer, generator and benchmark over Core (no VTK).
 #include "Options.h"
 #include "spaceskip/Builders.h"
+#include "spaceskip/BrickPool.h"
 #include "spaceskip/Engine.h"
 #include "spaceskip/Generators.h"
 #include "spaceskip/ImageIO.h"
@@ -253,7 +254,7 @@ int cmdSparse(const Options& o) {
       double kfps = 0, fps = 0, maxDiff = -1, firstMs = 0, editMs = 0;
       std::vector<Image> imgs;
       Image editImg;
-      ResidencyStats r;
+      ResidencyStats r, edit;
       std::string backend;
     };
     auto run = [&](bool sparse) {
@@ -288,6 +289,7 @@ int cmdSparse(const Options& o) {
       t0 = Clock::now();
       e.render(cam(0), w, h, out.editImg);
       out.editMs = 1e3 * since(t0);
+      out.edit = e.frameStats().residency;
       return out;
     };
     Run ref;
@@ -307,6 +309,14 @@ int cmdSparse(const Options& o) {
     std::printf("%-16s %-7s %9.1f %9.1f %9s %10s %9lld %9lld %9.1f %10.1f %11.2f\n", b.c_str(),
                 sp.r.overflow ? "over" : sp.r.sparse ? "sparse" : sp.backend.c_str(), sp.kfps, sp.fps, ratio, diff, (long long)sp.r.needed,
                 (long long)sp.r.resident, double(sp.r.poolBytes) / 1048576.0, sp.firstMs, sp.editMs);
+    if (sp.edit.sparse)
+      std::printf("%-16s %-7s after the edit to %s: %lld bricks needed, %lld uploaded (%.1f MiB), %lld evicted, "
+                  "pool %.1f MiB, residency update %.2f ms of the %.2f ms\n",
+                  b.c_str(), "", editName.c_str(), (long long)sp.edit.needed, (long long)sp.edit.uploaded,
+                  double(sp.edit.uploaded) * double(makePoolLayout(v.dims, buildParams(o, b).brick, poolBrick(o)).slotVoxels()) *
+                      double(voxelSize(v.type)) / 1048576.0,
+                  (long long)sp.edit.evicted, double(sp.edit.poolBytes) / 1048576.0, 1e3 * sp.edit.updateSeconds,
+                  sp.editMs);
     std::fflush(stdout);
   }
   if (worst) std::fprintf(stderr, "spaceskip: a sparse image differs from the in-core one by more than 1/255\n");

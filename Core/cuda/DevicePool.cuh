@@ -24,7 +24,9 @@ class DevicePool {
               const float* d_vmax, vec3i cdims, int cbrick, cudaStream_t stream);
 
   /// The pool as the render kernels read it (device pointers).
-  PoolView view() const { return PoolView{d_pool_.get(), d_table_.get(), vol_.dims, layout_.brick, layout_.bdims}; }
+  PoolView view() const {
+    return PoolView{d_pool_.get(), d_table_.get(), vol_.dims, layout_.brick, layout_.bdims, poolFill(rule_)};
+  }
   const ResidencyStats& stats() const { return stats_; }
 
  private:

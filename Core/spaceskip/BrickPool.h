@@ -96,10 +96,21 @@ SS_FUNC bool poolBrickNeeded(int64_t p, const PoolLayout& L, vec3i cdims, int cb
 /// classification used (`tf`, in sampled units).
 PoolNeedRule poolNeedFor(BlendMode mode, bool shade, const TransferFunction& tf, float avgLo, float avgHi);
 
+/// The value PoolSampler gives a non-resident sample under rule `r`: MIP's bound `r.lo` (every
+/// non-needed brick lies at or below it, and it maps to no opacity), MinIP's `r.hi`, else NaN.
+SS_FUNC float poolFill(const PoolNeedRule& r) {
+  if (r.need == PoolNeed::Above && r.lo > -INFINITY && r.lo < INFINITY) return r.lo;
+  if (r.need == PoolNeed::Below && r.hi > -INFINITY && r.hi < INFINITY) return r.hi;
+  return NAN;
+}
+
 /// Exact trilinear sampling through the pool: the same voxels and arithmetic as ArraySampler
 /// (Integrator.h), so a resident sample is bit-identical to the in-core one. A sample whose
-/// pool brick is not resident (table entry < 0) is NaN: transparent, not counted by MIP,
-/// MinIP or average; the residency rule guarantees such a sample could not change the image.
+/// pool brick is not resident (table entry < 0) reads `fill` (poolFill): NaN, transparent and
+/// not counted, or for MIP (MinIP) the rule's bound, a value every non-resident sample is at
+/// most (at least) and that maps to no opacity, so the running maximum (minimum) lets the
+/// value-range traversal skip the empty bricks as in core; the residency rule guarantees that
+/// such a sample cannot change the image.
 template <class T>
 struct PoolSampler {
   const T* pool;          ///< slots of (brick+1)^3 voxels, x fastest
@@ -107,6 +118,7 @@ struct PoolSampler {
   int64_t nx, ny, nz;     ///< voxels of the volume
   int brick;
   int bx, by;             ///< pool bricks along x and y
+  float fill;             ///< the value of a non-resident sample
 
   SS_FUNC float sample(vec3f p) const {
     int64_t x0, x1, y0, y1, z0, z1;
@@ -116,7 +128,7 @@ struct PoolSampler {
     ArraySampler<T>::axis(p.z, nz, z0, z1, fz);
     const int64_t Px = x0 / brick, Py = y0 / brick, Pz = z0 / brick;
     const int32_t slot = table[Px + int64_t(bx) * (Py + int64_t(by) * Pz)];
-    if (slot < 0) return NAN;
+    if (slot < 0) return fill;
     const int64_t e = int64_t(brick) + 1;
     const T* d = pool + int64_t(slot) * e * e * e;
     // Local voxel indices: x1 - x0 is 0 or 1 and x0 - Px*brick < brick, so all lie in the slot.
@@ -141,9 +153,10 @@ struct PoolView {
   vec3l dims{0, 0, 0};
   int brick = 0;
   vec3i bdims{0, 0, 0};
+  float fill = NAN;
   template <class T>
   PoolSampler<T> sampler() const {
-    return PoolSampler<T>{static_cast<const T*>(pool), table, dims.x, dims.y, dims.z, brick, bdims.x, bdims.y};
+    return PoolSampler<T>{static_cast<const T*>(pool), table, dims.x, dims.y, dims.z, brick, bdims.x, bdims.y, fill};
   }
 };
 
@@ -222,7 +235,9 @@ class HostPool {
   /// std::runtime_error when the needed bricks exceed the pool.
   void update(const PoolNeedRule& r, const uint8_t* occ, uint64_t generation, const float* vmin, const float* vmax,
               vec3i cdims, int cbrick);
-  PoolView view() const { return PoolView{pool_.data(), res_.table().data(), vol_.dims, layout_.brick, layout_.bdims}; }
+  PoolView view() const {
+    return PoolView{pool_.data(), res_.table().data(), vol_.dims, layout_.brick, layout_.bdims, poolFill(rule_)};
+  }
   const ResidencyStats& stats() const { return stats_; }
 
  private:

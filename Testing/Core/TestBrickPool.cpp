@@ -10,6 +10,7 @@
 #include "spaceskip/BrickPool.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 
@@ -83,7 +84,7 @@ TEST(BrickPool, ResidentSamplesAreBitIdenticalToInCoreOnesAndOthersAreNaN) {
       for (size_t i = 0; i < plan.bricks.size(); ++i)
         gatherBrick<T>(v, L, plan.bricks[i], pool.data() + int64_t(plan.slots[i]) * L.slotVoxels());
       const PoolSampler<T> ps{pool.data(), res.table().data(), v.dims.x, v.dims.y, v.dims.z, L.brick, L.bdims.x,
-                              L.bdims.y};
+                              L.bdims.y, NAN};
       const ArraySampler<T> as{static_cast<const T*>(v.data), v.dims.x, v.dims.y, v.dims.z};
       std::uniform_real_distribution<float> px(-2.f, 43.f);
       int nan = 0;
@@ -290,6 +291,28 @@ TEST(BrickPool, CpuSparseImageEqualsInCoreForEveryBuilderAndMode) {
   }
 }
 
+TEST(BrickPool, CpuSparseMipSkipsAsInCore) {
+  // Non-resident samples read MIP's bound (poolFill), so the running maximum lets the value-range
+  // traversal skip the empty bricks as in core (NaN would leave it marching every brick).
+  const Volume v = blobs();
+  RenderParams rp;
+  rp.blend = BlendMode::MaximumIntensity;
+  rp.countSamples = true;
+  int64_t samples[2] = {0, 0};
+  Image img[2];
+  for (int sparse = 0; sparse < 2; ++sparse) {
+    Engine e(BackendKind::CPU);
+    test::load(e, v, rampFrom(60), test::builder(BuilderKind::Grid));
+    if (sparse) e.setMemoryBudget(int64_t(v.byteSize()) / 2, 16);
+    e.setRenderParams(rp);
+    e.render(test::orbit(v, 30, 20, true), 80, 80, img[sparse]);
+    samples[sparse] = e.frameStats().samples;
+    EXPECT_EQ(e.frameStats().residency.sparse, sparse == 1);
+  }
+  EXPECT_EQ(compareImages(img[0], img[1]).maxAbs, 0.0);
+  EXPECT_LE(double(samples[1]), 1.05 * double(samples[0])) << "in core " << samples[0] << ", sparse " << samples[1];
+}
+
 TEST(BrickPool, CpuTfEditsUploadOnlyNewBricksAndEvictUnderATightBudget) {
   const Volume v = blobs();
   Engine e(BackendKind::CPU);
@@ -443,7 +466,9 @@ TEST(BrickPool, CudaSparseImageEqualsInCoreForEveryBuilderAndMode) {
         ASSERT_EQ(e.frameStats().backend, "cuda") << c.name << " " << builderName(b);
         EXPECT_TRUE(s.sparse);
         EXPECT_LT(s.needed, s.bricks);
-        EXPECT_EQ(compareImages(ref, img).maxAbs, 0.0) << c.name << " " << builderName(b) << " pool " << poolBrick;
+        // Bit-identical samples; the kernels that read them are separate instantiations, whose
+        // float contractions may differ in the last bit (shaded frames: 6e-8 measured on the H100).
+        EXPECT_LE(compareImages(ref, img).maxAbs, 1e-6) << c.name << " " << builderName(b) << " pool " << poolBrick;
         // CUDA's sparse image equals the CPU's in-core image as closely as the in-core ones agree.
         if (b == BuilderKind::Grid && poolBrick == 16) {
           Engine cpu(BackendKind::CPU);
@@ -474,4 +499,36 @@ TEST(BrickPool, CudaOverflowFallsBackToTheCpuWithOneMessage) {
   EXPECT_NE(said[0].find("exceed the memory budget"), std::string::npos) << said[0];
   const Image in = test::renderWith(v, rampFrom(10), test::builder(BuilderKind::Grid), 10, 30, false, 64);
   EXPECT_EQ(compareImages(in, img).maxAbs, 0.0);
+}
+
+TEST(BrickPool, CudaVolumeAboveTheDeviceStaysOnItSparse) {
+  // The default budget follows the device's memory (here capped by SPACESKIP_CUDA_MEMORY_LIMIT,
+  // which fails allocations as a real out-of-memory does): a volume above it is kept sparse on
+  // the device instead of falling back to the CPU.
+  std::string why;
+  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  const Volume v = blobs();
+  const TransferFunction tf = rampFrom(60);
+  const int64_t bricks = int64_t(20) * 20 * 20;
+  const int64_t limit = (int64_t(1) << 30) + bricks * 32 + int64_t(v.byteSize()) * 3 / 5;
+  setenv("SPACESKIP_CUDA_MEMORY_LIMIT", std::to_string(limit).c_str(), 1);
+  std::vector<std::string> said;
+  Image img;
+  ResidencyStats s;
+  std::string backend;
+  {
+    Engine e(BackendKind::CUDA);
+    test::load(e, v, tf, test::builder(BuilderKind::Grid));
+    e.setLogger([&](const std::string& m) { said.push_back(m); });
+    e.render(test::orbit(v, 30, 20, true), 80, 80, img);
+    s = e.frameStats().residency;
+    backend = e.frameStats().backend;
+  }
+  unsetenv("SPACESKIP_CUDA_MEMORY_LIMIT");
+  EXPECT_EQ(backend, "cuda");
+  EXPECT_TRUE(s.sparse);
+  EXPECT_LT(s.budgetBytes, int64_t(v.byteSize()));
+  EXPECT_TRUE(said.empty()) << said.front();
+  const Image in = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 30, 20, true, 80);
+  EXPECT_LE(compareImages(in, img).maxAbs * 255.0, 1.0);
 }

@@ -551,7 +551,9 @@ bool contains(const std::string& s, const char* what) { return s.find(what) != s
 // give one clear log message, a CPU backend, the CPU image, and no device memory left behind.
 // Case "volume": the first device allocation (the volume upload in setVolume) fails. Case "render":
 // upload, classification and the LBVH build fit (update() stays on the device), the frame buffers
-// allocated inside render() do not. Limits come from the bytes measured in an unlimited run.
+// allocated inside render() do not. Limits come from the bytes measured in an unlimited run. The
+// memory budget is set above everything, so the volume is uploaded whole (with the default
+// budget, a volume above the device's memory stays sparse instead: TestBrickPool).
 TEST(CudaBackend, DeviceOutOfMemoryFallsBackToCpu) {
   REQUIRE_CUDA();
   Volume v = generateVolume("nbody", vec3l{64, 64, 64}, 4);
@@ -598,6 +600,7 @@ TEST(CudaBackend, DeviceOutOfMemoryFallsBackToCpu) {
       DeviceMemoryLimit limit(c.limit);
       Engine e(BackendKind::Auto, [&](const std::string& m) { log.push_back(m); });
       ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+      e.setMemoryBudget(INT64_MAX);  // in core whatever the device has: the out-of-memory path (sparse: TestBrickPool)
       e.setVolume(v);
       e.setTransferFunction(tf);
       e.setBuildParams(p);
