@@ -56,7 +56,7 @@ public:
     KdTreeGPUFast,
     Hybrid,
     DistanceGrid,
-    AutoBuilder ///< measures Naive and a few structures one frame each and keeps the fastest
+    AutoBuilder ///< measures Naive and a few structures (the close ones twice) and keeps the fastest
   };
   enum LeafCriterionTypes
   {

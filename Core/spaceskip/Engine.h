@@ -72,7 +72,8 @@ class Engine {
   void setLaunchParams(const LaunchParams& p);
 
   const BuildStats& buildStats() const;
-  /// Builder Auto: true while it still measures its candidates (one frame each).
+  /// Builder Auto: true while it measures its candidates (one or two frames each, Engine.cpp),
+  /// at first or when it re-checks its choice at a new, still view.
   bool exploring() const;
   const FrameStats& frameStats() const;
   const Counters& counters() const;

@@ -576,8 +576,9 @@ int main(int argc, char* argv[])
         mapper->GetLastCompositeSeconds());
       firstOfAll = false;
     }
-    // Builder Auto measures its candidates one frame each first: the steady state starts after.
-    for (int i = 0; i < 12 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
+    // Builder Auto measures its candidates first (one or two frames each): the steady state
+    // starts after.
+    for (int i = 0; i < 24 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
     {
       TimedRender(win);
     }
