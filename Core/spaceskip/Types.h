@@ -175,6 +175,8 @@ struct Counters {
   int builds = 0;
   int colorUpdates = 0;
   int frames = 0;
+  /// Whole-table compares of Engine::setTransferFunction (the parts its caller said may differ).
+  int colorCompares = 0, opacityCompares = 0;
 };
 
 struct Image {

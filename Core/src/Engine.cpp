@@ -625,12 +625,23 @@ void Engine::setVolume(const Volume& v) {
   impl_->tableDirty = true;  // the default sample distance follows the spacing
 }
 
-void Engine::setTransferFunction(const TransferFunction& tf) {
+void Engine::setTransferFunction(TransferFunction tf, bool colorMayDiffer, bool opacityMayDiffer) {
   if (tf.table.empty()) throw std::invalid_argument("empty transfer-function table");
   Impl& d = *impl_;
-  if (!d.haveTF || !tf.sameOpacity(d.tf)) d.opacityDirty = true;
-  else if (!tf.sameColor(d.tf)) d.colorDirty = true;
-  d.tf = tf;
+  // A table of another size, or the first one, is new as a whole whatever the caller says.
+  const bool whole = !d.haveTF || tf.table.size() != d.tf.table.size();
+  bool opacity = whole;
+  if (!opacity && opacityMayDiffer) {
+    ++d.counters.opacityCompares;
+    opacity = !tf.sameOpacity(d.tf);
+  }
+  if (opacity) {
+    d.opacityDirty = true;  // re-classified, and the whole table set again
+  } else if (colorMayDiffer) {
+    ++d.counters.colorCompares;
+    if (!tf.sameColor(d.tf)) d.colorDirty = true;
+  }
+  d.tf = std::move(tf);
   d.haveTF = true;
 }
 
