@@ -170,7 +170,8 @@ public:
    *   `spaceskip accuracy`, docs/results/paper-bench h100/pareto). Skipping stays lossless: the
    *   filtered value lies within the 8 voxels' range like the exact one. The CPU backend has no
    *   texture unit and samples exactly (the image is ExactFilter's); volumes with several
-   *   dependent components are sampled exactly too (one warning).
+   *   dependent components, and volumes drawn with sparse residency (DeviceMemoryBudget), are
+   *   sampled exactly too (one warning).
    * With HardwareFilter the CUDA backend holds a second copy of the volume on the device (the
    * texture's array) from its first frame until the data changes.
    */
