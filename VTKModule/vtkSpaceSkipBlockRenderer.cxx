@@ -33,6 +33,7 @@ void CopySettings(vtkSpaceSkippingVolumeMapper* from, vtkSpaceSkippingVolumeMapp
   to->SetMacroCellSize(from->GetMacroCellSize());
   to->SetSampleDistance(from->GetSampleDistance());
   to->SetBackend(from->GetBackend());
+  to->SetFilterMode(from->GetFilterMode());
   to->SetEarlyRayTermination(from->GetEarlyRayTermination());
   to->SetEightBitComposite(from->GetEightBitComposite());
   to->SetGPUComposite(from->GetGPUComposite());

@@ -76,54 +76,74 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& e
     alo = opacityRange[0];
     ahi = opacityRange[1] > alo ? opacityRange[1] : alo + 1.0;
   }
-  if (this->HaveTF && this->PropertyKey == prop && this->PropertyMTime == prop->GetMTime() &&
-    this->ColorKey == color && this->ColorMTime == color->GetMTime() &&
-    this->OpacityKey == opacity && this->OpacityMTime == opacity->GetMTime() &&
-    this->TableRange[0] == lo && this->TableRange[1] == hi && this->OpacityTableRange[0] == alo &&
-    this->OpacityTableRange[1] == ahi && this->OpacityComponent == opacityComponent)
+  // ParaView and VTK call Modified() on the property for many reasons (its MTime includes its
+  // functions'): each part is judged by its own function, range and settings.
+  const double unit = std::max(prop->GetScalarOpacityUnitDistance(opacityComponent), 1e-12);
+  const double slo = opacityRange ? alo : lo, shi = opacityRange ? ahi : hi;
+  const bool colorStale = !this->HaveTF || this->ColorKey != color ||
+    this->ColorMTime != color->GetMTime() || this->TableRange[0] != lo || this->TableRange[1] != hi ||
+    this->Gray != gray;
+  const bool opacityStale = !this->HaveTF || this->OpacityKey != opacity ||
+    this->OpacityMTime != opacity->GetMTime() || this->OpacitySampleRange[0] != slo ||
+    this->OpacitySampleRange[1] != shi || this->OpacityTableRange[0] != alo ||
+    this->OpacityTableRange[1] != ahi || this->OpacityComponent != opacityComponent ||
+    this->UnitDistance != unit;
+  if (!colorStale && !opacityStale)
   {
     return;
+  }
+  if (colorStale)
+  {
+    this->RGB.resize(3 * kTableSize);
+    if (gray)
+    {
+      std::vector<float> g(kTableSize);
+      static_cast<vtkPiecewiseFunction*>(color)->GetTable(lo, hi, kTableSize, g.data());
+      for (int i = 0; i < kTableSize; ++i)
+      {
+        this->RGB[3 * i] = this->RGB[3 * i + 1] = this->RGB[3 * i + 2] = g[i];
+      }
+    }
+    else
+    {
+      static_cast<vtkColorTransferFunction*>(color)->GetTable(lo, hi, kTableSize, this->RGB.data());
+    }
+    ++this->ColorSamples;
+    this->ColorKey = color;
+    this->ColorMTime = color->GetMTime();
+    this->TableRange[0] = lo;
+    this->TableRange[1] = hi;
+    this->Gray = gray;
+  }
+  if (opacityStale)
+  {
+    this->Alpha.resize(kTableSize);
+    opacity->GetTable(slo, shi, kTableSize, this->Alpha.data());
+    ++this->OpacitySamples;
+    this->OpacityKey = opacity;
+    this->OpacityMTime = opacity->GetMTime();
+    this->OpacitySampleRange[0] = slo;
+    this->OpacitySampleRange[1] = shi;
+    this->OpacityTableRange[0] = alo;
+    this->OpacityTableRange[1] = ahi;
+    this->OpacityComponent = opacityComponent;
+    this->UnitDistance = unit;
   }
   spaceskip::TransferFunction tf;
   tf.rangeMin = lo;
   tf.rangeMax = hi;
-  tf.unitDistance = std::max(prop->GetScalarOpacityUnitDistance(opacityComponent), 1e-12);
+  tf.unitDistance = unit;
   tf.ownOpacityRange = opacityRange != nullptr;
   tf.opacityRangeMin = alo;
   tf.opacityRangeMax = ahi;
-  std::vector<float> rgb(3 * kTableSize), alpha(kTableSize);
-  if (gray)
-  {
-    std::vector<float> g(kTableSize);
-    static_cast<vtkPiecewiseFunction*>(color)->GetTable(lo, hi, kTableSize, g.data());
-    for (int i = 0; i < kTableSize; ++i)
-    {
-      rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = g[i];
-    }
-  }
-  else
-  {
-    static_cast<vtkColorTransferFunction*>(color)->GetTable(lo, hi, kTableSize, rgb.data());
-  }
-  opacity->GetTable(opacityRange ? alo : lo, opacityRange ? ahi : hi, kTableSize, alpha.data());
   tf.table.resize(kTableSize);
   for (int i = 0; i < kTableSize; ++i)
   {
-    tf.table[i] = spaceskip::vec4f{ rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2],
-      std::min(std::max(alpha[i], 0.f), 1.f) };
+    tf.table[i] = spaceskip::vec4f{ this->RGB[3 * i], this->RGB[3 * i + 1], this->RGB[3 * i + 2],
+      std::min(std::max(this->Alpha[i], 0.f), 1.f) };
   }
-  engine.setTransferFunction(tf);
-  this->PropertyKey = prop;
-  this->PropertyMTime = prop->GetMTime();
-  this->ColorKey = color;
-  this->ColorMTime = color->GetMTime();
-  this->OpacityKey = opacity;
-  this->OpacityMTime = opacity->GetMTime();
-  this->TableRange[0] = lo;
-  this->TableRange[1] = hi;
-  this->OpacityTableRange[0] = alo;
-  this->OpacityTableRange[1] = ahi;
-  this->OpacityComponent = opacityComponent;
+  // The engine compares only the parts that may differ from what it has.
+  engine.setTransferFunction(std::move(tf), colorStale, opacityStale);
   this->HaveTF = true;
 }
 
@@ -158,6 +178,11 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
   rp.sampleDistance = mapper->GetSampleDistance();
   rp.ertThreshold = mapper->GetEarlyRayTermination() ? kErtThreshold : 2.0;
   rp.jitter = mapper->GetUseJittering() != 0;
+  // The engine's own values (vtkSpaceSkippingVolumeMapper::FilterModeTypes); the CPU backend
+  // samples exactly whatever this says.
+  rp.filter = mapper->GetFilterMode() == vtkSpaceSkippingVolumeMapper::HardwareFilter
+    ? spaceskip::FilterMode::Hardware
+    : spaceskip::FilterMode::Exact;
   // Cropping: the planes are in the data's coordinates, as the engine's.
   rp.cropping = mapper->GetCropping() != 0;
   const double* crop = mapper->GetCroppingRegionPlanes();
@@ -364,7 +389,7 @@ spaceskip::Camera vtkSpaceSkipPropertyTranslator::ToCamera(
 //------------------------------------------------------------------------------
 void vtkSpaceSkipPropertyTranslator::Reset()
 {
-  this->PropertyKey = this->ColorKey = this->OpacityKey = nullptr;
-  this->PropertyMTime = this->ColorMTime = this->OpacityMTime = 0;
+  this->ColorKey = this->OpacityKey = nullptr;
+  this->ColorMTime = this->OpacityMTime = 0;
   this->HaveTF = false;
 }

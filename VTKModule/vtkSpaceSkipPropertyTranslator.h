@@ -8,6 +8,7 @@
 
 #include <functional> // For WarnFunction
 #include <string>     // For the warning texts
+#include <vector>     // For the sampled tables
 
 class vtkOpenGLCamera;
 class vtkRenderer;
@@ -29,10 +30,12 @@ public:
 
   /**
    * Resamples the property's colour and scalar-opacity functions over `scalarRange` into the
-   * engine's table, only when the property, one of its functions or the range changed (the
-   * engine itself tells a colour-only edit from an opacity edit). Dependent components: the
-   * opacity function over `opacityRange` instead, with component `opacityComponent`'s unit
-   * distance (vtkVolumeInputHelper::UpdateOpacityTransferFunction).
+   * engine's table, each only when it (its object, MTime or range) changed, and tells the engine
+   * which part may differ, so that it compares only that part with its table (a colour edit
+   * compares no opacity, an opacity edit no colour; another change of the property, e.g. its
+   * shading, does nothing here). Dependent components: the opacity function over `opacityRange`
+   * instead, with component `opacityComponent`'s unit distance
+   * (vtkVolumeInputHelper::UpdateOpacityTransferFunction).
    */
   void UpdateTransferFunction(spaceskip::Engine& engine, vtkVolumeProperty* prop,
     const double scalarRange[2], const double* opacityRange = nullptr, int opacityComponent = 0);
@@ -57,6 +60,10 @@ public:
   /// Forgets the table the engine was given (a new engine): the next update resamples it.
   void Reset();
 
+  /// How often the colour (opacity) function was sampled into the table: on its own edits only.
+  int GetColorTableSamples() const { return this->ColorSamples; }
+  int GetOpacityTableSamples() const { return this->OpacitySamples; }
+
 private:
   void SetBlendAndShading(spaceskip::RenderParams& rp, vtkSpaceSkippingVolumeMapper* mapper,
     int mode, vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
@@ -65,16 +72,21 @@ private:
     vtkVolume* vol, const WarnFunction& warnOnce);
 
   // What the engine was last given; compared by identity and MTime to redo only what changed.
-  const void* PropertyKey = nullptr;
+  // The colour part: its function, the range it was sampled over, grey or RGB; the opacity part:
+  // its function, range, component and unit distance. Each part's samples are kept.
   const void* ColorKey = nullptr;
   const void* OpacityKey = nullptr;
-  vtkMTimeType PropertyMTime = 0;
   vtkMTimeType ColorMTime = 0;
   vtkMTimeType OpacityMTime = 0;
   double TableRange[2] = { 0, 0 };
+  bool Gray = false;
   double OpacityTableRange[2] = { 0, 0 }; // dependent components; {0, 0}: none
+  double OpacitySampleRange[2] = { 0, 0 };
   int OpacityComponent = 0;
+  double UnitDistance = 1;
   bool HaveTF = false;
+  std::vector<float> RGB, Alpha;
+  int ColorSamples = 0, OpacitySamples = 0;
 
   // Unsupported features already said (the lights say their first cause only).
   bool WarnedNearest = false;

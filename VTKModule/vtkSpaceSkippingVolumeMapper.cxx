@@ -230,6 +230,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
       c.builds += e.builds;
       c.colorUpdates += e.colorUpdates;
       c.frames += e.frames;
+      c.colorCompares += e.colorCompares;
+      c.opacityCompares += e.opacityCompares;
     }
     return c;
   }
@@ -417,6 +419,12 @@ vtkSpaceSkippingVolumeMapper::~vtkSpaceSkippingVolumeMapper() = default;
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderAsString()
 {
   return spaceskip::builderName(static_cast<spaceskip::BuilderKind>(this->Builder));
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSpaceSkippingVolumeMapper::GetFilterModeAsString()
+{
+  return this->FilterMode == HardwareFilter ? "Hardware" : "Exact";
 }
 
 //------------------------------------------------------------------------------
@@ -624,6 +632,22 @@ int vtkSpaceSkippingVolumeMapper::GetColorUpdateCount()
   }
   return this->Internals->Counts().colorUpdates;
 }
+int vtkSpaceSkippingVolumeMapper::GetColorTableSampleCount()
+{
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetColorTableSampleCount);
+  }
+  return this->Internals->Properties.GetColorTableSamples();
+}
+int vtkSpaceSkippingVolumeMapper::GetOpacityTableSampleCount()
+{
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetOpacityTableSampleCount);
+  }
+  return this->Internals->Properties.GetOpacityTableSamples();
+}
 int vtkSpaceSkippingVolumeMapper::GetFrameCount()
 {
   if (this->Internals->Blocks.IsActive())
@@ -790,6 +814,7 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SampleDistance: " << this->SampleDistance << "\n";
   os << indent << "Backend: "
      << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";
+  os << indent << "FilterMode: " << this->GetFilterModeAsString() << "\n";
   os << indent << "EarlyRayTermination: " << (this->EarlyRayTermination ? "On" : "Off") << "\n";
   os << indent << "EightBitComposite: " << (this->EightBitComposite ? "On" : "Off") << "\n";
   os << indent << "GPUComposite: " << (this->GPUComposite ? "On" : "Off") << "\n";

@@ -56,7 +56,7 @@ public:
     KdTreeGPUFast,
     Hybrid,
     DistanceGrid,
-    AutoBuilder ///< measures Naive and a few structures one frame each and keeps the fastest
+    AutoBuilder ///< measures Naive and a few structures (the close ones twice) and keeps the fastest
   };
   enum LeafCriterionTypes
   {
@@ -68,6 +68,12 @@ public:
     Auto = 0,
     CPU = 1,
     CUDA = 2
+  };
+  /// Same values as spaceskip::FilterMode.
+  enum FilterModeTypes
+  {
+    ExactFilter = 0,
+    HardwareFilter = 1
   };
 
   ///@{
@@ -152,6 +158,28 @@ public:
   void SetBackendToAuto() { this->SetBackend(Auto); }
   void SetBackendToCPU() { this->SetBackend(CPU); }
   void SetBackendToCUDA() { this->SetBackend(CUDA); }
+  ///@}
+
+  ///@{
+  /**
+   * How samples between voxels are interpolated (trilinear either way):
+   * - ExactFilter (default): in float from the 8 voxels around the sample, on both backends;
+   * - HardwareFilter: CUDA backend, the texture unit's trilinear filter, whose weights have
+   *   8 bits of fraction (about 1/256 of a voxel): faster (N-body 2048^3 on an H100: 750 against
+   *   615 kernel fps, docs/results/round6-h100) at a small cost in accuracy (PSNR per data set:
+   *   `spaceskip accuracy`, docs/results/paper-bench h100/pareto). Skipping stays lossless: the
+   *   filtered value lies within the 8 voxels' range like the exact one. The CPU backend has no
+   *   texture unit and samples exactly (the image is ExactFilter's); volumes with several
+   *   dependent components, and volumes drawn with sparse residency (DeviceMemoryBudget), are
+   *   sampled exactly too (one warning).
+   * With HardwareFilter the CUDA backend holds a second copy of the volume on the device (the
+   * texture's array) from its first frame until the data changes.
+   */
+  vtkSetClampMacro(FilterMode, int, ExactFilter, HardwareFilter);
+  vtkGetMacro(FilterMode, int);
+  void SetFilterModeToExact() { this->SetFilterMode(ExactFilter); }
+  void SetFilterModeToHardware() { this->SetFilterMode(HardwareFilter); }
+  const char* GetFilterModeAsString();
   ///@}
 
   ///@{
@@ -327,6 +355,10 @@ public:
   int GetClassifyCount();
   int GetColorUpdateCount();
   int GetFrameCount();
+  /// How often the colour (scalar-opacity) function was sampled into the engine's table: only
+  /// when that function, its range (or the property's unit distance, for opacity) changed.
+  int GetColorTableSampleCount();
+  int GetOpacityTableSampleCount();
   ///@}
 
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
@@ -362,6 +394,7 @@ protected:
   int MacroCellSize = 8;
   double SampleDistance = 0.0;
   int Backend = Auto;
+  int FilterMode = ExactFilter;
   vtkTypeBool EarlyRayTermination = 1;
   vtkTypeBool EightBitComposite = 1;
   vtkTypeBool GPUComposite = 1;

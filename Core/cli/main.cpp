@@ -76,8 +76,9 @@ const char* kUsage = R"(usage:
 
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
-  --builder B        auto (default: one frame with each of naive, grid, distance-grid and a
-                     k-d tree, then the fastest) or one of the builders listed at the end
+  --builder B        auto (default: a frame with each of naive, grid, distance-grid and a
+                     k-d tree, one more for those within 1.5x of the fastest, then the fastest)
+                     or one of the builders listed at the end
   --leaf shallow|deep|empty  --mls N  --bins N  --brick N
       empty: deep, but leaves are kept or split by their empty space, not their size (MLS ignored)
       --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;

@@ -44,7 +44,12 @@ class Engine {
 
   /// The engine borrows `v.data` (or shares `v.storage`): keep it alive while rendering.
   void setVolume(const Volume& v);
-  void setTransferFunction(const TransferFunction& tf);
+  /// A new table: compared with the one the engine has, an opacity change re-classifies (and
+  /// rebuilds only when the occupied cells change), a colour-only change updates the table alone.
+  /// A caller that knows a part is unchanged (the VTK mapper: that function was not edited) says
+  /// so with `colorMayDiffer` / `opacityMayDiffer` false, and that part is not compared (it must
+  /// then equal the engine's; Counters::colorCompares/opacityCompares count the compares).
+  void setTransferFunction(TransferFunction tf, bool colorMayDiffer = true, bool opacityMayDiffer = true);
   void setBuildParams(const BuildParams& p);
   void setRenderParams(const RenderParams& p);
   /// The volume is one piece of a larger one (MPI; VolumePiece.h): rays, planes and the sample
@@ -82,7 +87,8 @@ class Engine {
   int64_t memoryBudget() const;
 
   const BuildStats& buildStats() const;
-  /// Builder Auto: true while it still measures its candidates (one frame each).
+  /// Builder Auto: true while it measures its candidates (one or two frames each, Engine.cpp),
+  /// at first or when it re-checks its choice at a new, still view.
   bool exploring() const;
   const FrameStats& frameStats() const;
   const Counters& counters() const;

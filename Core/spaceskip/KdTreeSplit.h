@@ -75,6 +75,27 @@ SS_FUNC int kdCandidatePlane(const box3i& box, int axis, int k, const KdSplitPar
   return (lo + dl * k) / p.brick * p.brick;
 }
 
+/// The sweep both rules run over a node's candidate planes: candidate k = 1..count is scored by
+/// `score(k)`; one whose score `beats(score, best)` (strictly better than `best` and every
+/// earlier one) becomes `best` and is handed to `keep(k)`, so ties keep the first candidate.
+/// Returns whether any did.
+#ifdef __CUDACC__
+#pragma nv_exec_check_disable
+#endif
+template <class T, class Score, class Beats, class Keep>
+SS_FUNC bool kdSweep(int count, T& best, Score&& score, Beats&& beats, Keep&& keep) {
+  bool found = false;
+  for (int k = 1; k <= count; ++k) {
+    const T v = score(k);
+    if (beats(v, best)) {
+      best = v;
+      keep(k);
+      found = true;
+    }
+  }
+  return found;
+}
+
 /// Cost of splitting `box` at `pos` along `axis` (sum of the tight children's volumes) and the
 /// children; INT64_MAX when the plane is rejected (on the border, or it removes <= 1/1000 of the
 /// node volume as empty space).
@@ -150,19 +171,23 @@ SS_FUNC KdDecision kdEmptySplit(const box3i& box, const KdSplitParams& p, Tight&
   int bestAxis = -1, bestPos = 0;
   for (int a = 0; a < 3; ++a) {
     const int64_t slab = n / (hi[a] - lo[a]);  // bricks per unit slab along a
-    for (int k = lo[a] + step; k < hi[a]; k += step) {
-      vec3i h2 = hi;
-      h2[a] = k;
-      const int64_t nl = slab * (k - lo[a]), nr = n - nl;
-      const int64_t ol = int64_t(tight.count(lo, h2)), orr = o - ol;
-      const double diff = double(ol * nr - orr * nl);
-      const double score = diff * diff / (double(nl) * double(nr));
-      if (score > best) {
-        best = score;
-        bestAxis = a;
-        bestPos = k;
-      }
-    }
+    // Candidate i: the brick plane lo + i step, strictly inside the node.
+    kdSweep(
+        (hi[a] - lo[a] - 1) / step, best,
+        [&](int i) {
+          const int k = lo[a] + i * step;
+          vec3i h2 = hi;
+          h2[a] = k;
+          const int64_t nl = slab * (k - lo[a]), nr = n - nl;
+          const int64_t ol = int64_t(tight.count(lo, h2)), orr = o - ol;
+          const double diff = double(ol * nr - orr * nl);
+          return diff * diff / (double(nl) * double(nr));
+        },
+        [](double v, double b) { return v > b; },
+        [&](int i) {
+          bestAxis = a;
+          bestPos = lo[a] + i * step;
+        });
   }
   if (bestAxis < 0) {  // no plane tells the two sides apart: halve the longest axis
     bestAxis = longestAxis(box);
@@ -202,19 +227,19 @@ SS_FUNC KdDecision decideKdSplit(const box3i& box, const KdSplitParams& p, Tight
   d.left = d.right = box;
   const int axis = longestAxis(box);
   if (!kdHalts(box, p)) {
-    const int count = kdCandidateCount(box, axis, p);
-    int64_t best = INT64_MAX;
-    for (int k = 1; k <= count; ++k) {
-      box3i l, r;
-      const int64_t c = kdPlaneCost(box, axis, kdCandidatePlane(box, axis, k, p), tight, l, r);
-      if (c < best) {
-        best = c;
-        d.split = 1;
-        d.left = l;
-        d.right = r;
-      }
+    int64_t best = INT64_MAX;  // a rejected plane costs INT64_MAX: it never beats this
+    box3i l, r;
+    if (kdSweep(
+            kdCandidateCount(box, axis, p), best,
+            [&](int k) { return kdPlaneCost(box, axis, kdCandidatePlane(box, axis, k, p), tight, l, r); },
+            [](int64_t c, int64_t b) { return c < b; },
+            [&](int) {
+              d.left = l;
+              d.right = r;
+            })) {
+      d.split = 1;
+      return d;
     }
-    if (d.split) return d;
   }
   return kdLeafSplit(box, axis, p, tight);
 }

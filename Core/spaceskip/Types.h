@@ -28,7 +28,7 @@ enum class BuilderKind : int {
   KdTreeGPUFast,  ///< ours: level-parallel CUDA k-d tree
   Hybrid,         ///< paper 3.3: shallow k-d tree + 16^3 grid
   DistanceGrid,   ///< ours: the Grid DDA leaping through empty space with a distance field
-  Auto            ///< measures a few structures (Naive among them) one frame each, keeps the fastest
+  Auto            ///< measures a few structures (Naive among them), the close ones twice, keeps the fastest
 };
 /// Empty (ours): Deep, but a leaf is kept or split by its empty space, not its size
 /// (KdTreeSplit.h, kdEmptySplit); MLS is ignored.
@@ -196,6 +196,8 @@ struct Counters {
   int builds = 0;
   int colorUpdates = 0;
   int frames = 0;
+  /// Whole-table compares of Engine::setTransferFunction (the parts its caller said may differ).
+  int colorCompares = 0, opacityCompares = 0;
 };
 
 struct Image {

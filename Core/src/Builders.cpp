@@ -53,7 +53,7 @@ constexpr BuilderInfo kRegistry[] = {
   {B::DistanceGrid,  "DistanceGrid",  "distance-grid",   T::Grid,   X::DistanceField, nullptr,            nullptr,                                B::DistanceGrid,
    "ours: the Grid DDA leaping through empty space with a distance field"},
   {B::Auto,          "Auto",          "auto",            T::Naive,  X::None,          nullptr,            nullptr,                                B::Auto,
-   "measures a few structures (Naive among them) one frame each and keeps the fastest"},
+   "measures a few structures (Naive among them), the close ones twice, and keeps the fastest"},
 };
 // clang-format on
 constexpr int kRegistrySize = int(sizeof kRegistry / sizeof kRegistry[0]);

@@ -87,28 +87,87 @@ struct Engine::Impl {
   Counters counters;
 
   // Builder Auto ("never slower than naive"): skipping is lossless, so every candidate draws the
-  // same image and only its speed differs. Each candidate renders one frame, the fastest is kept;
-  // the candidates are measured again when the occupancy moves by more than kAutoReexplore or
+  // same image and only its speed differs. Measuring: every candidate renders a frame, in turn
+  // (round 1); those within kAutoPrune of round 1's fastest render another, in the reverse order
+  // (round 2: A B C D, then D C B A, so a drift of the machine's load favours none and the last
+  // structure of round 1 needs no rebuild); a candidate's time is the minimum of its frames (other
+  // work only ever adds time). The fastest is kept, over Naive only when kAutoMargin faster.
+  // The candidates are measured again when the occupancy moves by more than kAutoReexplore or
   // the image size changes, otherwise an occupancy change rebuilds the chosen one only.
+  // Frame times depend on the view, so measurements are compared only when taken at one view:
+  // once the camera has moved far (kAutoFarDegrees, or a zoom of kAutoFarZoom) from where the
+  // choice was measured and then stays still, the kept structure is re-checked there against the
+  // contenders (those within kAutoPrune of it when it was measured, at least the runner-up), two
+  // frames each; a moving
+  // camera (an orbit) never triggers a re-check, and one that moves during it cancels it.
+  struct ViewKey {
+    double dir[3] = {0, 0, 0};  ///< the camera's backward axis in world space
+    double zoom = 0;            ///< |proj[0][0]|
+    double distance = 0;        ///< the eye's distance from the volume's centre (perspective)
+    bool valid = false;
+  };
   struct AutoState {
     std::vector<BuildParams> candidates;
-    std::vector<double> seconds;  ///< measured frame time per candidate, < 0: not yet
+    std::vector<double> seconds;  ///< measured frame time per candidate (minimum), < 0: not yet
     std::vector<double> buildSeconds;  ///< last build time per candidate, < 0: not yet
+    std::vector<int> frames;      ///< frames measured per candidate in the current measuring
+    std::vector<int> queue;       ///< the candidates still to render in this measuring, in order
     bool standIn = false;         ///< this frame draws Grid while the kept one waits (refinement)
     bool refined = false;         ///< the kept structure was rebuilt after a stand-in frame
-    bool freshEstimate = false;   ///< the next frame's time replaces the kept one's estimate
     int current = -1;             ///< the candidate built now
-    bool exploring = false;
+    int kept = -1;                ///< the kept structure (during a re-check: the one before it)
+    bool exploring = false;       ///< measuring (all candidates, or a re-check)
+    bool rechecking = false;      ///< this measuring is a re-check of the kept one at a new view
+    int round = 0;                ///< 1 or 2 while measuring all candidates
     double occupancy = -1;        ///< when the choice was made
     int width = 0, height = 0;
-    int switches = 0;             ///< changes of the kept structure since the measuring
+    ViewKey measuredAt;           ///< the view of the last measuring
+    ViewKey lastView;             ///< the previous frame's view
+    ViewKey recheckAt;            ///< the view a re-check started at
+    int rechecks = 0;             ///< re-checks at a new view since the measuring
+    int switches = 0;             ///< changes of the kept structure by a re-check
     std::string choice;
   } autoState;
   static constexpr double kAutoReexplore = 0.1;
-  /// The kept structure gives way when its running frame time exceeds another's by this factor.
-  static constexpr double kAutoSwitch = 1.2;
-  /// A structure is kept over Naive only when its measured frame is this much faster.
+  /// Round 2 (and a re-check) measures only candidates within this factor of the fastest.
+  static constexpr double kAutoPrune = 1.5;
+  /// A structure is kept over Naive (or over the kept one in a re-check) only when this much faster.
   static constexpr double kAutoMargin = 1.05;
+  /// A view this far from the measured one (degrees between view directions, or zoom ratio) is
+  /// another view; consecutive frames within kAutoStill* of each other are a still camera.
+  static constexpr double kAutoFarDegrees = 25.0, kAutoFarZoom = 1.25;
+  static constexpr double kAutoStillDegrees = 2.0, kAutoStillZoom = 1.02;
+  /// A re-check is cancelled when the camera moves this far from where it started.
+  static constexpr double kAutoRecheckDrift = 5.0;
+
+  ViewKey viewKey(const Camera& cam) const {
+    ViewKey k;
+    const double* v = cam.view.m;  // column-major: row 2 of the rotation is the backward axis
+    const double n = std::sqrt(v[2] * v[2] + v[6] * v[6] + v[10] * v[10]);
+    mat4 iv;
+    if (!(n > 0) || !invert(cam.view, iv)) return k;
+    for (int i = 0; i < 3; ++i) k.dir[i] = v[2 + 4 * i] / n;
+    k.zoom = std::fabs(cam.proj.m[0]);
+    double b[6];
+    volume.worldBounds(b);
+    double d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = iv.m[12 + i] - 0.5 * (b[2 * i] + b[2 * i + 1]);
+      d2 += d * d;
+    }
+    k.distance = std::sqrt(d2);
+    k.valid = std::isfinite(k.zoom) && std::isfinite(k.distance);
+    return k;
+  }
+  /// Whether two views are within `degrees` and a factor `zoom` (in scale and, for perspective
+  /// cameras, eye distance) of each other; an invalid one is near nothing.
+  static bool near(const ViewKey& a, const ViewKey& b, double degrees, double zoom) {
+    if (!a.valid || !b.valid) return false;
+    const double c = a.dir[0] * b.dir[0] + a.dir[1] * b.dir[1] + a.dir[2] * b.dir[2];
+    const double angle = std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
+    auto ratio = [](double x, double y) { return x > 0 && y > 0 ? std::max(x / y, y / x) : (x == y ? 1.0 : 1e30); };
+    return angle <= degrees && ratio(a.zoom, b.zoom) <= zoom && ratio(a.distance, b.distance) <= zoom;
+  }
 
   std::vector<BuildParams> autoCandidates() const {
     auto with = [&](BuilderKind k, int mls) {
@@ -138,68 +197,145 @@ struct Engine::Impl {
     return -1;
   }
 
+  /// Starts measuring: every candidate (round 1), or, for a re-check, the kept one and its
+  /// contenders; the first in the queue is built next.
+  void beginMeasuring(std::vector<int> queue, bool recheck) {
+    AutoState& a = autoState;
+    a.frames.assign(a.candidates.size(), 0);
+    a.queue = std::move(queue);
+    a.exploring = true;
+    a.rechecking = recheck;
+    a.round = recheck ? 0 : 1;
+    if (a.current != a.queue.front()) buildDirty = true;
+    a.current = a.queue.front();
+  }
+
   void startAutoExploration() {
-    autoState.candidates = autoCandidates();
-    autoState.seconds.assign(autoState.candidates.size(), -1.0);
-    autoState.buildSeconds.assign(autoState.candidates.size(), -1.0);
-    autoState.current = 0;
-    autoState.exploring = true;
-    autoState.choice = "Auto: measuring " + std::to_string(autoState.candidates.size()) + " structures";
+    AutoState& a = autoState;
+    a.candidates = autoCandidates();
+    a.seconds.assign(a.candidates.size(), -1.0);
+    a.buildSeconds.assign(a.candidates.size(), -1.0);
+    a.kept = -1;
+    a.current = -1;
+    a.rechecks = a.switches = 0;
+    std::vector<int> all(a.candidates.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+    beginMeasuring(all, false);
+    a.choice = "Auto: measuring " + std::to_string(a.candidates.size()) + " structures";
     buildDirty = true;
   }
 
-  /// After a frame of `seconds` at width x height: records it and picks the next build.
-  void autoFrameDone(double seconds, int width, int height) {
+  /// Ends a re-check without a decision: the kept structure draws the next frame.
+  void cancelRecheck() {
     AutoState& a = autoState;
+    if (!a.rechecking) return;
+    a.exploring = a.rechecking = false;
+    a.queue.clear();
+    if (a.current != a.kept) buildDirty = true;
+    a.current = a.kept;
+  }
+
+  /// Records a measured frame of the current candidate (the minimum of its frames so far).
+  void record(double seconds) {
+    AutoState& a = autoState;
+    double& t = a.seconds[size_t(a.current)];
+    t = a.frames[size_t(a.current)]++ == 0 ? seconds : std::min(t, seconds);
+  }
+
+  /// After a frame of `seconds` at width x height seen from `view`: records it and picks the
+  /// next build.
+  void autoFrameDone(double seconds, int width, int height, const ViewKey& view) {
+    AutoState& a = autoState;
+    const ViewKey previous = a.lastView;
+    a.lastView = view;
+    if (a.standIn) return;  // Grid stood in for the kept structure: not its frame time
     if (!a.exploring) {
-      if (a.standIn) return;  // Grid stood in for the kept structure: not its frame time
       if (width != a.width || height != a.height) {
         startAutoExploration();
         return;
       }
-      // Frame times depend on the view: the kept structure's estimate follows its own frames
-      // (running mean of the last few); when it falls clearly behind another candidate's
-      // estimate, that one is built and measured in turn. On H100 Menger 1024^3 the axis-aligned
-      // view favoured Grid while oblique views favoured Naive by 1.7x: one probe is not enough.
-      // The first frame after a switch replaces the new structure's estimate (it was measured at
-      // another view, maybe long ago); later frames blend in.
-      double& e = a.seconds[size_t(a.current)];
-      e = a.freshEstimate ? seconds : 0.75 * e + 0.25 * seconds;
-      a.freshEstimate = false;
-      int best = a.current;
-      for (size_t i = 0; i < a.seconds.size(); ++i)
-        if (a.seconds[i] < a.seconds[size_t(best)]) best = int(i);
-      if (best != a.current && e > kAutoSwitch * a.seconds[size_t(best)]) {
-        a.current = best;
-        a.freshEstimate = true;
-        ++a.switches;
-        buildDirty = true;
-        describeAutoChoice();
+      // Settled: the kept structure's frame at a view far from the measured one, with the camera
+      // still since the previous frame, starts a re-check here (this frame is its first).
+      if (near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) || !near(view, previous, kAutoStillDegrees, kAutoStillZoom))
+        return;
+      // The contenders: those within kAutoPrune of the kept one where it was measured, at least
+      // the runner-up (the likeliest to overtake it at another view).
+      std::vector<int> q;
+      int runnerUp = -1;
+      for (size_t i = 0; i < a.candidates.size(); ++i) {
+        if (int(i) == a.kept || !(a.seconds[i] > 0)) continue;
+        if (a.seconds[i] < kAutoPrune * a.seconds[size_t(a.kept)]) q.push_back(int(i));
+        if (runnerUp < 0 || a.seconds[i] < a.seconds[size_t(runnerUp)]) runnerUp = int(i);
       }
-      return;
-    }
-    a.seconds[size_t(a.current)] = seconds;
-    a.width = width;
-    a.height = height;
-    if (size_t(a.current) + 1 < a.candidates.size()) {
-      ++a.current;
+      if (q.empty() && runnerUp >= 0) q.push_back(runnerUp);
+      if (q.empty()) {  // a single candidate: nothing to re-check
+        a.measuredAt = view;
+        return;
+      }
+      const int contenders = int(q.size());
+      for (int i = contenders - 1; i >= 0; --i) q.push_back(q[size_t(i)]);  // round 2, reversed
+      q.push_back(a.kept);
+      ++a.rechecks;
+      a.recheckAt = view;
+      std::vector<int> queue{a.kept};
+      queue.insert(queue.end(), q.begin(), q.end());
+      beginMeasuring(queue, true);
+      record(seconds);  // the frame just drawn: the kept one at this view
+      a.queue.erase(a.queue.begin());
+      a.current = a.queue.front();
       buildDirty = true;
       return;
     }
-    int best = 0;
-    for (size_t i = 1; i < a.seconds.size(); ++i)
-      if (a.seconds[i] < a.seconds[size_t(best)]) best = int(i);
-    // Never slower than Naive: one measured frame each is noisy, so a structure must beat Naive
-    // by kAutoMargin to be kept (on dense noise, 256^3, one frame each once put Grid 4% ahead of
-    // Naive and the next frames 11% behind it).
+    const bool first = !a.rechecking && a.frames == std::vector<int>(a.frames.size(), 0);
+    if (!first && (width != a.width || height != a.height)) {  // not comparable: from the start
+      startAutoExploration();
+      return;
+    }
+    if (a.rechecking && !near(view, a.recheckAt, kAutoRecheckDrift, kAutoStillZoom)) {
+      // The camera moved during the re-check: its times are not comparable; keep the choice and
+      // measure again when the camera rests (measuredAt stays where it was).
+      cancelRecheck();
+      return;
+    }
+    if (first) {
+      a.width = width;
+      a.height = height;
+      a.measuredAt = view;
+    }
+    record(seconds);
+    a.queue.erase(a.queue.begin());
+    if (a.queue.empty() && a.round == 1) {
+      // Round 2: the candidates within kAutoPrune of round 1's fastest, in the reverse order.
+      double fastest = std::numeric_limits<double>::infinity();
+      for (double t : a.seconds) if (t > 0) fastest = std::min(fastest, t);
+      for (int i = int(a.candidates.size()) - 1; i >= 0; --i)
+        if (a.seconds[size_t(i)] > 0 && a.seconds[size_t(i)] <= kAutoPrune * fastest) a.queue.push_back(i);
+      a.round = 2;
+    }
+    if (!a.queue.empty()) {
+      if (a.queue.front() != a.current) buildDirty = true;
+      a.current = a.queue.front();
+      return;
+    }
+    // The decision over the candidates measured in this measuring.
+    int best = -1;
     for (size_t i = 0; i < a.candidates.size(); ++i)
-      if (a.candidates[i].builder == BuilderKind::Naive && int(i) != best &&
-          a.seconds[size_t(best)] * kAutoMargin > a.seconds[i])
+      if (a.frames[i] > 0 && (best < 0 || a.seconds[i] < a.seconds[size_t(best)])) best = int(i);
+    // Never slower than Naive: a structure must beat Naive by kAutoMargin to be kept (on dense
+    // noise, 256^3, one frame each once put Grid 4% ahead of Naive and the next frames 11% behind
+    // it); in a re-check the kept structure wins likewise unless another beats it by the margin.
+    for (size_t i = 0; i < a.candidates.size(); ++i) {
+      const bool favoured = a.rechecking ? int(i) == a.kept : a.candidates[i].builder == BuilderKind::Naive;
+      if (favoured && a.frames[i] > 0 && int(i) != best && a.seconds[size_t(best)] * kAutoMargin > a.seconds[i])
         best = int(i);
-    a.exploring = false;
+    }
+    if (a.rechecking && best != a.kept) ++a.switches;
+    a.exploring = a.rechecking = false;
+    a.round = 0;
+    a.measuredAt = view;
     a.occupancy = backend->occupiedFraction();
     if (best != a.current) buildDirty = true;
-    a.current = best;
+    a.current = a.kept = best;
     describeAutoChoice();
   }
 
@@ -207,10 +343,11 @@ struct Engine::Impl {
     AutoState& a = autoState;
     char buf[160];
     std::snprintf(buf, sizeof buf, "Auto: %s (%.3g ms/frame) at occupancy %.3f",
-                  builderName(a.candidates[size_t(a.current)].builder), 1e3 * a.seconds[size_t(a.current)], a.occupancy);
+                  builderName(a.candidates[size_t(a.kept)].builder), 1e3 * a.seconds[size_t(a.kept)], a.occupancy);
     std::string line = buf;
+    if (a.rechecks) line += ", re-checked " + std::to_string(a.rechecks) + "x at new views";
     if (a.switches) line += ", switched " + std::to_string(a.switches) + "x";
-    line += "; measured";
+    line += "; measured (ms, best of the frames)";
     for (size_t i = 0; i < a.seconds.size(); ++i) {
       std::snprintf(buf, sizeof buf, "%s %s %.3g", i ? "," : "", builderName(a.candidates[i].builder), 1e3 * a.seconds[i]);
       line += buf;
@@ -363,6 +500,7 @@ struct Engine::Impl {
       if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
       opacityDirty = cropClipDirty = false;
       if (changed) buildDirty = edited = true;
+      if (changed) cancelRecheck();  // its frames were drawn over the old occupancy
       if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
           std::fabs(backend->occupiedFraction() - autoState.occupancy) > kAutoReexplore)
         startAutoExploration();
@@ -477,12 +615,23 @@ void Engine::setVolume(const Volume& v) {
   impl_->tableDirty = true;  // the default sample distance follows the spacing
 }
 
-void Engine::setTransferFunction(const TransferFunction& tf) {
+void Engine::setTransferFunction(TransferFunction tf, bool colorMayDiffer, bool opacityMayDiffer) {
   if (tf.table.empty()) throw std::invalid_argument("empty transfer-function table");
   Impl& d = *impl_;
-  if (!d.haveTF || !tf.sameOpacity(d.tf)) d.opacityDirty = true;
-  else if (!tf.sameColor(d.tf)) d.colorDirty = true;
-  d.tf = tf;
+  // A table of another size, or the first one, is new as a whole whatever the caller says.
+  const bool whole = !d.haveTF || tf.table.size() != d.tf.table.size();
+  bool opacity = whole;
+  if (!opacity && opacityMayDiffer) {
+    ++d.counters.opacityCompares;
+    opacity = !tf.sameOpacity(d.tf);
+  }
+  if (opacity) {
+    d.opacityDirty = true;  // re-classified, and the whole table set again
+  } else if (colorMayDiffer) {
+    ++d.counters.colorCompares;
+    if (!tf.sameColor(d.tf)) d.colorDirty = true;
+  }
+  d.tf = std::move(tf);
   d.haveTF = true;
 }
 
@@ -739,7 +888,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     d.warn("the bricks this view needs exceed the memory budget: sampled from the whole volume in host memory");
   ++d.counters.frames;
   if (d.build.builder == BuilderKind::Auto)
-    d.autoFrameDone(d.frame.deviceSeconds > 0 ? d.frame.deviceSeconds : d.frame.seconds, width, height);
+    d.autoFrameDone(d.frame.deviceSeconds > 0 ? d.frame.deviceSeconds : d.frame.seconds, width, height, d.viewKey(cam));
 }
 
 bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }

@@ -286,6 +286,14 @@ int vtkSpaceSkipVolumeRepresentation::GetUseJittering()
 {
   return this->SpaceSkipMapper->GetUseJittering() ? 1 : 0;
 }
+void vtkSpaceSkipVolumeRepresentation::SetFilterMode(int v)
+{
+  this->SpaceSkipMapper->SetFilterMode(v);
+}
+int vtkSpaceSkipVolumeRepresentation::GetFilterMode()
+{
+  return this->SpaceSkipMapper->GetFilterMode();
+}
 
 void vtkSpaceSkipVolumeRepresentation::SetExtraBlendMode(int mode)
 {

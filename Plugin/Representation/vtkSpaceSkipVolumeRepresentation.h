@@ -53,6 +53,8 @@ public:
   int GetEarlyRayTermination();
   void SetUseJittering(int on);
   int GetUseJittering();
+  void SetFilterMode(int mode);
+  int GetFilterMode();
   /// The blend modes ParaView 5.11's Blend Mode menu lacks (vtkSpaceSkippingVolumeMapper's
   /// BlendModeOverride): -1 follows Blend Mode.
   void SetExtraBlendMode(int mode);

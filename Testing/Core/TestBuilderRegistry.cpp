@@ -102,3 +102,34 @@ TEST(BuilderRegistry, PluginMenuMatches) {
     EXPECT_EQ(entries[i].second, r[i].name);
   }
 }
+
+// The filter modes: Core's FilterMode, the mapper's FilterModeTypes and the plugin's Filter Mode
+// menu name the same values in the same order (the mapper casts its value to FilterMode).
+TEST(BuilderRegistry, FilterModeMatchesMapperAndPlugin) {
+  const std::vector<std::pair<FilterMode, std::string>> modes{{FilterMode::Exact, "Exact"},
+                                                              {FilterMode::Hardware, "Hardware"}};
+  const std::string h = readSource("VTKModule/vtkSpaceSkippingVolumeMapper.h");
+  const size_t at = h.find("enum FilterModeTypes");
+  ASSERT_NE(at, std::string::npos);
+  const std::string body = h.substr(at, h.find("};", at) - at);
+  const std::regex entry(R"((\w+)Filter\s*=\s*(\d+))");
+  std::vector<std::pair<int, std::string>> mapper;
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), entry); it != std::sregex_iterator(); ++it)
+    mapper.emplace_back(std::stoi((*it)[2]), (*it)[1]);
+  const std::string xml = readSource("Plugin/SpaceSkipRepresentation.xml");
+  const size_t x = xml.find("name=\"FilterMode\"");
+  ASSERT_NE(x, std::string::npos);
+  const std::string menu = xml.substr(x, xml.find("</EnumerationDomain>", x) - x);
+  const std::regex xmlEntry(R"re(<Entry\s+value="(\d+)"\s+text="([^"]+)")re");
+  std::vector<std::pair<int, std::string>> plugin;
+  for (auto it = std::sregex_iterator(menu.begin(), menu.end(), xmlEntry); it != std::sregex_iterator(); ++it)
+    plugin.emplace_back(std::stoi((*it)[1]), (*it)[2]);
+  ASSERT_EQ(mapper.size(), modes.size());
+  ASSERT_EQ(plugin.size(), modes.size());
+  for (size_t i = 0; i < modes.size(); ++i) {
+    EXPECT_EQ(mapper[i].first, int(modes[i].first)) << modes[i].second;
+    EXPECT_EQ(mapper[i].second, modes[i].second);
+    EXPECT_EQ(plugin[i].first, int(modes[i].first)) << modes[i].second;
+    EXPECT_EQ(plugin[i].second, modes[i].second);
+  }
+}

@@ -146,3 +146,63 @@ TEST(Engine, ColourEditUpdatesTableOnlyOpacityEditReclassifies) {
   EXPECT_EQ(e.counters().rangeGrids, 1);  // value ranges are computed once per volume
   EXPECT_EQ(test::coverage(img), 0.0);
 }
+
+TEST(Engine, ACallerThatKnowsWhatChangedSavesTheCompares) {
+  // setTransferFunction(tf, colorMayDiffer, opacityMayDiffer): the VTK mapper knows which of its
+  // functions was edited; the engine then compares only that part of the table, with the same
+  // outcome (counters) as the full compare.
+  Volume v = generateVolume("shell", vec3l{32, 32, 32});
+  Engine e(BackendKind::CPU);
+  e.setLogger([](const std::string&) {});
+  e.setVolume(v);
+  const auto tf = TransferFunction::preset("ramp", 0, 255);
+  e.setTransferFunction(tf);
+  e.setBuildParams(test::builder(BuilderKind::Grid));
+  double b[6];
+  v.worldBounds(b);
+  Image img;
+  const Camera cam = orbitCamera(b, 20, 10, 1, false, 1);
+  e.render(cam, 32, 32, img);
+  Counters c = e.counters();
+  EXPECT_EQ(c.colorCompares + c.opacityCompares, 0) << "the first table is new as a whole";
+  // A colour edit, said to be one: no opacity compare, a colour update only.
+  auto colour = tf;
+  for (auto& t : colour.table) t.x = 1.f - t.x;
+  e.setTransferFunction(colour, true, false);
+  e.render(cam, 32, 32, img);
+  EXPECT_EQ(e.counters().opacityCompares, c.opacityCompares);
+  EXPECT_EQ(e.counters().colorCompares, c.colorCompares + 1);
+  EXPECT_EQ(e.counters().colorUpdates, c.colorUpdates + 1);
+  EXPECT_EQ(e.counters().classifications, c.classifications);
+  c = e.counters();
+  // An opacity edit, said to be one: one opacity compare, no colour compare, re-classified.
+  auto opacity = colour;
+  for (auto& t : opacity.table) t.w *= 0.5f;
+  e.setTransferFunction(opacity, false, true);
+  e.render(cam, 32, 32, img);
+  EXPECT_EQ(e.counters().opacityCompares, c.opacityCompares + 1);
+  EXPECT_EQ(e.counters().colorCompares, c.colorCompares);
+  EXPECT_EQ(e.counters().classifications, c.classifications + 1);
+  EXPECT_EQ(e.counters().colorUpdates, c.colorUpdates);
+  c = e.counters();
+  // Nothing may differ: nothing compared, nothing redone.
+  e.setTransferFunction(opacity, false, false);
+  e.render(cam, 32, 32, img);
+  EXPECT_EQ(e.counters().opacityCompares + e.counters().colorCompares, c.opacityCompares + c.colorCompares);
+  EXPECT_EQ(e.counters().classifications, c.classifications);
+  EXPECT_EQ(e.counters().colorUpdates, c.colorUpdates);
+  // The default (both may differ): an unchanged opacity is compared, then the colour.
+  c = e.counters();
+  e.setTransferFunction(colour);
+  e.render(cam, 32, 32, img);
+  EXPECT_EQ(e.counters().opacityCompares, c.opacityCompares + 1);
+  EXPECT_EQ(e.counters().classifications, c.classifications + 1) << "the opacity differs";
+  EXPECT_EQ(e.counters().colorCompares, c.colorCompares) << "the whole table is set again";
+  // The image is the one of an engine given the same table from the start.
+  Engine fresh(BackendKind::CPU);
+  fresh.setLogger([](const std::string&) {});
+  test::load(fresh, v, colour, test::builder(BuilderKind::Grid));
+  Image ref;
+  fresh.render(cam, 32, 32, ref);
+  EXPECT_EQ(compareImages(ref, img).maxAbs, 0.f);
+}

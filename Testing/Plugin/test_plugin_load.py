@@ -22,6 +22,7 @@ enums = {
                 "Hybrid", "DistanceGrid", "Auto"],
     "LeafCriterion": ["Shallow", "Deep"],
     "Backend": ["Auto", "CPU", "CUDA"],
+    "FilterMode": ["Exact", "Hardware"],
 }
 for name, entries in enums.items():
     prop = disp.GetProperty(name)
@@ -46,7 +47,7 @@ ok.check(disp.GetProperty("EarlyRayTermination").SMProperty.GetDomain("bool") is
          "EarlyRayTermination boolean domain")
 
 for name in ["Builder", "LeafCriterion", "MaxLeafSize", "BinCount", "MacroCellSize",
-             "SampleDistance", "Backend", "EarlyRayTermination"]:
+             "SampleDistance", "Backend", "EarlyRayTermination", "FilterMode"]:
     smprop = disp.GetProperty(name).SMProperty
     doc = smprop.GetDocumentation()
     ok.check(doc is not None and len(doc.GetDescription() or "") > 40,

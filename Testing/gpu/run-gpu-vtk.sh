@@ -9,7 +9,9 @@
 #
 #   Testing/gpu/run-gpu-vtk.sh OUTDIR [PHASE...]
 #   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
-#          bench-ert bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
+#          bench-ert bench-hw (N-body 2048^3, the mapper's FilterMode Hardware (texture unit)
+#          against Exact: HW_ITEMS, default DistanceGrid,DistanceGrid:hw,Auto,Auto:hw)
+#          bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
 #          volume-only scene skips) bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
 #          shading, window and CLI, N-body and Menger 1024^3: modes.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
 #          its CUDA tests: core.log) auto (the CLI's Builder Auto against fixed builders, dense and
@@ -196,7 +198,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
 # vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -222,6 +224,9 @@ has bench-float && ITEMS=Grid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[
 # A volume-only scene skips the depth readback; one opaque actor brings it back (same items as
 # bench-nbody1024's DistanceGrid rows, for the ratio).
 has bench-depth && ITEMS=Grid,DistanceGrid,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --depth-actor
+# The mapper's hardware filter (FilterMode Hardware: the texture unit's trilinear filter) against
+# exact sampling, N-body 2048^3 (issue 13's window goal: >= 700 fps, TF edit <= 3 ms).
+has bench-hw && ITEMS=${HW_ITEMS:-DistanceGrid,DistanceGrid:hw,Auto,Auto:hw} window_bench nbody 2048 "${v2[@]}"
 # Early ray termination on (VTK's mapper cannot turn it off): like for like with its rows above.
 if has bench-ert; then
   ITEMS=Naive,Grid,KdTreeGPUFast:mls32,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --ert

@@ -6,7 +6,9 @@
 // occupied cells to the end of the first new frame. Run by Testing/gpu/run-gpu-vtk.sh.
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
-//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN]] [--vtk-gpu] [--csv FILE]
+//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact]] [--vtk-gpu]
+//       [--csv FILE] [--filter hw|exact (the mapper's FilterMode for every item without :hw or
+//        :exact; default exact)]
 //       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
 //       [--host-composite (GPUComposite off)] [--blend composite|mip|minip|average|additive]
 //       [--shade (gradient shading, VTK's default headlight and material)]
@@ -258,6 +260,7 @@ struct Item
   int leaf = vtkSpaceSkippingVolumeMapper::Deep;
   int mls = 0;
   int brick = 8;
+  int filter = -1; ///< vtkSpaceSkippingVolumeMapper::FilterModeTypes; -1: --filter's
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -296,6 +299,14 @@ bool ParseItem(const std::string& spec, Item& it)
     {
       it.brick = std::atoi(parts[i].c_str() + 5);
     }
+    else if (parts[i] == "hw")
+    {
+      it.filter = vtkSpaceSkippingVolumeMapper::HardwareFilter;
+    }
+    else if (parts[i] == "exact")
+    {
+      it.filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
+    }
     else
     {
       return false;
@@ -331,6 +342,7 @@ int main(int argc, char* argv[])
   bool vtkGpu = false, egl = false, floatComposite = false, ert = false, hostComposite = false;
   bool shade = false, depthActor = false;
   int blend = vtkVolumeMapper::COMPOSITE_BLEND;
+  int filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -380,6 +392,19 @@ int main(int argc, char* argv[])
         return 2;
       }
     }
+    else if (a == "--filter")
+    {
+      const std::string m = next();
+      if (m == "hw" || m == "hardware")
+        filter = vtkSpaceSkippingVolumeMapper::HardwareFilter;
+      else if (m == "exact")
+        filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
+      else
+      {
+        std::cerr << "unknown filter " << m << " (hw or exact)\n";
+        return 2;
+      }
+    }
     else if (a == "--csv")
       csvPath = next();
     else if (a == "--png")
@@ -410,6 +435,14 @@ int main(int argc, char* argv[])
     if (hostComposite)
     {
       it.label += "+host";
+    }
+    if (it.filter < 0)
+    {
+      it.filter = filter;
+      if (filter == vtkSpaceSkippingVolumeMapper::HardwareFilter)
+      {
+        it.label += "+hw";
+      }
     }
     items.push_back(it);
   }
@@ -563,6 +596,7 @@ int main(int argc, char* argv[])
     mapper->SetLeafCriterion(it.leaf);
     mapper->SetMaxLeafSize(it.mls);
     mapper->SetMacroCellSize(it.brick);
+    mapper->SetFilterMode(it.filter);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
@@ -576,8 +610,9 @@ int main(int argc, char* argv[])
         mapper->GetLastCompositeSeconds());
       firstOfAll = false;
     }
-    // Builder Auto measures its candidates one frame each first: the steady state starts after.
-    for (int i = 0; i < 12 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
+    // Builder Auto measures its candidates first (one or two frames each): the steady state
+    // starts after.
+    for (int i = 0; i < 24 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
     {
       TimedRender(win);
     }

@@ -4,18 +4,34 @@
 //  - opacity edit, same support -> classification, no build (occupied cells unchanged);
 //  - opacity edit, new support  -> classification and build;
 //  - a replaced (equal) colour function / a replaced property -> nothing redone;
-//  - ScalarOpacityUnitDistance  -> re-classification (the opacity table changes), no build.
+//  - ScalarOpacityUnitDistance  -> re-classification (the opacity table changes), no build;
+//  - the property modified without a TF change -> nothing redone, nothing resampled;
+// and, through the table-sample counts, that each edit resamples only the function it edited.
 #include "SpaceSkipTestHelpers.h"
 
 namespace
 {
 struct Counts
 {
-  int classify, build, color;
+  int classify, build, color, colorSamples, opacitySamples;
 };
 Counts Read(vtkSpaceSkippingVolumeMapper* m)
 {
-  return Counts{ m->GetClassifyCount(), m->GetBuildCount(), m->GetColorUpdateCount() };
+  return Counts{ m->GetClassifyCount(), m->GetBuildCount(), m->GetColorUpdateCount(),
+    m->GetColorTableSampleCount(), m->GetOpacityTableSampleCount() };
+}
+// The colour and opacity functions sampled `dColor` and `dOpacity` times between the two.
+bool Sampled(const Counts& before, const Counts& after, int dColor, int dOpacity)
+{
+  const int c = after.colorSamples - before.colorSamples;
+  const int o = after.opacitySamples - before.opacitySamples;
+  std::cout << "  table samples: colour +" << c << ", opacity +" << o << "\n";
+  if (c != dColor || o != dOpacity)
+  {
+    std::cout << "  expected +" << dColor << ", +" << dOpacity << "\n";
+    return false;
+  }
+  return true;
 }
 bool Expect(const char* what, const Counts& before, const Counts& after, int dClassify,
   int dBuild, int dColor)
@@ -64,6 +80,7 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   win->Render();
   Counts c1 = Read(mapper);
   ok &= Expect("re-render, no edit", c0, c1, 0, 0, 0);
+  ok &= Sampled(c0, c1, 0, 0);
 
   // Colour-only edit.
   vtkColorTransferFunction* ctf = prop->GetRGBTransferFunction(0);
@@ -71,6 +88,7 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   win->Render();
   Counts c2 = Read(mapper);
   ok &= Expect("colour-only edit", c1, c2, 0, 0, 1);
+  ok &= Sampled(c1, c2, 1, 0);
   auto img2 = sstest::Capture(win);
   const double psnrColor = sstest::PSNR(img0, img2);
   std::cout << "  PSNR(before, after colour edit) = " << psnrColor << " dB\n";
@@ -82,6 +100,7 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   win->Render();
   Counts c3 = Read(mapper);
   ok &= Expect("opacity edit, same occupied cells", c2, c3, 1, 0, 0);
+  ok &= Sampled(c2, c3, 0, 1);
   ok &= mapper->GetOccupancy() == occupancy0;
 
   // Opacity edit that empties more space: the zero plateau extends to 75% of the range.
@@ -92,6 +111,7 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   win->Render();
   Counts c4 = Read(mapper);
   ok &= Expect("opacity edit, fewer occupied cells", c3, c4, 1, 1, 0);
+  ok &= Sampled(c3, c4, 0, 1);
   std::cout << "  occupancy " << occupancy0 << " -> " << mapper->GetOccupancy() << "\n";
   ok &= mapper->GetOccupancy() < occupancy0;
 
@@ -102,6 +122,15 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   win->Render();
   Counts c5 = Read(mapper);
   ok &= Expect("replaced colour function (same content)", c4, c5, 0, 0, 0);
+  ok &= Sampled(c4, c5, 1, 0);
+
+  // The property modified for another reason (ParaView does so often): nothing to resample.
+  prop->Modified();
+  win->Render();
+  Counts c5b = Read(mapper);
+  ok &= Expect("property modified, functions unchanged", c5, c5b, 0, 0, 0);
+  ok &= Sampled(c5, c5b, 0, 0);
+  c5 = c5b;
 
   // A replaced property with a different colour function, same opacity: colour update only.
   vtkNew<vtkVolumeProperty> prop2;
@@ -117,12 +146,14 @@ int TestSpaceSkippingVolumeTFEdit(int, char*[])
   win->Render();
   Counts c6 = Read(mapper);
   ok &= Expect("replaced property, new colours", c5, c6, 0, 0, 1);
+  ok &= Sampled(c5, c6, 1, 1); // new objects, both
 
   // The opacity unit distance changes every corrected opacity but not which cells are empty.
   prop2->SetScalarOpacityUnitDistance(2.0);
   win->Render();
   Counts c7 = Read(mapper);
   ok &= Expect("unit distance 1 -> 2", c6, c7, 1, 0, 0);
+  ok &= Sampled(c6, c7, 0, 1);
 
   // Opacity 0 everywhere: classification finds nothing, the build yields an empty structure and
   // the frame is the background.
