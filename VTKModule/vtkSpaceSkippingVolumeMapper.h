@@ -385,6 +385,26 @@ private:
   }
   bool UseTableRange = false;
   double TableRange[2] = { 0, 1 };
+  // Composite input on one lattice (vtkSpaceSkipBlockRenderer): the block's own cells, [lo, hi)
+  // per axis in the index space of WholeExtent (instead of its ghost array), drawn exactly (no
+  // 8-bit rounding bias), and the frame kept as a float image for the block renderer to
+  // composite instead of drawn.
+  void SetBlockOwnedCells(const int owned[6])
+  {
+    this->UseBlockOwned = owned != nullptr;
+    for (int i = 0; owned && i < 6; ++i)
+    {
+      this->BlockOwned[i] = owned[i];
+    }
+  }
+  bool UseBlockOwned = false;
+  int BlockOwned[6] = { 0, 0, 0, 0, 0, 0 };
+  bool DeferDraw = false;
+  // With DeferDraw: the opacity each pixel's ray brings from the blocks in front (width x height
+  // of the renderer's tiled viewport, row 0 at the bottom), or null (spaceskip::Engine::render).
+  const float* IncomingAlpha = nullptr;
+  /// The last Render()'s premultiplied RGBA floats (row 0 at the bottom) when DeferDraw, else null.
+  const float* GetDeferredImage(int& width, int& height);
 };
 
 #endif
