@@ -326,6 +326,20 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
       anyScalars = true;
     }
   }
+  if (images.empty() && others.empty())
+  {
+    // An empty composite data set (e.g. a rank's share of a few partitions): nothing to draw.
+    this->Blocks.clear();
+    ++this->Frames;
+    return true;
+  }
+  // Under MPI the range of all ranks' blocks (the representation gathers it).
+  const double* wholeRange = parent->GetWholeScalarRange();
+  if (anyScalars && wholeRange[0] <= wholeRange[1])
+  {
+    range[0] = wholeRange[0];
+    range[1] = wholeRange[1];
+  }
   if (images.empty() || !anyScalars)
   {
     problem = images.empty()
@@ -359,6 +373,16 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
     static_cast<unsigned long long>(parent->GetArrayAccessMode()),
     static_cast<unsigned long long>(parent->GetArrayId()),
     std::hash<std::string>()(parent->GetArrayName() ? parent->GetArrayName() : "") };
+  for (int i = 0; i < 6; ++i)
+  {
+    key.push_back(static_cast<unsigned long long>(static_cast<long long>(parent->GetWholeExtent()[i])));
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    unsigned long long bits = 0;
+    std::memcpy(&bits, &parent->GetWholeOrigin()[a], sizeof(bits));
+    key.push_back(bits);
+  }
   for (vtkImageData* image : images)
   {
     vtkDataArray* a = SelectedScalars(parent, image);
@@ -507,11 +531,38 @@ bool vtkSpaceSkipBlockRenderer::PlanLattice(
   vtkSpaceSkippingVolumeMapper* parent, int layers, std::string& why)
 {
   const size_t n = this->Blocks.size();
-  vtkImageData* ref = this->Blocks[0].Image;
+  vtkImageData* firstImage = this->Blocks[0].Image;
   double spacing[3], origin[3];
-  ref->GetSpacing(spacing);
-  ref->GetOrigin(origin);
-  vtkMatrix3x3* dir = ref->GetDirectionMatrix();
+  firstImage->GetSpacing(spacing);
+  firstImage->GetOrigin(origin);
+  vtkMatrix3x3* dir = firstImage->GetDirectionMatrix();
+  // The lattice's index space: the whole image's the parent was given (MPI: all ranks' blocks,
+  // its first point at WholeOrigin, the same bits on every rank), else the first block's.
+  const int* given = parent->GetWholeExtent();
+  const bool anchored = given[0] <= given[1] && given[2] <= given[3] && given[4] <= given[5];
+  if (anchored)
+  {
+    const double* o = parent->GetWholeOrigin();
+    for (int a = 0; a < 3; ++a)
+    {
+      origin[a] = o[a];
+    }
+    if (given[0] != 0 || given[2] != 0 || given[4] != 0)
+    {
+      // the point of index given[lo] at WholeOrigin
+      double shift[3] = { given[0] * spacing[0], given[2] * spacing[1], given[4] * spacing[2] };
+      dir->MultiplyPoint(shift, shift);
+      for (int a = 0; a < 3; ++a)
+      {
+        origin[a] -= shift[a];
+      }
+    }
+  }
+  this->Lattice = vtkSmartPointer<vtkImageData>::New();
+  this->Lattice->SetOrigin(origin);
+  this->Lattice->SetSpacing(spacing);
+  this->Lattice->SetDirectionMatrix(dir);
+  vtkImageData* ref = this->Lattice;
   std::vector<std::array<int, 6>> pts(n), cells(n), owned(n);
   std::vector<vtkDataArray*> arrays(n);
   for (size_t i = 0; i < n; ++i)
@@ -597,6 +648,21 @@ bool vtkSpaceSkipBlockRenderer::PlanLattice(
   {
     why = "no block with the drawn scalars";
     return false;
+  }
+  if (anchored)
+  {
+    for (size_t i = 0; i < n; ++i)
+    {
+      for (int a = 0; a < 3 && this->Blocks[i].Draws; ++a)
+      {
+        if (pts[i][2 * a] < given[2 * a] || pts[i][2 * a + 1] > given[2 * a + 1])
+        {
+          why = "a block outside the whole extent given to the mapper";
+          return false;
+        }
+      }
+    }
+    std::copy(given, given + 6, whole);
   }
   // Owned cells: the block's own (non-duplicate) cells, and the cell layer past its last points
   // where a neighbour starts one point further on (blocks that do not share their face points).
@@ -795,7 +861,7 @@ std::vector<size_t> vtkSpaceSkipBlockRenderer::VisibilityOrder(vtkRenderer* ren,
   vtkMatrix4x4::Invert(vol->GetMatrix(), toData);
   toData->MultiplyPoint(eye, eye);
   toData->MultiplyPoint(ahead, ahead);
-  vtkImageData* ref = this->Blocks[0].Piece ? this->Blocks[0].Piece.Get() : this->Blocks[0].Image;
+  vtkImageData* ref = this->Lattice;
   double e[3], f[3], d[3];
   ref->TransformPhysicalPointToContinuousIndex(eye, e);
   ref->TransformPhysicalPointToContinuousIndex(ahead, f);

@@ -142,6 +142,7 @@ private:
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   std::vector<unsigned long long> PlanKey;
   std::string OffLatticeWhy;
+  vtkSmartPointer<vtkImageData> Lattice; // the lattice's geometry (origin, spacing, orientation)
   std::unique_ptr<vtkSpaceSkipCompositor> Compositor; // draws the blended blocks
   std::unique_ptr<spaceskip::Image> SumImage;          // the blended blocks, row 0 at the bottom
   std::vector<float> Alpha;                            // SumImage's opacity, for the next block

@@ -237,9 +237,16 @@ public:
    * pieces give the serial image. WholeScalarRange: the whole image's range of the drawn scalars
    * (the transfer function's table spans it on every rank). Empty (the defaults): the input's
    * own extent and range.
+   * For composite input (image blocks, each rank holding some of them): WholeExtent and
+   * WholeOrigin describe the image the blocks of all ranks make, on the blocks' spacing and
+   * orientation, its point WholeExtent[0,2,4] at WholeOrigin (pass the same bits on every rank);
+   * the blocks then sample its lattice and their table spans WholeScalarRange. Empty: the image
+   * this process's blocks make, and their range.
    */
   vtkSetVector6Macro(WholeExtent, int);
   vtkGetVector6Macro(WholeExtent, int);
+  vtkSetVector3Macro(WholeOrigin, double);
+  vtkGetVector3Macro(WholeOrigin, double);
   vtkSetVector2Macro(WholeScalarRange, double);
   vtkGetVector2Macro(WholeScalarRange, double);
   ///@}
@@ -353,6 +360,7 @@ protected:
   int VectorComponent = 0;
   int BlendModeOverride = -1;
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  double WholeOrigin[3] = { 0, 0, 0 };
   double WholeScalarRange[2] = { 1, 0 };
 
   /// vtkImageData, and composite data sets of them (see GetBounds()).
