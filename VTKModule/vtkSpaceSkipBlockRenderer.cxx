@@ -30,6 +30,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -512,6 +513,19 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   {
     return true; // the blocks said why (or none was in view)
   }
+  const int* given = parent->GetWholeExtent();
+  if (this->OnLattice && carry && given[0] <= given[1] && given[2] <= given[3] && given[4] <= given[5])
+  {
+    // Under MPI IceT blends the ranks' images in 8 bits and truncates: where a ray goes on into
+    // another rank's blocks, this rank's colour is raised by half a unit, as a single piece's is
+    // (VolumePiece::followBias; SPACESKIP_PIECE_BIAS in 1/255 overrides).
+    const char* env = std::getenv("SPACESKIP_PIECE_BIAS");
+    const float bias = static_cast<float>((env ? std::atof(env) : 0.5) / 255.0);
+    if (bias != 0.f)
+    {
+      this->AddFollowBias(ren, vol, bias);
+    }
+  }
   if (!this->Compositor)
   {
     this->Compositor.reset(new vtkSpaceSkipCompositor);
@@ -824,6 +838,112 @@ bool vtkSpaceSkipBlockRenderer::PlanLattice(
   }
   std::copy(whole, whole + 6, this->WholeExtent);
   return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipBlockRenderer::AddFollowBias(vtkRenderer* ren, vtkVolume* vol, float bias)
+{
+  spaceskip::Image& sum = *this->SumImage;
+  const int width = sum.width, height = sum.height;
+  // NDC -> lattice index space: the camera's inverse projection, the volume's inverse matrix,
+  // the lattice's physical-to-index map (as RayGen's primary rays, in double).
+  vtkCamera* cam = ren->GetActiveCamera();
+  vtkNew<vtkMatrix4x4> ndcToWorld;
+  ndcToWorld->DeepCopy(cam->GetCompositeProjectionTransformMatrix(ren->GetTiledAspectRatio(), -1, 1));
+  ndcToWorld->Invert();
+  vtkNew<vtkMatrix4x4> worldToData;
+  vtkMatrix4x4::Invert(vol->GetMatrix(), worldToData);
+  vtkNew<vtkMatrix4x4> ndcToData;
+  vtkMatrix4x4::Multiply4x4(worldToData, ndcToWorld, ndcToData);
+  vtkImageData* lattice = this->Lattice;
+  auto toIndex = [&](double nx, double ny, double nz, double out[3]) {
+    double p[4] = { nx, ny, nz, 1.0 };
+    ndcToData->MultiplyPoint(p, p);
+    const double q[3] = { p[0] / p[3], p[1] / p[3], p[2] / p[3] };
+    lattice->TransformPhysicalPointToContinuousIndex(q, out);
+  };
+  // The ray's parameter range [t0, t1] inside box [lo, hi]; false when it misses.
+  auto slab = [](const double o[3], const double d[3], const double lo[3], const double hi[3],
+                double& t0, double& t1) {
+    t0 = -std::numeric_limits<double>::infinity();
+    t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a)
+    {
+      if (d[a] == 0)
+      {
+        if (o[a] < lo[a] || o[a] > hi[a])
+        {
+          return false;
+        }
+        continue;
+      }
+      double u = (lo[a] - o[a]) / d[a], v = (hi[a] - o[a]) / d[a];
+      if (u > v)
+      {
+        std::swap(u, v);
+      }
+      t0 = std::max(t0, u);
+      t1 = std::min(t1, v);
+    }
+    return t0 < t1 && t1 > 0;
+  };
+  double wlo[3], whi[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    wlo[a] = this->WholeExtent[2 * a];
+    whi[a] = this->WholeExtent[2 * a + 1];
+  }
+  std::vector<std::array<double, 6>> boxes;
+  for (const Block& b : this->Blocks)
+  {
+    if (b.Draws)
+    {
+      boxes.push_back({ double(b.Owned[0]), double(b.Owned[2]), double(b.Owned[4]),
+        double(b.Owned[1]), double(b.Owned[3]), double(b.Owned[5]) });
+    }
+  }
+  spaceskip::vec4f* out = sum.rgba.data();
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    for (int py = rows.begin(); py < rows.end(); ++py)
+    {
+      for (int px = 0; px < width; ++px)
+      {
+        spaceskip::vec4f& c = out[static_cast<size_t>(py) * width + px];
+        if (!(c.w > 0.f))
+        {
+          continue;
+        }
+        const double nx = (px + 0.5) / width * 2 - 1, ny = (py + 0.5) / height * 2 - 1;
+        double o[3], f[3], d[3];
+        toIndex(nx, ny, -1, o);
+        toIndex(nx, ny, 1, f);
+        for (int a = 0; a < 3; ++a)
+        {
+          d[a] = f[a] - o[a];
+        }
+        double w0, w1;
+        if (!slab(o, d, wlo, whi, w0, w1))
+        {
+          continue;
+        }
+        double localExit = -std::numeric_limits<double>::infinity();
+        for (const auto& b : boxes)
+        {
+          double t0, t1;
+          if (slab(o, d, b.data(), b.data() + 3, t0, t1))
+          {
+            localExit = std::max(localExit, t1);
+          }
+        }
+        if (localExit < w1 - 1e-6 * std::abs(w1 - w0))
+        {
+          c.x += bias;
+          c.y += bias;
+          c.z += bias;
+        }
+      }
+    }
+  });
 }
 
 //------------------------------------------------------------------------------

@@ -130,6 +130,9 @@ private:
   // Lays the blocks on one lattice (Piece, Owned, WholeExtent); false with the reason when they
   // are not on one.
   bool PlanLattice(vtkSpaceSkippingVolumeMapper* parent, int layers, std::string& why);
+  // MPI (WholeExtent given): raises the summed colour by `bias` where a pixel's ray goes on
+  // into another rank's blocks behind this rank's (IceT's 8-bit blend truncates).
+  void AddFollowBias(vtkRenderer* ren, vtkVolume* vol, float bias);
   // Front-to-back order of the drawn blocks (indices into Blocks).
   std::vector<size_t> VisibilityOrder(vtkRenderer* ren, vtkVolume* vol) const;
 
