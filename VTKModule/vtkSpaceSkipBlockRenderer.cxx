@@ -42,7 +42,8 @@ namespace
 constexpr size_t kManyBlocks = 64;
 
 // The parent's settings, as vtkMultiBlockVolumeMapper hands its own to each block's mapper.
-void CopySettings(vtkSpaceSkippingVolumeMapper* from, vtkSpaceSkippingVolumeMapper* to)
+// `padded`: the block is a copy holding the drawn scalars alone, as its active point scalars.
+void CopySettings(vtkSpaceSkippingVolumeMapper* from, vtkSpaceSkippingVolumeMapper* to, bool padded)
 {
   to->SetBuilder(from->GetBuilder());
   to->SetLeafCriterion(from->GetLeafCriterion());
@@ -60,8 +61,12 @@ void CopySettings(vtkSpaceSkippingVolumeMapper* from, vtkSpaceSkippingVolumeMapp
   to->SetBlendModeOverride(from->GetBlendModeOverride());
   to->SetBlendMode(from->GetBlendMode());
   to->SetAverageIPScalarRange(from->GetAverageIPScalarRange());
-  to->SetScalarMode(from->GetScalarMode());
-  if (from->GetArrayAccessMode() == VTK_GET_ARRAY_BY_ID)
+  to->SetScalarMode(padded ? VTK_SCALAR_MODE_USE_POINT_DATA : from->GetScalarMode());
+  if (padded)
+  {
+    // the active scalars: nothing to select
+  }
+  else if (from->GetArrayAccessMode() == VTK_GET_ARRAY_BY_ID)
   {
     to->SelectScalarArray(from->GetArrayId());
   }
@@ -414,7 +419,7 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   vtkMatrix4x4* matrix = vol->GetMatrix();
   for (Block& b : this->Blocks)
   {
-    CopySettings(parent, b.Mapper);
+    CopySettings(parent, b.Mapper, this->OnLattice && b.Draws && b.Padded);
     b.Mapper->SetTableRange(range);
     b.Mapper->DeferDraw = true;
     if (this->OnLattice && b.Draws)
@@ -422,11 +427,6 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
       if (b.Mapper->GetInputDataObject(0, 0) != b.Piece)
       {
         b.Mapper->SetInputData(b.Piece);
-      }
-      if (b.Padded)
-      {
-        // A padded copy holds the drawn scalars alone, as its active scalars.
-        b.Mapper->SetScalarMode(VTK_SCALAR_MODE_USE_POINT_DATA);
       }
       b.Mapper->SetWholeExtent(this->WholeExtent);
       b.Mapper->SetBlockOwnedCells(b.Owned);

@@ -230,6 +230,19 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
       }
     }
   }
+  // Later frames of padded blocks (shading, gaps) build nothing again: the copies are made once.
+  blocks->SetInputDataObject(gaps);
+  scene.Window->Render();
+  const int builds = blocks->GetBuildCount();
+  scene.Camera()->Azimuth(10);
+  scene.Window->Render();
+  scene.Window->Render();
+  if (blocks->GetBuildCount() != builds)
+  {
+    std::cerr << "padded blocks rebuilt on a camera change: builds " << builds << " -> "
+              << blocks->GetBuildCount() << "\n";
+    ok = false;
+  }
   scene.Property->SetShade(0);
 
   // Blocks off one lattice: one warning naming it, each block drawn on its own (the image is
