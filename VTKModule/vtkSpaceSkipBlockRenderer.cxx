@@ -1113,6 +1113,12 @@ const char* vtkSpaceSkipBlockRenderer::Names(
 }
 
 //------------------------------------------------------------------------------
+const char* vtkSpaceSkipBlockRenderer::GetCompositePath() const
+{
+  return this->Compositor ? this->Compositor->GetCompositePath().c_str() : "none";
+}
+
+//------------------------------------------------------------------------------
 double vtkSpaceSkipBlockRenderer::MinSampleDistance() const
 {
   double best = 0;

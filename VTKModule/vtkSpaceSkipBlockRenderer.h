@@ -107,6 +107,8 @@ public:
   double Occupancy() const;
   /// A string statistic of the blocks: the one value when all agree, else the values joined by '/'.
   const char* Names(const char* (vtkSpaceSkippingVolumeMapper::*getter)());
+  /// How the blended blocks reached the window: "host", or "none" before the first draw.
+  const char* GetCompositePath() const;
   /// The smallest sample distance the blocks used.
   double MinSampleDistance() const;
   /// Frames drawn through the blocks (one per Render() that drew at least one block).

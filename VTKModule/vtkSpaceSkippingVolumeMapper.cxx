@@ -558,7 +558,7 @@ const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
 {
   if (this->Internals->Blocks.IsActive())
   {
-    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetCompositePathUsed);
+    return this->Internals->Blocks.GetCompositePath(); // the blended blocks' way to the window
   }
   return this->Internals->Compositor.GetCompositePath().c_str();
 }

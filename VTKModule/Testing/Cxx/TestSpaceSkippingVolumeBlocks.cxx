@@ -181,12 +181,14 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
       // Every block got its own hierarchy; the statistics add them up.
       if (blocks->GetFrameCount() != framesBefore + 1 || blocks->GetNodeCount() <= 0 ||
         std::string(blocks->GetBuilderUsed()) != "KdTreeCPU" || blocks->GetBuildCount() < c.blocks ||
-        !(blocks->GetOccupancy() > 0 && blocks->GetOccupancy() < 1))
+        !(blocks->GetOccupancy() > 0 && blocks->GetOccupancy() < 1) ||
+        std::string(blocks->GetCompositePathUsed()) != "host")
       {
         std::cerr << name << ": statistics: frames " << blocks->GetFrameCount() << " (before "
                   << framesBefore << "), nodes " << blocks->GetNodeCount() << ", builder "
                   << blocks->GetBuilderUsed() << ", builds " << blocks->GetBuildCount()
-                  << ", occupancy " << blocks->GetOccupancy() << "\n";
+                  << ", occupancy " << blocks->GetOccupancy() << ", composite path "
+                  << blocks->GetCompositePathUsed() << "\n";
         ok = false;
       }
       // The bounds are the union of the blocks' (the camera and clipping range rely on them).
