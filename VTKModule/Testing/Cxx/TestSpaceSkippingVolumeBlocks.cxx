@@ -203,7 +203,8 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
         }
       }
       const bool isMixed = c.input == mixed.GetPointer();
-      // vtkMultiBlockVolumeMapper (VTK 9.2) draws ghost cells twice and leaves the gaps empty.
+      // vtkMultiBlockVolumeMapper (VTK 9.2) draws each block whole: the cells between blocks
+      // with a gap and the ghost cells are not drawn as one image would: printed, not checked.
       const bool vtkDrawsIt = c.input != gaps.GetPointer() && c.input != ghosts.GetPointer();
       const bool warns = isMixed && !mixedSeen;
       mixedSeen = mixedSeen || isMixed;
@@ -215,14 +216,14 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
                   << "]\n";
         ok = false;
       }
-      if (!isMixed && vtkDrawsIt)
+      if (!isMixed)
       {
         reference->SetInputDataObject(c.input);
         auto theirs = sstest::RenderWith(scene.Window, scene.Volume, reference);
         const double psnrRef = sstest::PrintComparison(
           name, theirs, ours, "vtkMultiBlockVolumeMapper", "multiblock");
         std::cout << "\n";
-        if (!(psnrRef >= kMinPSNRMultiBlock))
+        if (vtkDrawsIt && !(psnrRef >= kMinPSNRMultiBlock))
         {
           std::cerr << name << ": PSNR against vtkMultiBlockVolumeMapper " << psnrRef << " < "
                     << kMinPSNRMultiBlock << " dB\n";
