@@ -56,6 +56,7 @@ void CopySettings(vtkSpaceSkippingVolumeMapper* from, vtkSpaceSkippingVolumeMapp
   to->SetEightBitComposite(from->GetEightBitComposite());
   to->SetGPUComposite(from->GetGPUComposite());
   to->SetUseJittering(from->GetUseJittering());
+  to->SetDeviceMemoryBudget(from->GetDeviceMemoryBudget());
   to->SetVectorMode(from->GetVectorMode());
   to->SetVectorComponent(from->GetVectorComponent());
   to->SetBlendModeOverride(from->GetBlendModeOverride());

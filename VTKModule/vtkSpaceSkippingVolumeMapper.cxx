@@ -28,6 +28,7 @@
 #include "spaceskip/Engine.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <iostream>
@@ -186,6 +187,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   std::set<std::string> Said;
   double SampleDistanceUsed = 0;
   std::string BuilderChoice;
+  std::string Residency = "none";
+  vtkIdType ResidentBricks = 0;
 
   std::string BackendUsed = "none";
   std::string BuilderUsed = "none";
@@ -315,6 +318,10 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWind
 {
   spaceskip::Engine& engine = *this->Engine;
   auto t0 = std::chrono::steady_clock::now();
+  if (engine.backendKind() == spaceskip::BackendKind::CUDA)  // the CPU backend keeps the volume in host memory
+  {
+    engine.setMemoryBudget(static_cast<int64_t>(this->Self->DeviceMemoryBudget) << 20);
+  }
   engine.update();
   this->UpdateSeconds = SecondsSince(t0);
 
@@ -354,6 +361,12 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWind
   this->BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
   this->SampleDistanceUsed = engine.sampleDistance();
   this->BuilderChoice = engine.buildStats().choice;
+  const spaceskip::ResidencyStats& rs = engine.frameStats().residency;
+  this->ResidentBricks = rs.sparse ? static_cast<vtkIdType>(rs.resident) : 0;
+  char text[160];
+  std::snprintf(text, sizeof text, "sparse: %lld of %lld bricks resident (%.0f MiB pool)",
+    static_cast<long long>(rs.resident), static_cast<long long>(rs.bricks), double(rs.poolBytes) / 1048576.0);
+  this->Residency = rs.sparse ? text : "in core";
 }
 
 //------------------------------------------------------------------------------
@@ -577,6 +590,18 @@ double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
     return this->Internals->Blocks.MinSampleDistance();
   }
   return this->Internals->SampleDistanceUsed;
+}
+const char* vtkSpaceSkippingVolumeMapper::GetResidency()
+{
+  if (this->Internals->Blocks.IsActive())
+  {
+    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetResidency);
+  }
+  return this->Internals->Residency.c_str();
+}
+vtkIdType vtkSpaceSkippingVolumeMapper::GetResidentBricks()
+{
+  return this->Internals->ResidentBricks;
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetDeviceBytesInUse()
 {
@@ -807,6 +832,7 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GPUComposite: " << (this->GPUComposite ? "On" : "Off") << "\n";
   os << indent << "CompositePathUsed: " << this->Internals->Compositor.GetCompositePath() << "\n";
   os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
+  os << indent << "DeviceMemoryBudget: " << this->DeviceMemoryBudget << " MiB\n";
   os << indent << "VectorMode: " << this->VectorMode << "\n";
   os << indent << "VectorComponent: " << this->VectorComponent << "\n";
   os << indent << "BlendModeOverride: " << this->BlendModeOverride << "\n";

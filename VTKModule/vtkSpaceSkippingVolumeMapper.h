@@ -253,6 +253,23 @@ public:
 
   ///@{
   /**
+   * The most device memory the voxels may take, in MiB (0, the default: the free device memory
+   * less what the mapper's other structures need). A volume above it stays sparse: only the
+   * bricks the transfer function, blend mode and shading make visible are kept on the device
+   * (uploaded on an edit, the least recently needed evicted), and the image is the in-core one.
+   * A view whose visible bricks exceed it is drawn by the CPU backend, said once.
+   * GetResidency() reports which ran. The CPU backend ignores it.
+   */
+  vtkSetClampMacro(DeviceMemoryBudget, vtkIdType, 0, VTK_ID_MAX);
+  vtkGetMacro(DeviceMemoryBudget, vtkIdType);
+  /// "in core", "sparse: R of N bricks resident (P MiB pool)", or "none" before the first frame.
+  const char* GetResidency();
+  /// Bricks resident in the sparse pool after the last frame (0 in core).
+  vtkIdType GetResidentBricks();
+  ///@}
+
+  ///@{
+  /**
    * Statistics of the last build and frame.
    */
   double GetLastBuildSeconds();
@@ -356,6 +373,7 @@ protected:
   vtkTypeBool EightBitComposite = 1;
   vtkTypeBool GPUComposite = 1;
   vtkTypeBool UseJittering = 0;
+  vtkIdType DeviceMemoryBudget = 0;
   int VectorMode = 1; // vtkScalarsToColors::COMPONENT
   int VectorComponent = 0;
   int BlendModeOverride = -1;

@@ -25,11 +25,12 @@ const std::set<std::string>& valueOptions() {
       "-o", "--dims", "--seed", "--builder", "--builders", "--leaf", "--mls", "--bins", "--brick", "--backend",
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
-      "--shade", "--cuda-block", "--cuda-carveout", "--scale", "--datasets", "--time-limit"};
+      "--shade", "--cuda-block", "--cuda-carveout", "--scale", "--datasets", "--time-limit", "--memory-budget",
+      "--pool-brick", "--edit-tf"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
-  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper"};
+  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper", "--no-in-core"};
   return s;
 }
 
@@ -148,6 +149,17 @@ uint64_t maxVolumeBytes(const Options& o) {
     throw bad("--max-volume-bytes", s, "is not a positive byte count (e.g. 68719476736 or 64G)");
   return v;
 }
+
+int64_t memoryBudget(const Options& o) {
+  if (!o.has("--memory-budget")) return 0;
+  uint64_t v = 0;
+  const std::string s = o.get("--memory-budget", "");
+  if (!parseByteCount(s, v) || v == 0 || v > uint64_t(INT64_MAX))
+    throw bad("--memory-budget", s, "is not a positive byte count (e.g. 1073741824 or 1G)");
+  return int64_t(v);
+}
+
+int poolBrick(const Options& o) { return int(o.getInt("--pool-brick", 16, 1, 1024)); }
 
 std::vector<std::string> split(const std::string& s, char c) {
   std::vector<std::string> out;

@@ -52,6 +52,12 @@ uint64_t checkGeneratorSize(const std::string& shape, vec3l dims, uint64_t maxBy
 /// --max-volume-bytes (N with an optional K/M/G/T suffix), else defaultMaxVolumeBytes().
 uint64_t maxVolumeBytes(const Options& o);
 
+/// --memory-budget N[K|M|G|T]: the most memory the voxels may take on the backend (0 when
+/// absent: the backend's default); above it the volume is kept sparse (Engine::setMemoryBudget).
+int64_t memoryBudget(const Options& o);
+/// --pool-brick N (1..1024, default 16): cells per pool brick edge of sparse residency.
+int poolBrick(const Options& o);
+
 /// `spec` is NAME[:SUFFIX]... (bench variants); suffixes override --leaf/--mls/--bins/--brick:
 /// shallow, deep, mlsN, binsN, brickN.
 BuildParams buildParams(const Options& o, const std::string& spec);

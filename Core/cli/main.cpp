@@ -67,6 +67,12 @@ const char* kUsage = R"(usage:
       rotating orthographic camera, no ERT; progress on stderr; --time-limit S stops starting new
       items after S seconds (the rest are written as skipped). Figures: scripts/plot-paper-bench.py
 
+  spaceskip sparse VOLUME --memory-budget N[K|M|G] [--pool-brick N] [--builders b1,b2] [--edit-tf PRESET]
+                   [--no-in-core] [--frames N] [options]
+      sparse residency: only the bricks a frame needs on the device, within the budget; per
+      builder the in-core and the sparse run side by side (kernel fps, max difference of every
+      frame), and the TF edit --tf -> --edit-tf (default ramp) timed to its first frame
+
   VOLUME: NAME_XxYxZ_TYPE.raw, FILE.nrrd, or gen:SHAPE:N / gen:SHAPE:XxYxZ (generated in memory)
 options:
   --builder B        auto (default: one frame with each of naive, grid, distance-grid and a
@@ -87,6 +93,9 @@ options:
   --shade on|AMBIENT,DIFFUSE,SPECULAR,POWER  gradient shading with a headlight (on: 0,0.7,0.2,10)
   --compare REF.png  print max difference and PSNR against a reference image
   --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
+  --memory-budget N[K|M|G|T]  the most memory the voxels may take on the device (default: free
+                     device memory less what the rest needs); above it the volume stays sparse:
+                     only the pool bricks a frame needs are resident (--pool-brick N cells, 16)
   --max-volume-bytes N[K|M|G|T]  largest volume read or generated (default: the environment's
                      SPACESKIP_MAX_VOLUME_BYTES, else min(64 GiB, physical memory))
 builders:
@@ -154,6 +163,14 @@ int cmdGenerate(const Options& o) {
   return 0;
 }
 
+void printResidency(const ResidencyStats& r) {
+  if (!r.sparse) return;
+  std::printf("residency sparse: pool bricks of %d cells, %lld needed, %lld resident of %lld (%lld slots, %.1f MiB "
+              "pool, budget %.1f MiB)\n",
+              r.poolBrick, (long long)r.needed, (long long)r.resident, (long long)r.bricks, (long long)r.capacity,
+              double(r.poolBytes) / 1048576.0, double(r.budgetBytes) / 1048576.0);
+}
+
 int cmdRender(const Options& o) {
   if (o.positional.size() != 1 || !o.has("-o")) throw std::invalid_argument("render needs VOLUME -o out.png");
   auto t0 = Clock::now();
@@ -162,6 +179,7 @@ int cmdRender(const Options& o) {
   int w = 512, h = 512;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   Engine engine(backendKind(o));
+  engine.setMemoryBudget(memoryBudget(o), poolBrick(o));
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
   engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
@@ -185,6 +203,7 @@ int cmdRender(const Options& o) {
               (long long)s.nodes, s.height, (long long)s.leaves, 100.0 * s.occupancy);
   std::printf("render %dx%d: %.4f s (%.2f fps), sample distance %g\n", w, h, engine.frameStats().seconds,
               1.0 / engine.frameStats().seconds, engine.sampleDistance());
+  printResidency(engine.frameStats().residency);
   savePng(img, o.get("-o", ""));
   std::printf("wrote %s\n", o.get("-o", "").c_str());
   if (o.has("--compare")) {
@@ -198,6 +217,100 @@ int cmdRender(const Options& o) {
     }
   }
   return 0;
+}
+
+
+/// `spaceskip sparse`: the same frames in core and sparse under --memory-budget, per builder:
+/// images compared, frame rates side by side, and the TF edit (--tf -> --edit-tf) that makes
+/// new bricks visible timed to its first frame. --no-in-core: sparse alone (a volume the device
+/// cannot hold).
+int cmdSparse(const Options& o) {
+  if (o.positional.size() != 1 || !o.has("--memory-budget"))
+    throw std::invalid_argument("sparse needs VOLUME --memory-budget N[K|M|G]");
+  const std::vector<std::string> builders = split(o.get("--builders", "naive,grid,distance-grid,auto"), ',');
+  const int frames = int(o.getInt("--frames", 8, 1, 1000000));
+  int w = 1024, h = 1024;
+  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  const bool inCore = !o.has("--no-in-core");
+  auto tg = Clock::now();
+  Volume v = openVolume(o.positional[0], o);
+  std::printf("volume %s: %lldx%lldx%lld %s, %.2f GiB, ready in %.1f s\n", o.positional[0].c_str(), (long long)v.dims.x,
+              (long long)v.dims.y, (long long)v.dims.z, voxelTypeName(v.type), double(v.byteSize()) / 1073741824.0,
+              since(tg));
+  double lo, hi;
+  if (!v.scalarRange(lo, hi)) lo = 0, hi = 1;
+  const TransferFunction tf = makeTF(o, v);
+  const std::string editName = o.get("--edit-tf", "ramp");
+  const TransferFunction edited = TransferFunction::preset(editName, lo, hi);
+  double b6[6];
+  v.worldBounds(b6);
+  auto cam = [&](int f) { return orbitCamera(b6, 360.0 * f / frames, 15, 1, false, double(w) / h); };
+  std::printf("%-16s %-7s %9s %9s %9s %10s %9s %9s %9s %10s %11s\n", "builder", "mode", "kern_fps", "fps", "vs_incore",
+              "max_diff", "needed", "resident", "pool_MiB", "first_ms", "edit_ms");
+  int worst = 0;
+  for (const std::string& b : builders) {
+    struct Run {
+      double kfps = 0, fps = 0, maxDiff = -1, firstMs = 0, editMs = 0;
+      std::vector<Image> imgs;
+      Image editImg;
+      ResidencyStats r;
+      std::string backend;
+    };
+    auto run = [&](bool sparse) {
+      Run out;
+      Engine e(backendKind(o));
+      if (sparse) e.setMemoryBudget(memoryBudget(o), poolBrick(o));
+      else e.setMemoryBudget(INT64_MAX);  // in core whatever the default budget says
+      e.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+      e.setVolume(v);
+      e.setTransferFunction(tf);
+      e.setBuildParams(buildParams(o, b));
+      e.setRenderParams(renderParams(o));
+      Image img;
+      auto t0 = Clock::now();
+      e.render(cam(0), w, h, img);  // ranges, classification, build, residency, one frame
+      out.firstMs = 1e3 * since(t0);
+      for (int i = 0; i < 16 && e.exploring(); ++i) e.render(cam(0), w, h, img);
+      double total = 0, dev = 0;
+      for (int f = 0; f < frames; ++f) {
+        e.render(cam(f), w, h, img);
+        total += e.frameStats().seconds;
+        dev += e.frameStats().deviceSeconds;
+        out.imgs.push_back(img);
+      }
+      out.fps = frames / total;
+      out.kfps = dev > 0 ? frames / dev : out.fps;
+      out.r = e.frameStats().residency;
+      out.backend = e.frameStats().backend;
+      // The edit: new bricks become visible; its first frame is timed (classification, rebuild,
+      // residency update, the frame) and compared.
+      e.setTransferFunction(edited);
+      t0 = Clock::now();
+      e.render(cam(0), w, h, out.editImg);
+      out.editMs = 1e3 * since(t0);
+      return out;
+    };
+    Run ref;
+    if (inCore) ref = run(false);
+    Run sp = run(true);
+    if (inCore) {
+      sp.maxDiff = 0;
+      for (int f = 0; f < frames; ++f) sp.maxDiff = std::max(sp.maxDiff, double(compareImages(ref.imgs[size_t(f)], sp.imgs[size_t(f)]).maxAbs));
+      sp.maxDiff = std::max(sp.maxDiff, double(compareImages(ref.editImg, sp.editImg).maxAbs));
+      std::printf("%-16s %-7s %9.1f %9.1f %9s %10s %9s %9s %9s %10.1f %11.2f\n", b.c_str(), "incore", ref.kfps, ref.fps,
+                  "1", "-", "-", "-", "-", ref.firstMs, ref.editMs);
+      if (sp.maxDiff * 255.0 > 1.0) worst = 3;
+    }
+    char diff[32] = "-", ratio[32] = "-";
+    if (sp.maxDiff >= 0) std::snprintf(diff, sizeof diff, "%.2f/255", sp.maxDiff * 255.0);
+    if (inCore) std::snprintf(ratio, sizeof ratio, "%.3f", sp.kfps / ref.kfps);
+    std::printf("%-16s %-7s %9.1f %9.1f %9s %10s %9lld %9lld %9.1f %10.1f %11.2f\n", b.c_str(),
+                sp.r.overflow ? "over" : sp.r.sparse ? "sparse" : sp.backend.c_str(), sp.kfps, sp.fps, ratio, diff, (long long)sp.r.needed,
+                (long long)sp.r.resident, double(sp.r.poolBytes) / 1048576.0, sp.firstMs, sp.editMs);
+    std::fflush(stdout);
+  }
+  if (worst) std::fprintf(stderr, "spaceskip: a sparse image differs from the in-core one by more than 1/255\n");
+  return worst;
 }
 
 /// One measured bench item: a builder variant on one volume, the paper's protocol (orthographic
@@ -332,6 +445,7 @@ int cmdBench(const Options& o) {
     // One engine per data set: the volume is uploaded (CUDA) and its ranges computed once.
     Engine engine(backendKind(o));
     engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+    engine.setMemoryBudget(memoryBudget(o), poolBrick(o));
     engine.setVolume(v);
     engine.setTransferFunction(tf);
     for (const std::string& b : builders) {
@@ -690,6 +804,7 @@ int main(int argc, char** argv) {
     if (cmd == "render") return cmdRender(o);
     if (cmd == "bench") return cmdBench(o);
     if (cmd == "accuracy") return cmdAccuracy(o);
+    if (cmd == "sparse") return cmdSparse(o);
     std::fprintf(stderr, "unknown command '%s'\n", cmd.c_str());
     printUsage(stderr);
     return 2;

@@ -85,6 +85,20 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
                             stream));
 }
 
+void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaStream_t stream) {
+  haveOcc = false;
+  brick = r.brick;
+  cellDims = vol.cellDims();
+  bdims = r.dims;
+  const size_t nb = size_t(numBricks());
+  d_vmin.reserve(nb);
+  d_vmax.reserve(nb);
+  d_occ[0].reserve(nb);
+  d_occ[1].reserve(nb);
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_vmin.get(), r.vmin.data(), nb * sizeof(float), cudaMemcpyHostToDevice, stream));
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_vmax.get(), r.vmax.data(), nb * sizeof(float), cudaMemcpyHostToDevice, stream));
+}
+
 bool BrickClassification::classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream) {
   // The sparse table over the TF's (uncorrected) opacity, built as on the CPU, queried on the device.
   const OpacityRangeMax table(tf);
@@ -105,6 +119,7 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
   cur = 1 - cur;
   const bool changed = !haveOcc || flags->changed != 0;
+  if (changed) ++generation;
   haveOcc = true;
   occupied = int64_t(flags->occupied);
   hostOccValid_ = false;

@@ -34,6 +34,9 @@ class BrickClassification {
 
   /// Sizes the grid for `v` and launches the range kernel on `stream` (no synchronization).
   void setVolume(const DeviceVolume& v, int brick, cudaStream_t stream);
+  /// The same from ranges computed on the host (sparse residency: the voxels are not on the
+  /// device); copies them on `stream` (no synchronization: keep `r` alive until it is synchronized).
+  void setRanges(const Volume& vol, const RangeGrid& r, cudaStream_t stream);
   /// Classifies against `tf`'s opacity and `cc`; true when the occupancy changed (or is the first).
   bool classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream);
   /// The occupancy on the host (downloaded once per classification).
@@ -49,6 +52,7 @@ class BrickClassification {
   int cur = 0;
   bool haveOcc = false;  ///< classify() ran for this volume
   int64_t occupied = 0;
+  uint64_t generation = 0;  ///< counts classify() calls that changed the occupancy
 
  private:
   DeviceBuffer<float> d_levels_;  ///< OpacityRangeMax's levels

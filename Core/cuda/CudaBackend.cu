@@ -3,6 +3,7 @@
 #include "BuildContext.cuh"
 #include "Classification.cuh"
 #include "CudaExecutor.cuh"
+#include "DevicePool.cuh"
 #include "DeviceVolume.cuh"
 #include "DistanceField.cuh"
 #include "KdTreeBuilder.cuh"
@@ -32,12 +33,35 @@ class CudaBackend final : public Backend {
     traversal_ = TraversalKind::Naive;
     d_distField_ = nullptr;
     cls_.haveOcc = false;
-    vol_.upload(v, stream_);
-    cls_.setVolume(vol_, brick, stream_);
+    pool_.release();
+    const int64_t budget = budget_ > 0 ? budget_ : defaultBudget(v, brick);
+    if (int64_t(v.byteSize()) <= budget) {
+      vol_.upload(v, stream_);
+      cls_.setVolume(vol_, brick, stream_);
+      SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
+      inCore_ = ResidencyStats{};
+      inCore_.budgetBytes = budget;
+      return;
+    }
+    // Sparse residency (BrickPool.h): the value ranges from the host's voxels, and a pool of
+    // the budget's size that each frame fills with the bricks it needs.
+    vol_.describe(v);
+    const RangeGrid ranges = computeRangeGrid(v, brick);
+    cls_.setRanges(v, ranges, stream_);
     SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
+    pool_.init(v, brick, poolBrick_, budget);
   }
 
-  bool classify(const TransferFunction& tf, const CropClip& cc) override { return cls_.classify(tf, cc, stream_); }
+  bool classify(const TransferFunction& tf, const CropClip& cc) override {
+    tf_ = tf;
+    return cls_.classify(tf, cc, stream_);
+  }
+
+  void setMemoryBudget(int64_t bytes, int poolBrick) override {
+    budget_ = bytes > 0 ? bytes : 0;
+    poolBrick_ = poolBrick > 0 ? poolBrick : kPoolBrick;
+  }
+  ResidencyStats residency() const override { return pool_.active() ? pool_.stats() : inCore_; }
 
   void setTransferTable(const std::vector<vec4f>& t, float lo, float scale) override {
     exec_.setTransferTable(t, lo, scale, stream_);
@@ -96,7 +120,11 @@ class CudaBackend final : public Backend {
       f.traversal = TraversalKind::Grid;
       f.grid = GridView{nullptr, bdims_, brick_, nullptr, cls_.d_vmin.get(), cls_.d_vmax.get()};
     }
-    exec_.render(f, filter, depth, vol_, out, stream_);
+    if (pool_.active())
+      pool_.update(poolNeedFor(f.blend, f.shade != 0, tf_, f.avgLo, f.avgHi), cls_.d_occ[cls_.cur].get(),
+                   cls_.generation, cls_.d_vmin.get(), cls_.d_vmax.get(), bdims_, brick_, stream_);
+    const PoolView view = pool_.view();
+    exec_.render(f, filter, depth, vol_, pool_.active() ? &view : nullptr, out, stream_);
   }
 
   bool setImageOnDevice(bool on) override { return exec_.setImageOnDevice(on); }
@@ -123,6 +151,24 @@ class CudaBackend final : public Backend {
   }
 
  private:
+  /// Free device memory at setVolume, less what the rest of the backend may need (value
+  /// ranges, occupancy, distance field and trees: 32 bytes per brick) and 1 GiB for images,
+  /// textures' conversions and the builders' workspaces.
+  static int64_t defaultBudget(const Volume& v, int brick) {
+    size_t freeBytes = 0, total = 0;
+    if (cudaMemGetInfo(&freeBytes, &total) != cudaSuccess) {
+      (void)cudaGetLastError();
+      return INT64_MAX;  // unknown: try in core (an allocation failure falls back to the CPU)
+    }
+    const vec3i cd = v.cellDims();
+    const int b = std::max(1, brick);
+    const int64_t bricks = int64_t((cd.x + b - 1) / b) * ((cd.y + b - 1) / b) * ((cd.z + b - 1) / b);
+    const int64_t limit = cuda::deviceMemoryLimit();  // the testing cap, when set
+    int64_t avail = int64_t(freeBytes) + cuda::liveDeviceBytes().load();
+    if (limit >= 0) avail = std::min(avail, limit);
+    return std::max<int64_t>(0, avail - bricks * 32 - (int64_t(1) << 30));
+  }
+
   void uploadTree(const Tree& t) {
     tree_.numNodes = int(t.nodes.size());
     tree_.height = t.height;
@@ -135,6 +181,12 @@ class CudaBackend final : public Backend {
 
   cuda::Stream stream_;  // first: made first, destroyed last
   cuda::DeviceVolume vol_;
+  cuda::DevicePool pool_;
+  int64_t budget_ = 0;       ///< setMemoryBudget (0: defaultBudget)
+  ResidencyStats inCore_;    ///< residency() of an in-core volume
+  TransferFunction tf_;      ///< the last classify()'s TF (the pool's MIP/MinIP rule reads it)
+  static constexpr int kPoolBrick = 16;
+  int poolBrick_ = kPoolBrick;
   cuda::BrickClassification cls_;
   cuda::CudaExecutor exec_;
   // The classification under the names build() reads (until the builder registry replaces its switch).

@@ -68,6 +68,11 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
 }
 
 template <class Sampler>
+struct IsPoolSampler : std::false_type {};
+template <class T>
+struct IsPoolSampler<PoolSampler<T>> : std::true_type {};
+
+template <class Sampler>
 using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*);
 
 template <class Sampler, bool Plain>
@@ -88,6 +93,10 @@ RenderKernelPtr<Sampler> renderKernelFor(const FrameView& f) {
   // voxel types times four traversals more would double this file's compile time).
   if constexpr (IsChannelSampler<Sampler>::value)
     return renderKernel<Sampler, -1, false>;
+  // Sparse residency: the plain frames' kernels per traversal (the speed that matters), one
+  // kernel reading the traversal from the frame for the other modes.
+  else if constexpr (IsPoolSampler<Sampler>::value)
+    return isPlainFrame(f) ? renderKernelFor<Sampler, true>(f.traversal) : renderKernel<Sampler, -1, false>;
   else
     return isPlainFrame(f) ? renderKernelFor<Sampler, true>(f.traversal)
                            : renderKernelFor<Sampler, false>(f.traversal);
@@ -128,8 +137,8 @@ void CudaExecutor::setTransferTable(const std::vector<vec4f>& t, float lo, float
   table_ = TransferFunctionView{d_table_.get(), int(t.size()), lo, scale};
 }
 
-void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol, Image& out,
-                          cudaStream_t stream) {
+void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol,
+                          const PoolView* pool, Image& out, cudaStream_t stream) {
   const size_t pixels = size_t(f.width) * size_t(f.height);
   f.tf = table_;
   f.depth = nullptr;
@@ -156,7 +165,12 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   const dim3 grid(unsigned((f.width + bx - 1) / bx), unsigned((f.height + by - 1) / by));
   SS_CUDA_CHECK(cudaEventRecord(ev0_, stream));
   const Volume& v = vol.volume();
-  if (v.components > 1) {  // dependent components (render/Components.h): exact sampling only
+  if (pool) {  // sparse residency: the resident bricks, exact sampling
+    dispatchVoxelType(v.type, [&](auto t) {
+      using T = decltype(t);
+      launch(f, pool->sampler<T>(), grid, block, 0, stream);
+    });
+  } else if (v.components > 1) {  // dependent components (render/Components.h): exact sampling only
     dispatchVoxelType(v.type, [&](auto t) {
       using T = decltype(t);
       launch(f, ChannelSampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z, v.components}, grid, block, 0,

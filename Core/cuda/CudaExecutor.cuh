@@ -3,6 +3,7 @@
 // image's way back (a pinned staging copy, or left on the device for CUDA-GL interop).
 #pragma once
 #include "DeviceVolume.cuh"
+#include "spaceskip/BrickPool.h"
 #include "spaceskip/LaunchParams.h"
 #include "spaceskip/Types.h"
 #include "spaceskip/render/Integrator.h"
@@ -21,7 +22,9 @@ class CudaExecutor {
   void setTransferTable(const std::vector<vec4f>& table, float lo, float scale, cudaStream_t stream);
   /// Renders `f` (grid and tree pointing at device memory; the table and depth filled here) from
   /// `vol` into `out`, or only sizes `out` and leaves the image in deviceImage() (setImageOnDevice).
-  void render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol, Image& out, cudaStream_t stream);
+  /// With a `pool` (sparse residency, device pointers) the voxels are read through it, exactly.
+  void render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol, const PoolView* pool,
+              Image& out, cudaStream_t stream);
 
   bool setImageOnDevice(bool on) {
     imageOnDevice_ = on;

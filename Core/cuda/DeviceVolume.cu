@@ -28,6 +28,13 @@ void DeviceVolume::upload(const Volume& v, cudaStream_t stream) {
   SS_CUDA_CHECK(cudaMemcpyAsync(d_voxels_.get(), v.data, bytes, cudaMemcpyHostToDevice, stream));
 }
 
+void DeviceVolume::describe(const Volume& v) {
+  destroyTexture();
+  volume_ = v;
+  volume_.storage.reset();
+  d_voxels_.release();
+}
+
 TextureSampler DeviceVolume::texture(cudaStream_t stream) {
   if (tex_) return TextureSampler{tex_, texScale_};
   destroyTexture();  // an array left by an earlier attempt that failed after allocating it

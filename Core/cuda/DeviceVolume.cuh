@@ -24,6 +24,9 @@ class DeviceVolume {
   /// Copies `v`'s voxels to the device, asynchronously on `stream`; drops the texture of the last
   /// volume. Keeps `v`'s description, not its host voxels (the caller keeps those alive).
   void upload(const Volume& v, cudaStream_t stream);
+  /// Keeps `v`'s description only and frees the device voxels (sparse residency: DevicePool
+  /// holds what is resident).
+  void describe(const Volume& v);
   /// The description of the volume (its `data` is the caller's host pointer).
   const Volume& volume() const { return volume_; }
   /// The voxels on the device, as `T` (the C++ type of volume().type).

@@ -39,6 +39,14 @@ class Backend {
   virtual void setLaunchParams(const LaunchParams& /*p*/) {}
   /// Seconds the last render() spent in device work (CUDA events), -1 when not measured.
   virtual double lastFrameDeviceSeconds() const { return -1; }
+  /// The most memory the voxels may take (bytes; 0: the backend's default, for CUDA the free
+  /// device memory less what the rest needs; the CPU backend holds the volume in host memory
+  /// and ignores it unless set). A volume above it is kept sparse (BrickPool.h): only the
+  /// bricks each frame needs are resident. Takes effect at the next setVolume().
+  /// `poolBrick`: cells per pool brick edge (rounded to a multiple of the classification brick).
+  virtual void setMemoryBudget(int64_t /*bytes*/, int /*poolBrick*/) {}
+  /// Where the voxels live: in core, or sparse with the last frame's residency figures.
+  virtual ResidencyStats residency() const { return ResidencyStats{}; }
   virtual const OccupancyGrid& occupancy() = 0;
   /// Fraction of occupied bricks after the last classify(), without a host copy of the grid.
   virtual double occupiedFraction() { return occupancy().occupancy(); }

@@ -75,6 +75,16 @@ class Engine {
   const void* deviceImage() const;
   /// CUDA: the launch shape of the render kernels (LaunchParams.h); other backends ignore it.
   void setLaunchParams(const LaunchParams& p);
+  /// The most memory the voxels may take on the backend, in bytes (0, the default: CUDA takes
+  /// the free device memory less what its other structures need; the CPU backend has no limit).
+  /// A volume above it is kept sparse (BrickPool.h): each frame makes resident only the pool
+  /// bricks it can need (bit-identical images), evicting the least recently needed ones; a
+  /// view that needs more than the budget falls back to the CPU backend (CUDA) or samples
+  /// the host's volume (CPU), said once. frameStats().residency reports it.
+  /// `poolBrick`: cells per pool brick edge (a multiple of the classification brick; smaller
+  /// bricks fit sparse data tighter, at (brick+1)^3/brick^3 voxels per slot and a larger table).
+  void setMemoryBudget(int64_t bytes, int poolBrick = 16);
+  int64_t memoryBudget() const;
 
   const BuildStats& buildStats() const;
   /// Builder Auto: true while it still measures its candidates (one frame each).

@@ -63,6 +63,10 @@ std::vector<vec4f> correctedTable(const TransferFunction& tf, float dt);
 /// corrects opacity for dt, additive scales it by dt/unitDistance, the others use it raw.
 std::vector<vec4f> tableForBlend(const TransferFunction& tf, float dt, BlendMode mode);
 
+/// The voxel-to-table mapping in float for the integrator: entry x = (v - lo) * scale over
+/// [tf.rangeMin, tf.rangeMax] for a table of `size` entries; finite for any range.
+void tableMapping(const TransferFunction& tf, int size, float& lo, float& scale);
+
 /// Plain view of a (corrected) table for the integrator; device pointers on the GPU.
 struct TransferFunctionView {
   const vec4f* table;

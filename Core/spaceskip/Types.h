@@ -161,11 +161,32 @@ struct BuildStats {
   std::string choice;
 };
 
+/// Where the voxels live (sparse residency, BrickPool.h): in core, or only the pool bricks a
+/// frame needs, in a pool of a device-memory budget.
+struct ResidencyStats {
+  bool sparse = false;        ///< false: the whole volume is resident (in core)
+  int poolBrick = 0;          ///< cells per pool brick edge
+  int64_t bricks = 0;         ///< pool bricks of the volume
+  int64_t capacity = 0;       ///< pool slots allocated (grown with what views need)
+  int64_t maxCapacity = 0;    ///< pool slots the budget allows
+  int64_t needed = 0;         ///< pool bricks the last frame needed
+  int64_t resident = 0;       ///< pool bricks resident after it
+  int64_t uploaded = 0;       ///< pool bricks the last frame uploaded
+  int64_t evicted = 0;        ///< pool bricks the last frame evicted
+  double updateSeconds = 0;   ///< the last frame's residency update (needed set, gather, copies)
+  int64_t budgetBytes = 0;    ///< the budget the choice was made against
+  int64_t poolBytes = 0;      ///< bytes of the pool (slots x slot size)
+  /// The last frame needed more bricks than the pool holds (the CPU backend then sampled the
+  /// volume in host memory; the CUDA backend falls back to the CPU backend).
+  bool overflow = false;
+};
+
 struct FrameStats {
   double seconds = 0;
   int64_t samples = -1;  ///< samples taken in the frame (RenderParams::countSamples), else -1
   double deviceSeconds = -1;  ///< render kernel time on the GPU (CUDA events), -1 on the CPU
   std::string backend;
+  ResidencyStats residency;
 };
 
 /// How often each stage ran: what tests use to check "rebuild only what a change needs".

@@ -1,5 +1,6 @@
 // The oneTBB backend: tiles of pixels run the shared per-ray integrator.
 #include "spaceskip/Backend.h"
+#include "spaceskip/BrickPool.h"
 #include "spaceskip/Builders.h"
 #include "spaceskip/DistanceField.h"
 
@@ -24,6 +25,11 @@ class CpuBackend final : public Backend {
   void setVolume(const Volume& v, int brick) override {
     volume_ = v;
     ranges_ = computeRangeGrid(v, brick);
+    pool_.release();
+    // Sparse residency in host memory when a budget below the volume is set (the device
+    // pool's rules, checked here without a GPU); one component only, else in core.
+    if (budget_ > 0 && int64_t(v.byteSize()) > budget_ && v.components == 1)
+      pool_.init(v, ranges_.brick, poolBrick_, budget_);
     dist_.clear();
     occ_ = OccupancyGrid{};
     tree_ = Tree{};
@@ -34,7 +40,20 @@ class CpuBackend final : public Backend {
     bool changed = o.occ != occ_.occ || o.dims.x != occ_.dims.x || o.dims.y != occ_.dims.y ||
                    o.dims.z != occ_.dims.z;
     occ_ = std::move(o);
+    tf_ = tf;
+    if (changed) ++generation_;
     return changed;
+  }
+
+  void setMemoryBudget(int64_t bytes, int poolBrick) override {
+    budget_ = bytes > 0 ? bytes : 0;
+    poolBrick_ = poolBrick > 0 ? poolBrick : kPoolBrick;
+  }
+  ResidencyStats residency() const override {
+    ResidencyStats s = pool_.active() ? pool_.stats() : ResidencyStats{};
+    if (!pool_.active()) s.budgetBytes = budget_;
+    s.overflow = overflow_;
+    return s;
   }
 
   void setTransferTable(const std::vector<vec4f>& t, float lo, float scale) override {
@@ -75,6 +94,15 @@ class CpuBackend final : public Backend {
     out.width = f.width;
     out.height = f.height;
     out.rgba.assign(size_t(f.width) * size_t(f.height), vec4f{0, 0, 0, 0});
+    overflow_ = false;
+    if (pool_.active()) {
+      try {
+        pool_.update(poolNeedFor(f.blend, f.shade != 0, tf_, f.avgLo, f.avgHi), occ_.occ.data(), generation_,
+                     ranges_.vmin.data(), ranges_.vmax.data(), ranges_.dims, ranges_.brick);
+      } catch (const std::runtime_error&) {
+        overflow_ = true;  // the whole volume is in host memory: this frame samples it in core
+      }
+    }
     dispatchVoxelType(volume_.type, [&](auto voxel) { run<decltype(voxel)>(f, out); });
   }
 
@@ -84,6 +112,10 @@ class CpuBackend final : public Backend {
  private:
   template <class T>
   void run(const FrameView& f, Image& out) {
+    if (pool_.active() && !overflow_) {
+      tiles(f, out, pool_.view().sampler<T>());
+      return;
+    }
     if (volume_.components > 1) {  // dependent components (render/Components.h)
       tiles(f, out, ChannelSampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y,
                                       volume_.dims.z, volume_.components});
@@ -103,7 +135,14 @@ class CpuBackend final : public Backend {
                       });
   }
 
+  static constexpr int kPoolBrick = 16;
+  int poolBrick_ = kPoolBrick;
   Volume volume_;
+  HostPool pool_;
+  int64_t budget_ = 0;
+  bool overflow_ = false;
+  uint64_t generation_ = 0;
+  TransferFunction tf_;
   RangeGrid ranges_;
   OccupancyGrid occ_;
   OccupancyGrid hybridGrid_;

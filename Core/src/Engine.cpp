@@ -61,20 +61,6 @@ double effectiveSampleDistance(const Volume& v, double requested, std::string* n
   return dt;
 }
 
-namespace {
-// The voxel-to-table mapping in float for the integrator: lo and entries-per-unit, finite and
-// overflow-free for any finite range (ranges are clamped to float; empty ones get one unit).
-void tableMapping(const TransferFunction& tf, int size, float& lo, float& scale) {
-  const double big = double(std::numeric_limits<float>::max());
-  double a = std::isfinite(tf.rangeMin) ? std::clamp(tf.rangeMin, -big, big) : 0.0;
-  double b = std::isfinite(tf.rangeMax) ? std::clamp(tf.rangeMax, -big, big) : a + 1.0;
-  double width = b - a;
-  if (!(width > 0)) width = std::max(std::fabs(a) * 1e-6, 1e-30);
-  lo = float(a);
-  scale = float(std::min(double(size - 1) / width, big));
-}
-}  // namespace
-
 struct Engine::Impl {
   BackendKind requested;
   std::unique_ptr<Backend> backend;
@@ -87,6 +73,8 @@ struct Engine::Impl {
   bool haveTF = false;
   BuildParams build;
   RenderParams render;
+  int64_t memoryBudget = 0;  ///< setMemoryBudget (0: the backend's default)
+  int poolBrick = 16;
   VolumePiece piece;  ///< inactive: the volume is whole
 
   bool rangesDirty = true, opacityDirty = true, colorDirty = true, buildDirty = true, tableDirty = true;
@@ -234,10 +222,12 @@ struct Engine::Impl {
   void chooseBackend() {
     if (requested == BackendKind::CPU) {
       backend = makeCpuBackend();
+      backend->setMemoryBudget(memoryBudget, poolBrick);
       return;
     }
     try {
       backend = makeCudaBackend();
+      backend->setMemoryBudget(memoryBudget, poolBrick);
     } catch (const BackendError& e) {
       if (requested == BackendKind::CUDA) warn(std::string("CUDA backend unavailable (") + e.what() + "); using the CPU backend");
       backend = makeCpuBackend();
@@ -744,6 +734,11 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     for (unsigned c : counts) d.frame.samples += c;
   }
   d.frame.backend = d.backend->name();
+  d.frame.residency = d.backend->residency();
+  if (d.frame.residency.sparse && d.render.filter == FilterMode::Hardware)
+    d.warn("sparse residency samples exactly (hardware filtering needs the whole volume in one texture)");
+  if (d.frame.residency.overflow)
+    d.warn("the bricks this view needs exceed the memory budget: sampled from the whole volume in host memory");
   ++d.counters.frames;
   if (d.build.builder == BuilderKind::Auto)
     d.autoFrameDone(d.frame.deviceSeconds > 0 ? d.frame.deviceSeconds : d.frame.seconds, width, height);
@@ -752,6 +747,16 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
 bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }
 const void* Engine::deviceImage() const { return impl_->backend->deviceImage(); }
 void Engine::setLaunchParams(const LaunchParams& p) { impl_->backend->setLaunchParams(p); }
+void Engine::setMemoryBudget(int64_t bytes, int poolBrick) {
+  bytes = bytes > 0 ? bytes : 0;
+  poolBrick = std::clamp(poolBrick, 1, 1024);
+  if (bytes == impl_->memoryBudget && poolBrick == impl_->poolBrick) return;
+  impl_->memoryBudget = bytes;
+  impl_->poolBrick = poolBrick;
+  impl_->backend->setMemoryBudget(bytes, poolBrick);
+  impl_->rangesDirty = true;  // in core or sparse is decided when the volume is set
+}
+int64_t Engine::memoryBudget() const { return impl_->memoryBudget; }
 
 const BuildStats& Engine::buildStats() const { return impl_->stats; }
 bool Engine::exploring() const {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -129,6 +130,18 @@ OpacityRangeMax::OpacityRangeMax(const TransferFunction& tf) {
     for (int i = 0; i + len <= size; ++i) cur[i] = std::max(prev[i], prev[i + len / 2]);
   }
   view_.levels = levels_.data();
+}
+
+// The voxel-to-table mapping in float for the integrator: lo and entries-per-unit, finite and
+// overflow-free for any finite range (ranges are clamped to float; empty ones get one unit).
+void tableMapping(const TransferFunction& tf, int size, float& lo, float& scale) {
+  const double big = double(std::numeric_limits<float>::max());
+  double a = std::isfinite(tf.rangeMin) ? std::clamp(tf.rangeMin, -big, big) : 0.0;
+  double b = std::isfinite(tf.rangeMax) ? std::clamp(tf.rangeMax, -big, big) : a + 1.0;
+  double width = b - a;
+  if (!(width > 0)) width = std::max(std::fabs(a) * 1e-6, 1e-30);
+  lo = float(a);
+  scale = float(std::min(double(size - 1) / width, big));
 }
 
 }  // namespace spaceskip

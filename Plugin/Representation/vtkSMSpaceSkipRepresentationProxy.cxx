@@ -4,7 +4,9 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVSession.h"
+#include "vtkPVXMLElement.h"
 #include "vtkSMProperty.h"
+#include "vtkSMPropertyGroup.h"
 #include "vtkSMPropertyHelper.h"
 #include "vtkSpaceSkipStatisticsInformation.h"
 
@@ -62,6 +64,81 @@ void vtkSMSpaceSkipRepresentationProxy::UpdatePropertyInformationInternal(vtkSMP
     {
       vtkSMPropertyHelper(this, vtkSpaceSkipStatisticsInformation::GetTextName(i))
         .Set(info->GetText(i));
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+namespace
+{
+constexpr const char* kRepresentationName = "Space Skipping Volume";
+
+bool IsRepresentationDecorator(vtkPVXMLElement* e, const char* value)
+{
+  const char* name = e->GetName();
+  const char* type = e->GetAttribute("type");
+  const char* property = e->GetAttribute("property");
+  const char* v = e->GetAttribute("value");
+  return name && strcmp(name, "PropertyWidgetDecorator") == 0 && type &&
+    strcmp(type, "GenericDecorator") == 0 && property && strcmp(property, "Representation") == 0 &&
+    v && strcmp(v, value) == 0;
+}
+
+// In `element` and below: every <Expression type="or"> that lists Representation == "Volume" gets
+// Representation == "Space Skipping Volume" beside it, unless it has it already. Returns how
+// many such expressions there are.
+int AddRepresentationToOr(vtkPVXMLElement* element)
+{
+  int found = 0;
+  const unsigned int n = element->GetNumberOfNestedElements();
+  for (unsigned int i = 0; i < n; ++i)
+  {
+    found += AddRepresentationToOr(element->GetNestedElement(i));
+  }
+  const char* name = element->GetName();
+  const char* type = element->GetAttribute("type");
+  if (!name || strcmp(name, "Expression") != 0 || !type || strcmp(type, "or") != 0)
+  {
+    return found;
+  }
+  bool volume = false, ours = false;
+  for (unsigned int i = 0; i < n; ++i)
+  {
+    volume = volume || IsRepresentationDecorator(element->GetNestedElement(i), "Volume");
+    ours = ours || IsRepresentationDecorator(element->GetNestedElement(i), kRepresentationName);
+  }
+  if (volume && !ours)
+  {
+    vtkNew<vtkPVXMLElement> decorator;
+    decorator->SetName("PropertyWidgetDecorator");
+    decorator->AddAttribute("type", "GenericDecorator");
+    decorator->AddAttribute("mode", "visibility");
+    decorator->AddAttribute("property", "Representation");
+    decorator->AddAttribute("value", kRepresentationName);
+    element->AddNestedElement(decorator);
+  }
+  return found + (volume ? 1 : 0);
+}
+}
+
+//------------------------------------------------------------------------------
+void vtkSMSpaceSkipRepresentationProxy::CreateVTKObjects()
+{
+  const bool wasCreated = this->ObjectsCreated != 0;
+  this->Superclass::CreateVTKObjects();
+  vtkSMProxy* display = this->GetParentProxy();
+  if (wasCreated || !this->ObjectsCreated || !display)
+  {
+    return;
+  }
+  for (size_t i = 0; i < display->GetNumberOfPropertyGroups(); ++i)
+  {
+    vtkSMPropertyGroup* group = display->GetPropertyGroup(i);
+    const char* label = group ? group->GetXMLLabel() : nullptr;
+    if (label && group->GetHints() &&
+      (strcmp(label, "Volume Rendering") == 0 || strcmp(label, "Cropping Parameters") == 0))
+    {
+      AddRepresentationToOr(group->GetHints());
     }
   }
 }

@@ -11,6 +11,8 @@
  * vtkSpaceSkipStatisticsInformation from the render server (rank 0) and sets the statistics
  * properties from it. In the built-in session (GUI, pvpython, pvbatch) the render server is the
  * same process and the values are the ones the pull read.
+ * It also lets the Properties panel show the stock volume groups for this representation (see
+ * CreateVTKObjects).
  * Created for the XML element `<SpaceSkipRepresentationProxy>` (SpaceSkipRepresentation.xml).
  */
 #ifndef vtkSMSpaceSkipRepresentationProxy_h
@@ -33,6 +35,14 @@ protected:
 
   /// The usual pull, then the statistics from the render server.
   void UpdatePropertyInformationInternal(vtkSMProperty* prop = nullptr) override;
+
+  /// ParaView 5.11's Properties panel shows the image-data display's stock "Volume Rendering"
+  /// and "Cropping Parameters" groups (Blend Mode, Slice Type, Shade, Use Cropping...) only while
+  /// Representation is "Volume" or "NVIDIA IndeX": an `or` of GenericDecorators in ParaView's own
+  /// XML, which a plugin's XML cannot extend. Those properties are shared with this
+  /// representation, so after the usual creation "Space Skipping Volume" is added to that `or`
+  /// in the parent display's group hints (once: the hints belong to the shared definition).
+  void CreateVTKObjects() override;
 
 private:
   vtkSMSpaceSkipRepresentationProxy(const vtkSMSpaceSkipRepresentationProxy&) = delete;

@@ -16,7 +16,7 @@ const char* const kNumberNames[vtkSpaceSkipStatisticsInformation::NumberCount] =
   "ColorUpdateCount", "FrameCount"
 };
 const char* const kTextNames[vtkSpaceSkipStatisticsInformation::TextCount] = { "BackendUsed",
-  "BuilderUsed", "BuilderChoice" };
+  "BuilderUsed", "BuilderChoice", "Residency" };
 constexpr int kFrameCount = 11; // index of FrameCount in kNumberNames
 }
 
@@ -57,7 +57,8 @@ void vtkSpaceSkipStatisticsInformation::CopyFromObject(vtkObject* object)
     rep->GetLeafCount(), rep->GetOccupancy(), static_cast<double>(rep->GetTreeHeight()),
     static_cast<double>(rep->GetBuildCount()), static_cast<double>(rep->GetClassifyCount()),
     static_cast<double>(rep->GetColorUpdateCount()), static_cast<double>(rep->GetFrameCount()) };
-  this->Texts = { rep->GetBackendUsed(), rep->GetBuilderUsed(), rep->GetBuilderChoice() };
+  this->Texts = { rep->GetBackendUsed(), rep->GetBuilderUsed(), rep->GetBuilderChoice(),
+    rep->GetResidency() };
 }
 
 //------------------------------------------------------------------------------

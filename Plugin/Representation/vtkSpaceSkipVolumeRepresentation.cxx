@@ -399,6 +399,10 @@ int vtkSpaceSkipVolumeRepresentation::GetEarlyRayTermination()
 {
   return this->SpaceSkipMapper->GetEarlyRayTermination() ? 1 : 0;
 }
+void vtkSpaceSkipVolumeRepresentation::SetDeviceMemoryBudget(int mib)
+{
+  this->SpaceSkipMapper->SetDeviceMemoryBudget(mib);
+}
 void vtkSpaceSkipVolumeRepresentation::SetUseJittering(int v)
 {
   this->SpaceSkipMapper->SetUseJittering(v != 0);
@@ -452,6 +456,12 @@ double vtkSpaceSkipVolumeRepresentation::GetOccupancy()
   return this->SpaceSkipMapper->GetOccupancy();
 }
 // The string getters copy: the wrapped caller reads the value after the mapper may change it.
+const char* vtkSpaceSkipVolumeRepresentation::GetResidency()
+{
+  const char* text = this->SpaceSkipMapper->GetResidency();
+  this->ResidencyText = text ? text : "";
+  return this->ResidencyText.c_str();
+}
 const char* vtkSpaceSkipVolumeRepresentation::GetBuilderChoice()
 {
   const char* text = this->SpaceSkipMapper->GetBuilderChoice();

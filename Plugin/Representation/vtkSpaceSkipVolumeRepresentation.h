@@ -48,6 +48,7 @@ public:
   double GetSampleDistance();
   void SetBackend(int backend);
   int GetBackend();
+  void SetDeviceMemoryBudget(int mib);
   void SetEarlyRayTermination(int on);
   int GetEarlyRayTermination();
   void SetUseJittering(int on);
@@ -71,6 +72,7 @@ public:
   const char* GetBackendUsed();
   const char* GetBuilderUsed();
   const char* GetBuilderChoice();
+  const char* GetResidency();
   int GetBuildCount();
   int GetClassifyCount();
   int GetColorUpdateCount();
@@ -110,6 +112,7 @@ protected:
   std::string BackendUsedName;
   std::string BuilderUsedName;
   std::string BuilderChoiceText;
+  std::string ResidencyText;
 
 private:
   vtkSpaceSkipVolumeRepresentation(const vtkSpaceSkipVolumeRepresentation&) = delete;

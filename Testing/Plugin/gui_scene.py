@@ -24,7 +24,8 @@ try:
     SaveScreenshot(os.path.join(out, "gui_view.png"), view, ImageResolution=list(ssptest.IMAGE_SIZE),
                    TransparentBackground=0)
     result = {"representation": disp.SMProxy.GetProperty("Representation").GetElement(0),
-              "stats": ssptest.stats(disp)}
+              "stats": ssptest.stats(disp),
+              "groups_shown": ssptest.groups_shown_for(disp)}
 except Exception as e:  # report to the driver instead of leaving it waiting
     import traceback
     result = {"error": traceback.format_exc()}

@@ -171,6 +171,55 @@ def compare_to_baseline(path, baseline_name, min_psnr=40.0):
     return value
 
 
+def groups_shown_for(disp, labels=("Volume Rendering", "Cropping Parameters"),
+                     representation="Space Skipping Volume"):
+    """{label: True/False} for the display's property groups `labels`: whether their Properties
+    panel decorators list Representation == `representation` (vtkSMSpaceSkipRepresentationProxy
+    adds it beside ParaView's "Volume")."""
+    def has(e):
+        if (e.GetName() == "PropertyWidgetDecorator" and e.GetAttribute("type") == "GenericDecorator"
+                and e.GetAttribute("property") == "Representation"
+                and e.GetAttribute("value") == representation):
+            return True
+        return any(has(e.GetNestedElement(i)) for i in range(e.GetNumberOfNestedElements()))
+
+    px = disp.SMProxy
+    found = {}
+    for i in range(px.GetNumberOfPropertyGroups()):
+        g = px.GetPropertyGroup(i)
+        if g.GetXMLLabel() in labels:
+            found[g.GetXMLLabel()] = g.GetHints() is not None and has(g.GetHints())
+    return found
+
+
+class WarningCapture:
+    """Collects the VTK warnings and errors of the client/builtin process until stop() (a
+    vtkStringOutputWindow in place of ParaView's). pvpython routes print() through the same output
+    window, so stop() replays everything captured on stdout and returns the warning and error
+    messages alone (header line and message line of each)."""
+
+    def __init__(self):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
+        self.previous = vtkOutputWindow.GetInstance()
+        self.window = vtkStringOutputWindow()
+        vtkOutputWindow.SetInstance(self.window)
+
+    def stop(self):
+        from vtkmodules.vtkCommonCore import vtkOutputWindow
+        vtkOutputWindow.SetInstance(self.previous)
+        text = self.window.GetOutput()
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        lines = text.splitlines()
+        found = []
+        for i, line in enumerate(lines):
+            if line.startswith(("Warning: In ", "ERROR: In ", "Generic Warning", "Generic Error")):
+                found.append(line)
+                if i + 1 < len(lines):
+                    found.append(lines[i + 1])
+        return "\n".join(found)
+
+
 class Checker:
     """Collects failures so one run reports all of them; exit code 1 when any failed."""
 

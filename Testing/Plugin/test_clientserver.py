@@ -1,8 +1,9 @@
 """Client/server: a pvserver started here on a free localhost port, pvpython connected to it with
 the plugin loaded on both sides. The server renders the Space Skipping Volume; the client reads
 the server's statistics (vtkSMSpaceSkipRepresentationProxy gathers them from the render server;
-the client's own copy of the representation never renders and stays at "none"/0), and the image
-matches the built-in session's baseline.
+the client's own copy of the representation never renders and stays at "none"/0), the image
+matches the built-in session's baseline, and Blend Mode Slice follows the Slice Type plane moved
+from the client as ParaView's Volume does.
 
 Usage: pvpython test_clientserver.py PVSERVER
 The server is started under `timeout` and killed at the end, whatever happened.
@@ -126,6 +127,28 @@ try:
     ok.check(s2["BuilderUsed"] == "Grid" and s2["FrameCount"] > frames,
              "after a Grid frame: builder %r, frames %s > %s" % (s2["BuilderUsed"],
                                                                  s2["FrameCount"], frames))
+
+    # Blend Mode "Slice" with its Slice Type plane: the Volume's Plane proxy is shared with the
+    # server's Space Skipping Volume, so moving it moves our slice there as it moves the stock one.
+    disp.Builder = "Naive"
+    disp.BlendMode = "Slice"
+    c = [(d - 1) / 2.0 for d in ssptest.DIMS]
+    shots = []
+    for i, (origin, normal) in enumerate([([c[0] + 4.0, c[1] - 3.0, c[2] + 2.0], [0.3, 0.5, 0.81]),
+                                          ([c[0] - 9.0, c[1] + 5.0, c[2] - 4.0], [1.0, 0.0, 0.0])]):
+        disp.SliceFunction.Origin = origin
+        disp.SliceFunction.Normal = normal
+        ours = ssptest.read_png(ssptest.render_to(view, "clientserver_slice%d_ss.png" % i))
+        disp.SetRepresentationType("Volume")
+        stock = ssptest.read_png(ssptest.render_to(view, "clientserver_slice%d_stock.png" % i))
+        disp.SetRepresentationType("Space Skipping Volume")
+        p = ssptest.psnr(ours, stock)
+        ok.check(p >= 40.0 and ssptest.lit_fraction(ours) > 0.1,
+                 "slice plane %d on the server matches ParaView's Volume (PSNR %.2f >= 40 dB)"
+                 % (i, p))
+        shots.append(ours)
+    p = ssptest.psnr(shots[0], shots[1])
+    ok.check(p < 30.0, "moving the plane moves the server's slice (PSNR %.2f dB)" % p)
     Disconnect()
 except Exception as e:  # reported as a failed check; the server goes below
     ok.check(False, "client/server run raised %s: %s" % (type(e).__name__, e))

@@ -59,6 +59,9 @@ if not result:
 ok.check("error" not in result, "the GUI script succeeded %s" % result.get("error", ""))
 ok.check(result.get("representation") == "Space Skipping Volume",
          "the GUI offers and uses 'Space Skipping Volume' (%s)" % result.get("representation"))
+ok.check(result.get("groups_shown") == {"Volume Rendering": True, "Cropping Parameters": True},
+         "the GUI's panel lists the stock Volume Rendering and cropping groups for Space Skipping "
+         "Volume (%s)" % result.get("groups_shown"))
 stats = result.get("stats", {})
 ok.check(stats.get("FrameCount", 0) >= 1 and stats.get("BuildCount", 0) >= 1,
          "the mapper drew in the GUI (%s frames, %s builds)" % (stats.get("FrameCount"),

@@ -1,8 +1,9 @@
 // The slice blend mode (vtkVolumeMapper::SLICE_BLEND with the volume property's slice function, a
 // vtkPlane): the wavelet through vtkSpaceSkippingVolumeMapper on the CPU backend, regression image;
 // before it, in the same window, the PSNR against vtkGPUVolumeRayCastMapper for an oblique plane
-// (parallel and perspective, unshaded and shaded) and every builder's image against Naive's; a
-// missing or non-plane slice function gives one warning and the centre plane.
+// near the centre and for planes far from it (oblique, axis-aligned, and with the volume moved and
+// turned; parallel and perspective, unshaded and shaded) and every builder's image against Naive's;
+// a missing or non-plane slice function gives one warning and the centre plane.
 #include "vtkPlane.h"
 #include "vtkSphere.h"
 
@@ -51,13 +52,29 @@ int TestSpaceSkippingVolumeSlice(int argc, char* argv[])
   {
     const char* name;
     bool perspective, shade;
+    double origin[3], normal[3];
+    bool transformed; // the volume moved and turned: the plane stays in world coordinates
   };
-  const Case cases[] = { { "slice-perspective", true, false }, { "slice-parallel", false, false },
-    { "slice-shade-perspective", true, true } };
+  // The first plane passes near the data's centre; the others lie far from it (the centre
+  // fallback would be a different image), one of them axis-aligned, one with the volume moved.
+  const Case cases[] = {
+    { "slice-perspective", true, false, { 2.5, -1.5, 3.0 }, { 0.35, 0.55, 0.76 }, false },
+    { "slice-parallel", false, false, { 2.5, -1.5, 3.0 }, { 0.35, 0.55, 0.76 }, false },
+    { "slice-shade-perspective", true, true, { 2.5, -1.5, 3.0 }, { 0.35, 0.55, 0.76 }, false },
+    { "slice-offcentre-perspective", true, false, { -19.0, 11.5, -14.0 }, { 0.8, -0.3, 0.52 },
+      false },
+    { "slice-offcentre-x-parallel", false, false, { 17.25, 0.0, 0.0 }, { 1.0, 0.0, 0.0 }, false },
+    { "slice-offcentre-shade", true, true, { -19.0, 11.5, -14.0 }, { 0.8, -0.3, 0.52 }, false },
+    { "slice-offcentre-transformed", true, false, { -12.0, 8.0, -5.0 }, { 0.2, 0.9, 0.4 }, true },
+  };
   for (const Case& c : cases)
   {
     cam->SetParallelProjection(c.perspective ? 0 : 1);
     prop->SetShade(c.shade ? 1 : 0);
+    plane->SetOrigin(c.origin[0], c.origin[1], c.origin[2]);
+    plane->SetNormal(c.normal[0], c.normal[1], c.normal[2]);
+    volume->SetPosition(c.transformed ? 6.0 : 0.0, c.transformed ? -4.0 : 0.0, c.transformed ? 3.0 : 0.0);
+    volume->SetOrientation(0.0, c.transformed ? 10.0 : 0.0, c.transformed ? 25.0 : 0.0);
     auto a = sstest::RenderWith(win, volume, gpu);
     auto b = sstest::RenderWith(win, volume, t.Mapper);
     const double psnr = sstest::PrintComparison(c.name, a, b);
@@ -69,7 +86,25 @@ int TestSpaceSkippingVolumeSlice(int argc, char* argv[])
       std::cout << "  FAILED (threshold " << kMinPSNR << " dB)\n";
       ++failures;
     }
+    if (std::string(c.name).find("offcentre") != std::string::npos)
+    {
+      // Not the centre fallback: the plane through the data's centre, normal z, differs.
+      const double* bc = volume->GetCenter();
+      plane->SetOrigin(bc[0], bc[1], bc[2]);
+      plane->SetNormal(0.0, 0.0, 1.0);
+      auto centre = sstest::RenderWith(win, volume, t.Mapper);
+      const int d = sstest::MaxDiff(centre, b);
+      std::cout << "  vs the centre plane: max |diff| " << d << "/255\n";
+      if (d <= 30)
+      {
+        ++failures;
+      }
+    }
   }
+  volume->SetPosition(0.0, 0.0, 0.0);
+  volume->SetOrientation(0.0, 0.0, 0.0);
+  plane->SetOrigin(2.5, -1.5, 3.0);
+  plane->SetNormal(0.35, 0.55, 0.76);
   cam->SetParallelProjection(0);
 
   // Every builder equals Naive, unshaded and shaded.
