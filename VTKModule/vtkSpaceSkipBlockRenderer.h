@@ -10,11 +10,17 @@
 #include <algorithm>  // For std::max
 
 #include <functional> // For WarnFunction
+#include <memory>     // For the compositor
 #include <string>     // For the warning texts
 #include <vector>     // For the blocks
 
 class vtkDataObject;
 class vtkImageData;
+class vtkSpaceSkipCompositor;
+namespace spaceskip
+{
+struct Image;
+}
 class vtkRenderer;
 class vtkVolume;
 class vtkWindow;
@@ -22,15 +28,31 @@ class vtkWindow;
 /**
  * Draws every vtkImageData leaf of a composite data set with a mapper of its own (its own
  * engine and hierarchy), as vtkMultiBlockVolumeMapper does with its vtkSmartVolumeMapper per
- * block: the block mappers take the parent's settings, are sorted back to front by the distance
- * of their block's centre from the camera, and each blends its image over what the ones before
- * it drew. All blocks sample the transfer function over the same table range (the union of the
- * blocks' scalar ranges), so that adjacent blocks render as one image would. Other leaves
- * (rectilinear grids, unstructured data) are skipped with one warning.
+ * block, but as one image would be drawn:
+ * - **one sample lattice**: when the blocks lie on one voxel lattice (same spacing and
+ *   orientation, origins a whole number of voxels apart), each block is a piece of the image
+ *   they make together (spaceskip::VolumePiece, as an MPI rank's piece): its rays take the
+ *   whole image's samples and it draws only its own cells. Blocks that share a face of points
+ *   own the cells on their side; between blocks that do not (a gap of one cell), the lower
+ *   block owns the gap and gets the neighbours' voxels it reads (a padded copy); with shading
+ *   (or slice mode) one more layer for the gradients. Cells marked duplicate in a block's
+ *   ghost array are left to their owner. Blocks off one lattice (different spacing,
+ *   orientation, a fractional offset) or overlapping: one warning, each block sampled on its
+ *   own from its box entry (seams at the faces possible).
+ * - **float compositing**: every block renders into its float image; the images are blended
+ *   front to back per pixel in visibility order (a binary space partition of the owned boxes by
+ *   axis planes, exact for grid and k-d splits; else by the distance of the block centres), and
+ *   the sum reaches the window once, rounded once.
+ * All blocks sample the transfer function over the same table range (the union of the blocks'
+ * scalar ranges). Other leaves (rectilinear grids, unstructured data) are skipped with one
+ * warning.
  */
 class vtkSpaceSkipBlockRenderer
 {
 public:
+  vtkSpaceSkipBlockRenderer();
+  ~vtkSpaceSkipBlockRenderer();
+
   using WarnFunction = std::function<void(const std::string&)>;
 
   /// Whether `input` is a composite data set (this class draws it).
@@ -55,6 +77,8 @@ public:
   bool IsActive() const { return this->Active; }
   /// Forgets the blocks (the input is no longer composite).
   void Clear();
+  /// Whether the last Render() laid the blocks on one lattice (else each sampled on its own).
+  bool IsOnLattice() const { return this->Active && this->OnLattice; }
 
   ///@{
   /// Statistics over the block mappers of the last frame (see vtkSpaceSkippingVolumeMapper):
@@ -83,6 +107,8 @@ public:
   double Occupancy() const;
   /// A string statistic of the blocks: the one value when all agree, else the values joined by '/'.
   const char* Names(const char* (vtkSpaceSkippingVolumeMapper::*getter)());
+  /// How the blended blocks reached the window: "host", or "none" before the first draw.
+  const char* GetCompositePath() const;
   /// The smallest sample distance the blocks used.
   double MinSampleDistance() const;
   /// Frames drawn through the blocks (one per Render() that drew at least one block).
@@ -95,12 +121,36 @@ private:
   {
     vtkSmartPointer<vtkSpaceSkippingVolumeMapper> Mapper;
     vtkImageData* Image = nullptr;
-    double Depth = 0; // distance of the block's centre from the camera, for the sort
+    // On the shared lattice: the block in the first block's index space (the leaf's arrays, or
+    // a copy padded with its neighbours' voxels), and the cells it draws, [lo, hi) per axis.
+    vtkSmartPointer<vtkImageData> Piece;
+    int Owned[6] = { 0, 0, 0, 0, 0, 0 };
+    bool Padded = false; // Piece is a copy holding the drawn scalars alone
+    bool Draws = true;  // false: every cell is another block's (all ghost), or no scalars
+    double Depth = 0;   // distance of the block's centre from the camera (the sort off-lattice)
   };
+  // Lays the blocks on one lattice (Piece, Owned, WholeExtent); false with the reason when they
+  // are not on one.
+  bool PlanLattice(vtkSpaceSkippingVolumeMapper* parent, int layers, std::string& why);
+  // MPI (WholeExtent given): raises the summed colour by `bias` where a pixel's ray goes on
+  // into another rank's blocks behind this rank's (IceT's 8-bit blend truncates).
+  void AddFollowBias(vtkRenderer* ren, vtkVolume* vol, float bias);
+  // Front-to-back order of the drawn blocks (indices into Blocks).
+  std::vector<size_t> VisibilityOrder(vtkRenderer* ren, vtkVolume* vol) const;
+
   std::vector<Block> Blocks;
   bool Active = false;
   int Frames = 0;
   std::string NamesText;
+  // The lattice of the last plan and what it was made from (re-planned when that changes).
+  bool OnLattice = false;
+  int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  std::vector<unsigned long long> PlanKey;
+  std::string OffLatticeWhy;
+  vtkSmartPointer<vtkImageData> Lattice; // the lattice's geometry (origin, spacing, orientation)
+  std::unique_ptr<vtkSpaceSkipCompositor> Compositor; // draws the blended blocks
+  std::unique_ptr<spaceskip::Image> SumImage;          // the blended blocks, row 0 at the bottom
+  std::vector<float> Alpha;                            // SumImage's opacity, for the next block
 };
 
 #endif

@@ -60,9 +60,11 @@ int BackendFromEnvironment()
 
 // The input as a piece of the image of extent `whole` (an empty `whole`: its own extent), and
 // the cells it draws: those its vtkGhostType cell array does not mark as duplicates of another
-// piece's. Inactive (the serial path, untouched) when the input is the whole image without ghosts.
-spaceskip::VolumePiece PieceOf(
-  vtkImageData* input, const int whole[6], const std::function<void(const std::string&)>& warn)
+// piece's, or `owned` ([lo, hi) cells per axis, whole-extent indices) when given (a block of a
+// composite input: drawn exactly, composited in float). Inactive (the serial path, untouched)
+// when the input is the whole image without ghosts.
+spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
+  const std::function<void(const std::string&)>& warn)
 {
   spaceskip::VolumePiece piece;
   int ext[6], w[6];
@@ -89,7 +91,16 @@ spaceskip::VolumePiece PieceOf(
     own[2 * a + 1] = std::max(ext[2 * a + 1] - 1, ext[2 * a]);
   }
   bool ghosts = false;
-  if (vtkUnsignedCharArray* g = input->GetCellData()->GetGhostArray())
+  if (owned)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      own[2 * a] = owned[2 * a];
+      own[2 * a + 1] = owned[2 * a + 1] - 1;
+      ghosts = ghosts || own[2 * a] != ext[2 * a] || own[2 * a + 1] != std::max(ext[2 * a + 1] - 1, ext[2 * a]);
+    }
+  }
+  else if (vtkUnsignedCharArray* g = input->GetCellData()->GetGhostArray())
   {
     // The first and the last cell that is not a duplicate bound the owned cells (an image
     // piece's ghost cells are layers on its faces), as ParaView's volume representation does.
@@ -140,7 +151,7 @@ spaceskip::VolumePiece PieceOf(
   // blend truncates (README, Parallel). SPACESKIP_PIECE_BIAS (in 1/255) overrides, for
   // measurements.
   const char* bias = std::getenv("SPACESKIP_PIECE_BIAS");
-  piece.followBias = static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
+  piece.followBias = owned ? 0.f : static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
   return piece;
 }
 
@@ -195,6 +206,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   double MapperSeconds = 0;
 
   spaceskip::Image Image;
+  bool DeferredReady = false; // DeferDraw: Image holds this Render()'s frame
   const float* FrameDepth = nullptr; // this frame's depth (the compositor's buffer), or null
   // Last, so that it goes (with its CUDA-GL interop registration) before the engine.
   vtkSpaceSkipCompositor Compositor;
@@ -328,10 +340,12 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWind
 
   const int buildsBefore = engine.counters().builds;
   // GPUComposite: the CUDA backend leaves the image on the device for the interop copy.
-  engine.setImageOnDevice(this->Compositor.CanUseDeviceImage(this->Self->GPUComposite != 0) &&
+  engine.setImageOnDevice(!this->Self->DeferDraw &&
+    this->Compositor.CanUseDeviceImage(this->Self->GPUComposite != 0) &&
     engine.backendKind() == spaceskip::BackendKind::CUDA);
   t0 = std::chrono::steady_clock::now();
-  engine.render(camera, width, height, this->Image, this->FrameDepth);
+  engine.render(camera, width, height, this->Image, this->FrameDepth,
+    this->Self->DeferDraw ? this->Self->IncomingAlpha : nullptr);
   this->EngineSeconds = SecondsSince(t0);
   if (engine.counters().builds != buildsBefore)
   {
@@ -565,7 +579,7 @@ const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
 {
   if (this->Internals->Blocks.IsActive())
   {
-    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetCompositePathUsed);
+    return this->Internals->Blocks.GetCompositePath(); // the blended blocks' way to the window
   }
   return this->Internals->Compositor.GetCompositePath().c_str();
 }
@@ -658,6 +672,19 @@ int vtkSpaceSkippingVolumeMapper::GetFrameCount()
 }
 
 //------------------------------------------------------------------------------
+const float* vtkSpaceSkippingVolumeMapper::GetDeferredImage(int& width, int& height)
+{
+  vtkInternals& d = *this->Internals;
+  if (!d.DeferredReady || d.Image.rgba.empty())
+  {
+    return nullptr;
+  }
+  width = d.Image.width;
+  height = d.Image.height;
+  return &d.Image.rgba[0].x;
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
   this->Internals->Blocks.ReleaseGraphicsResources(win);
@@ -669,6 +696,7 @@ void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   vtkInternals& d = *this->Internals;
+  d.DeferredReady = false;
   vtkOpenGLRenderWindow* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
   vtkOpenGLCamera* cam = vtkOpenGLCamera::SafeDownCast(ren->GetActiveCamera());
   if (!renWin || !cam || !vol || !vol->GetProperty())
@@ -725,7 +753,8 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.RangeSeconds = d.Input.Update(engine, d.Warn);
     // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
     // composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
-    engine.setPiece(PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent, d.Warn));
+    engine.setPiece(PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent,
+      this->UseBlockOwned ? this->BlockOwned : nullptr, d.Warn));
     const double* range = this->UseTableRange ? this->TableRange
       : this->WholeScalarRange[0] <= this->WholeScalarRange[1] ? this->WholeScalarRange
                                                                : d.Input.GetScalarRange();
@@ -742,6 +771,14 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       return;
     }
     d.RenderFrame(renWin, vtkSpaceSkipCompositor::SceneHasDepth(ren), camera, x0, y0, width, height);
+    if (this->DeferDraw)
+    {
+      // A block of a composite input: the block renderer composites the float images.
+      d.DeferredReady = true;
+      d.MapperSeconds = SecondsSince(tRender);
+      d.LastProblem.clear();
+      return;
+    }
     if (!d.Composite(renWin, camera, width, height))
     {
       return;

@@ -265,9 +265,16 @@ public:
    * pieces give the serial image. WholeScalarRange: the whole image's range of the drawn scalars
    * (the transfer function's table spans it on every rank). Empty (the defaults): the input's
    * own extent and range.
+   * For composite input (image blocks, each rank holding some of them): WholeExtent and
+   * WholeOrigin describe the image the blocks of all ranks make, on the blocks' spacing and
+   * orientation, its point WholeExtent[0,2,4] at WholeOrigin (pass the same bits on every rank);
+   * the blocks then sample its lattice and their table spans WholeScalarRange. Empty: the image
+   * this process's blocks make, and their range.
    */
   vtkSetVector6Macro(WholeExtent, int);
   vtkGetVector6Macro(WholeExtent, int);
+  vtkSetVector3Macro(WholeOrigin, double);
+  vtkGetVector3Macro(WholeOrigin, double);
   vtkSetVector2Macro(WholeScalarRange, double);
   vtkGetVector2Macro(WholeScalarRange, double);
   ///@}
@@ -404,6 +411,7 @@ protected:
   int VectorComponent = 0;
   int BlendModeOverride = -1;
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  double WholeOrigin[3] = { 0, 0, 0 };
   double WholeScalarRange[2] = { 1, 0 };
 
   /// vtkImageData, and composite data sets of them (see GetBounds()).
@@ -436,6 +444,26 @@ private:
   }
   bool UseTableRange = false;
   double TableRange[2] = { 0, 1 };
+  // Composite input on one lattice (vtkSpaceSkipBlockRenderer): the block's own cells, [lo, hi)
+  // per axis in the index space of WholeExtent (instead of its ghost array), drawn exactly (no
+  // 8-bit rounding bias), and the frame kept as a float image for the block renderer to
+  // composite instead of drawn.
+  void SetBlockOwnedCells(const int owned[6])
+  {
+    this->UseBlockOwned = owned != nullptr;
+    for (int i = 0; owned && i < 6; ++i)
+    {
+      this->BlockOwned[i] = owned[i];
+    }
+  }
+  bool UseBlockOwned = false;
+  int BlockOwned[6] = { 0, 0, 0, 0, 0, 0 };
+  bool DeferDraw = false;
+  // With DeferDraw: the opacity each pixel's ray brings from the blocks in front (width x height
+  // of the renderer's tiled viewport, row 0 at the bottom), or null (spaceskip::Engine::render).
+  const float* IncomingAlpha = nullptr;
+  /// The last Render()'s premultiplied RGBA floats (row 0 at the bottom) when DeferDraw, else null.
+  const float* GetDeferredImage(int& width, int& height);
 };
 
 #endif

@@ -147,6 +147,11 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
     SS_CUDA_CHECK(cudaMemcpyAsync(d_depth_.get(), depth, pixels * sizeof(float), cudaMemcpyHostToDevice, stream));
     f.depth = d_depth_.get();
   }
+  if (f.alphaIn) {
+    d_alphaIn_.reserve(pixels);
+    SS_CUDA_CHECK(cudaMemcpyAsync(d_alphaIn_.get(), f.alphaIn, pixels * sizeof(float), cudaMemcpyHostToDevice, stream));
+    f.alphaIn = d_alphaIn_.get();
+  }
   unsigned* hostCounts = f.sampleCount;
   f.sampleCount = nullptr;
   if (hostCounts) {

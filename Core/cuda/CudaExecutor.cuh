@@ -45,6 +45,7 @@ class CudaExecutor {
   DeviceBuffer<vec4f> d_table_;
   TransferFunctionView table_{nullptr, 0, 0.f, 1.f};
   DeviceBuffer<float> d_depth_;
+  DeviceBuffer<float> d_alphaIn_;
   DeviceBuffer<unsigned> d_counts_;
   DeviceBuffer<vec4f> d_image_;
   DeviceBuffer<unsigned> d_tileCounter_;

@@ -63,8 +63,13 @@ class Engine {
   /// Brings ranges, classification and hierarchy up to date (render() calls it).
   void update();
   /// Renders `width` x `height` pixels; `depth` (optional) is the window depth of opaque
-  /// geometry per pixel, in [0,1], row 0 at the bottom.
-  void render(const Camera& cam, int width, int height, Image& out, const float* depth = nullptr);
+  /// geometry per pixel, in [0,1], row 0 at the bottom. `alphaIn` (optional, same layout): the
+  /// opacity each ray brings from pieces in front of this one when pieces of one volume are
+  /// composited front to back in float (composite and isosurface modes): the ray goes on from
+  /// it (early ray termination stops where the whole volume's ray would) and the image holds
+  /// this piece's share, to be added to what is in front.
+  void render(const Camera& cam, int width, int height, Image& out, const float* depth = nullptr,
+              const float* alphaIn = nullptr);
 
   /// CUDA: keep each frame's image in device memory (deviceImage()) instead of downloading it;
   /// render()'s Image then gets only its size. Returns false (and changes nothing) when the

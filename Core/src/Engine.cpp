@@ -807,7 +807,8 @@ void fillComponents(Impl& d, FrameView& f) {
 }
 }  // namespace
 
-void Engine::render(const Camera& cam, int width, int height, Image& out, const float* depth) {
+void Engine::render(const Camera& cam, int width, int height, Image& out, const float* depth,
+                    const float* alphaIn) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("render size must be positive");
   update();
   Impl& d = *impl_;
@@ -836,6 +837,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     for (int c = 0; c < 4; ++c) f.worldToIndex[r * 4 + c] = float(w2i.m[c * 4 + r]);
   f.width = width;
   f.height = height;
+  f.alphaIn = alphaIn;
   vec3i cd = piece ? d.latticeShape().cellDims() : d.volume.cellDims();
   f.boxHi = vec3f{float(cd.x), float(cd.y), float(cd.z)};
   if (piece) {

@@ -8,6 +8,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkMath.h"
+#include "vtkMatrix3x3.h"
 #include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -20,7 +21,123 @@
 #include "vtkSpaceSkippingVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 
+#include <algorithm>
+#include <cmath>
+
 vtkStandardNewMacro(vtkSpaceSkipVolumeRepresentation);
+
+namespace
+{
+// The range of the drawn array over all ranks, per component and then of the magnitude
+// ({lo0, hi0, lo1, hi1, ..., loMag, hiMag}), from each rank's `arrays` (maybe none). Collective:
+// every rank calls it. Empty when no rank has the array.
+std::vector<double> GatherWholeRanges(
+  vtkMultiProcessController* controller, const std::vector<vtkDataArray*>& arrays)
+{
+  int local = 0, k = 0;
+  for (vtkDataArray* a : arrays)
+  {
+    local = std::max(local, a->GetNumberOfComponents());
+  }
+  controller->AllReduce(&local, &k, 1, vtkCommunicator::MAX_OP);
+  if (k < 1)
+  {
+    return {};
+  }
+  std::vector<double> lo(static_cast<size_t>(k + 1), VTK_DOUBLE_MAX);
+  std::vector<double> hi(static_cast<size_t>(k + 1), VTK_DOUBLE_MIN);
+  for (vtkDataArray* array : arrays)
+  {
+    if (array->GetNumberOfComponents() != k)
+    {
+      continue;
+    }
+    // As the mapper reads them: native single-component types as they are, the rest as float.
+    const int t = array->GetDataType();
+    const bool native = k == 1 &&
+      (t == VTK_UNSIGNED_CHAR || t == VTK_CHAR || t == VTK_SIGNED_CHAR || t == VTK_UNSIGNED_SHORT ||
+        t == VTK_SHORT || t == VTK_FLOAT || t == VTK_DOUBLE);
+    for (int c = 0; c <= k; ++c)
+    {
+      double r[2];
+      array->GetFiniteRange(r, c == k ? -1 : c);
+      if (r[0] <= r[1])
+      {
+        lo[c] = std::min(lo[c], native ? r[0] : static_cast<double>(static_cast<float>(r[0])));
+        hi[c] = std::max(hi[c], native ? r[1] : static_cast<double>(static_cast<float>(r[1])));
+      }
+    }
+  }
+  std::vector<double> wlo(lo.size()), whi(hi.size());
+  controller->AllReduce(lo.data(), wlo.data(), static_cast<vtkIdType>(lo.size()), vtkCommunicator::MIN_OP);
+  controller->AllReduce(hi.data(), whi.data(), static_cast<vtkIdType>(hi.size()), vtkCommunicator::MAX_OP);
+  std::vector<double> ranges(2 * lo.size());
+  for (size_t c = 0; c < lo.size(); ++c)
+  {
+    ranges[2 * c] = wlo[c];
+    ranges[2 * c + 1] = whi[c];
+  }
+  return ranges;
+}
+
+// The image all ranks' image partitions make, when they lie on one axis-aligned lattice of one
+// spacing: the world position of its first point (the same bits on every rank) and its extent
+// counted from there. Collective: every rank calls it (with its partitions, maybe none). False
+// (every rank alike) when there is no image, the spacings differ or an image is rotated: each
+// rank then lays its blocks on a lattice of its own.
+bool GatherLattice(vtkMultiProcessController* controller, const std::vector<vtkImageData*>& images,
+  double origin[3], int extent[6])
+{
+  // lo[3], -hi[3], spacing[3], -spacing[3], rotated: reduced with MIN.
+  double local[13], global[13];
+  for (int a = 0; a < 3; ++a)
+  {
+    local[a] = local[3 + a] = local[6 + a] = local[9 + a] = VTK_DOUBLE_MAX;
+  }
+  local[12] = 0;
+  for (vtkImageData* image : images)
+  {
+    const double* s = image->GetSpacing();
+    const double* o = image->GetOrigin();
+    const int* e = image->GetExtent();
+    vtkMatrix3x3* d = image->GetDirectionMatrix();
+    for (int r = 0; r < 3; ++r)
+    {
+      for (int c = 0; c < 3; ++c)
+      {
+        if (d->GetElement(r, c) != (r == c ? 1.0 : 0.0))
+        {
+          local[12] = -1;
+        }
+      }
+    }
+    for (int a = 0; a < 3; ++a)
+    {
+      local[a] = std::min(local[a], o[a] + e[2 * a] * s[a]);
+      local[3 + a] = std::min(local[3 + a], -(o[a] + e[2 * a + 1] * s[a]));
+      local[6 + a] = std::min(local[6 + a], s[a]);
+      local[9 + a] = std::min(local[9 + a], -s[a]);
+    }
+  }
+  controller->AllReduce(local, global, 13, vtkCommunicator::MIN_OP);
+  if (global[12] < 0 || global[0] == VTK_DOUBLE_MAX)
+  {
+    return false;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    const double s = global[6 + a];
+    if (!(s > 0) || std::abs(-global[9 + a] - s) > 1e-6 * s)
+    {
+      return false;
+    }
+    origin[a] = global[a];
+    extent[2 * a] = 0;
+    extent[2 * a + 1] = static_cast<int>(std::lround((-global[3 + a] - global[a]) / s));
+  }
+  return true;
+}
+} // namespace
 
 //------------------------------------------------------------------------------
 vtkSpaceSkipVolumeRepresentation::vtkSpaceSkipVolumeRepresentation()
@@ -129,42 +246,12 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   {
     return ok;
   }
-  vtkDataArray* array = input ? input->GetPointData()->GetArray(name) : nullptr;
-  int local = array ? array->GetNumberOfComponents() : 0, k = 0;
-  controller->AllReduce(&local, &k, 1, vtkCommunicator::MAX_OP);
-  if (k < 1)
+  std::vector<vtkDataArray*> arrays;
+  if (vtkDataArray* array = input ? input->GetPointData()->GetArray(name) : nullptr)
   {
-    return ok;
+    arrays.push_back(array);
   }
-  std::vector<double> lo(static_cast<size_t>(k + 1), VTK_DOUBLE_MAX);
-  std::vector<double> hi(static_cast<size_t>(k + 1), VTK_DOUBLE_MIN);
-  if (array && local == k)
-  {
-    // As the mapper reads them: native single-component types as they are, the rest as float.
-    const int t = array->GetDataType();
-    const bool native = k == 1 &&
-      (t == VTK_UNSIGNED_CHAR || t == VTK_CHAR || t == VTK_SIGNED_CHAR || t == VTK_UNSIGNED_SHORT ||
-        t == VTK_SHORT || t == VTK_FLOAT || t == VTK_DOUBLE);
-    for (int c = 0; c <= k; ++c)
-    {
-      double r[2];
-      array->GetFiniteRange(r, c == k ? -1 : c);
-      if (r[0] <= r[1])
-      {
-        lo[c] = native ? r[0] : static_cast<double>(static_cast<float>(r[0]));
-        hi[c] = native ? r[1] : static_cast<double>(static_cast<float>(r[1]));
-      }
-    }
-  }
-  std::vector<double> wlo(lo.size()), whi(hi.size());
-  controller->AllReduce(lo.data(), wlo.data(), static_cast<vtkIdType>(lo.size()), vtkCommunicator::MIN_OP);
-  controller->AllReduce(hi.data(), whi.data(), static_cast<vtkIdType>(hi.size()), vtkCommunicator::MAX_OP);
-  this->WholeRanges.resize(2 * lo.size());
-  for (size_t c = 0; c < lo.size(); ++c)
-  {
-    this->WholeRanges[2 * c] = wlo[c];
-    this->WholeRanges[2 * c + 1] = whi[c];
-  }
+  this->WholeRanges = GatherWholeRanges(controller, arrays);
   return ok;
 }
 
@@ -195,6 +282,44 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
     // Other types stay in: the mapper says once that it skips them.
     cache->SetPartition(n++, partition);
   }
+  // Under MPI the blocks of all ranks make one image: its lattice (every rank's blocks sample
+  // it) and the range of the drawn array (every rank's table spans it). Collective.
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  this->WholeRanges.clear();
+  double wholeOrigin[3] = { 0, 0, 0 };
+  int wholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    std::vector<vtkImageData*> images;
+    std::vector<vtkDataArray*> arrays;
+    vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
+    const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
+      ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
+      : nullptr;
+    for (unsigned int i = 0; i < cache->GetNumberOfPartitions(); ++i)
+    {
+      auto* image = vtkImageData::SafeDownCast(cache->GetPartition(i));
+      if (image && image->GetNumberOfPoints() > 0)
+      {
+        images.push_back(image);
+        if (vtkDataArray* a = name && name[0] ? image->GetPointData()->GetArray(name) : nullptr)
+        {
+          arrays.push_back(a);
+        }
+      }
+    }
+    if (!GatherLattice(controller, images, wholeOrigin, wholeExtent))
+    {
+      wholeExtent[1] = -1;
+    }
+    if (name && name[0])
+    {
+      this->WholeRanges = GatherWholeRanges(controller, arrays);
+    }
+  }
+  this->SpaceSkipMapper->SetWholeOrigin(wholeOrigin);
+  this->SpaceSkipMapper->SetWholeExtent(wholeExtent);
+
   cache->GetBounds(this->DataBounds);
   if (vtkMath::AreBoundsInitialized(this->DataBounds))
   {

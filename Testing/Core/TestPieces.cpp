@@ -270,3 +270,85 @@ TEST(Pieces, FollowBiasRaisesOnlyPixelsWithAPieceBehind) {
   EXPECT_EQ(compareImages(b0, b1).maxAbs, 0.f);  // nothing behind the back piece
   EXPECT_NEAR(compareImages(f0, f1).maxAbs, 0.5f / 255.f, 1e-6f);
 }
+
+namespace {
+/// Two pieces (x split at cell 17) rendered front to back, the back one given the front one's
+/// opacity as alphaIn (pieces composited in float in one process: vtkSpaceSkipBlockRenderer).
+/// Returns front + back (the back image is already weighted), and in `plainOver` the two blended
+/// with "over" without alphaIn.
+Image carriedPieces(const Case& c, BackendKind backend, Image* plainOver) {
+  const Volume v = whole();
+  const int pts[3] = {int(v.dims.x), int(v.dims.y), int(v.dims.z)};
+  Part all{{0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}, {0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}};
+  Part a, b;
+  split(all, 0, 17, 1, pts[0], a, b);
+  VolumePiece pa, pb;
+  const Volume va = cut(v, a, pa), vb = cut(v, b, pb);
+  const bool aFront = eyeBelow(v, 35, 25, c.persp, 0, 17);
+  const Image front = renderPiece(aFront ? va : vb, aFront ? &pa : &pb, c, 35, 25, v, backend);
+  std::vector<float> alpha(front.rgba.size());
+  for (size_t i = 0; i < alpha.size(); ++i) alpha[i] = front.rgba[i].w;
+  Engine e(backend);
+  test::load(e, aFront ? vb : va, TransferFunction::preset("ramp", 0, 255), test::builder(c.builder));
+  e.setRenderParams(c.rp);
+  e.setPiece(aFront ? pb : pa);
+  Image back;
+  e.render(test::orbit(v, 35, 25, c.persp), 64, 64, back, nullptr, alpha.data());
+  Image sum = front;
+  for (size_t i = 0; i < sum.rgba.size(); ++i) {
+    sum.rgba[i].x += back.rgba[i].x;
+    sum.rgba[i].y += back.rgba[i].y;
+    sum.rgba[i].z += back.rgba[i].z;
+    sum.rgba[i].w += back.rgba[i].w;
+  }
+  if (plainOver) {
+    *plainOver = front;
+    over(*plainOver, renderPiece(aFront ? vb : va, aFront ? &pb : &pa, c, 35, 25, v, backend));
+  }
+  return sum;
+}
+
+/// Early ray termination at a low threshold, so that many rays stop in the back piece.
+std::vector<Case> ertCases() {
+  std::vector<Case> cs;
+  for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::KdTreeCPU})
+    for (bool persp : {false, true}) {
+      RenderParams rp;
+      rp.firstSampleOffset = 1;
+      rp.ertThreshold = 0.3;
+      cs.push_back({k, persp, rp});
+    }
+  RenderParams shade;
+  shade.shade = true;
+  shade.ertThreshold = 0.3;
+  cs.push_back({BuilderKind::Grid, true, shade});
+  return cs;
+}
+}  // namespace
+
+// alphaIn: the back piece's rays go on from the front piece's opacity, so early ray termination
+// stops where the whole volume's ray stops and front + back is the whole image; blended with
+// "over" without it, the pieces differ where a ray terminates in the back piece.
+TEST(Pieces, AlphaInCarriesEarlyRayTerminationAcrossPieces) {
+  const Volume v = whole();
+  for (const Case& c : ertCases()) {
+    const Image serial = renderPiece(v, nullptr, c, 35, 25, v);
+    ASSERT_GT(test::coverage(serial), 0.01);
+    Image plain;
+    const Image carried = carriedPieces(c, BackendKind::CPU, &plain);
+    EXPECT_LE(compareImages(serial, carried).maxAbs, 1e-3f) << builderName(c.builder) << " persp " << c.persp;
+    EXPECT_GT(compareImages(serial, plain).maxAbs, 0.01f) << builderName(c.builder) << " persp " << c.persp;
+  }
+}
+
+TEST(Pieces, CudaAlphaInCarriesEarlyRayTerminationAcrossPieces) {
+  std::string why;
+  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  const Volume v = whole();
+  for (const Case& c : ertCases()) {
+    if (c.builder == BuilderKind::KdTreeCPU) continue;
+    const Image serial = renderPiece(v, nullptr, c, 35, 25, v);
+    const Image carried = carriedPieces(c, BackendKind::CUDA, nullptr);
+    EXPECT_LE(compareImages(serial, carried).maxAbs, 1.f / 255.f) << builderName(c.builder);
+  }
+}

@@ -4,7 +4,9 @@ Usage: pvbatch parallel_scene.py OUT.png [builder] [scene]
            Volume representation on the same scene (for comparisons)
   scene:   "mni" (default: the bundled MNI152 T1 head, 99x117x95, 2 mm voxels, an origin off
            zero, oblique camera, a translucent transfer function that shows the tissue along the
-           planes where the pieces meet) or "shell" (the plugin tests' 64^3 reference scene)
+           planes where the pieces meet), "shell" (the plugin tests' 64^3 reference scene) or
+           "vtpd=PATH" (the MNI scene read from a partitioned data set file: its partitions go
+           to the ranks as they are)
 Prints how the data was distributed (the ranks that hold a piece of the volume)."""
 import os
 import sys
@@ -26,12 +28,15 @@ stock = builder == "stock" or bool(os.environ.get("SPACESKIP_STOCK_VOLUME"))
 if scene == "shell":
     reader, view, disp = ssptest.make_scene(builder="Grid" if stock else builder, backend="CPU")
 else:
-    reader = ImageReader(FileNames=[os.path.join(ssptest.env("SPACESKIP_DATA"),
-                                                 "mni152_t1_99x117x95_uint8.raw")])
-    reader.DataScalarType = "unsigned char"
-    reader.DataExtent = [0, 98, 0, 116, 0, 94]
-    reader.DataSpacing = [2.0, 2.0, 2.0]
-    reader.DataOrigin = [-98.0, -134.0, -72.0]
+    if scene.startswith("vtpd="):
+        reader = XMLPartitionedDatasetReader(FileName=[scene[5:]])
+    else:
+        reader = ImageReader(FileNames=[os.path.join(ssptest.env("SPACESKIP_DATA"),
+                                                     "mni152_t1_99x117x95_uint8.raw")])
+        reader.DataScalarType = "unsigned char"
+        reader.DataExtent = [0, 98, 0, 116, 0, 94]
+        reader.DataSpacing = [2.0, 2.0, 2.0]
+        reader.DataOrigin = [-98.0, -134.0, -72.0]
     view = ssptest.make_view((360, 360))
     disp = Show(reader, view)
     disp.SetRepresentationType("Space Skipping Volume")

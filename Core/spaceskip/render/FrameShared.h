@@ -74,6 +74,10 @@ struct FrameView {
   float firstSample;       ///< first sample at the box entry + firstSample * dt (see RenderParams)
   uint32_t jitterSeed;
   const float* depth;      ///< optional window depth in [0,1] per pixel (opaque geometry)
+  /// Optional opacity each pixel's ray brings from the pieces in front of this one (pieces
+  /// composited front to back in one process; composite and isosurface modes): the march goes
+  /// on from it and the pixel returns the piece's own share (Engine::render).
+  const float* alphaIn;
   TraversalKind traversal;
   GridView grid;           ///< Grid and Hybrid
   TreeView tree;           ///< Tree and Hybrid

@@ -403,8 +403,14 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
   if (!(tEnter < tExit)) return vec4f{0, 0, 0, 0};
   float ownA = 0.f, ownB = 0.f;  // a piece of the volume (MPI): where this ray is its own
   if (f.lattice.active && !ownedInterval(f, r, inv, ownA, ownB)) return vec4f{0, 0, 0, 0};
+  // The opacity the ray brings from pieces in front (FrameView::alphaIn): early ray termination
+  // then stops where the whole volume's ray stops.
+  const float aIn = f.alphaIn && (Plain || f.blend == BlendMode::Composite || f.blend == BlendMode::Isosurface)
+                        ? f.alphaIn[int64_t(py) * f.width + px]
+                        : 0.f;
+  if (aIn >= f.ertThreshold) return vec4f{0, 0, 0, 0};
 
-  IntervalMarcher<Sampler, Plain> m{&f, &s, rl, tEnter, 0, vec4f{0, 0, 0, 0}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
+  IntervalMarcher<Sampler, Plain> m{&f, &s, rl, tEnter, 0, vec4f{0, 0, 0, aIn}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
                              0.f, 0u, -1};
   if (!Plain && f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
     const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
@@ -487,7 +493,9 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
     }
   }
   if (f.sampleCount) f.sampleCount[int64_t(py) * f.width + px] = m.samples;
-  return f.lattice.active ? pieceResult(f, m.result(), ownB, tExit) : m.result();
+  vec4f res = m.result();
+  res.w -= aIn;  // the piece's own share (premultiplied colour was weighted from aIn on)
+  return f.lattice.active ? pieceResult(f, res, ownB, tExit) : res;
 }
 
 }  // namespace spaceskip

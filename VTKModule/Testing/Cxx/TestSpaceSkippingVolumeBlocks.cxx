@@ -1,7 +1,11 @@
 // Composite input: a vtkMultiBlockDataSet / vtkPartitionedDataSet / vtkPartitionedDataSetCollection
-// of adjacent image blocks cut from one wavelet renders as the single image does (each block with
-// its own engine and hierarchy, composited back to front), and like vtkMultiBlockVolumeMapper on
-// the same blocks; a rectilinear block is skipped with one warning; the statistics add up.
+// of adjacent image blocks cut from one wavelet renders as the single image does, within 1/255
+// (each block with its own engine and hierarchy on the single image's sample lattice, composited
+// front to back in float): blocks sharing their face points, blocks with a gap of one cell
+// between them, blocks with ghost layers, with and without shading, three cameras; like
+// vtkMultiBlockVolumeMapper on the same blocks; blocks off one lattice (another spacing) or
+// overlapping are drawn each on its own with one warning; a rectilinear block is skipped with
+// one warning; the statistics add up.
 #include "SpaceSkipTestHelpers.h"
 
 #include "vtkExtractVOI.h"
@@ -11,15 +15,17 @@
 #include "vtkPartitionedDataSetCollection.h"
 #include "vtkRectilinearGrid.h"
 #include "vtkSmartVolumeMapper.h"
+#include "vtkStructuredData.h"
+#include "vtkUnsignedCharArray.h"
 
 namespace
 {
-// Blocks vs the single image, same mapper settings. Each block starts its samples at its own box
-// entry (as each rank does in parallel), so samples near the block faces sit elsewhere than in
-// the single image: measured 2026-11-24 on Mesa llvmpipe (Xvfb), 47.7-65.1 dB, max 5-8/255;
-// against vtkMultiBlockVolumeMapper 49.0-55.9 dB (ctest -R Blocks -V).
-constexpr double kMinPSNRSingle = 45.0;
-constexpr int kMaxDiffSingle = 10; // measured 5-8/255 (47.7-65.1 dB)
+// Blocks vs the single image, same mapper settings: the same samples (one lattice), composited
+// in float and rounded once; float sums in another order leave rare 1/255 roundings (measured
+// 2026-11-24 on Mesa llvmpipe (Xvfb): max 0-1/255, >= 98 dB; before the shared lattice, each
+// block sampling from its own box entry: 47.7-65.1 dB, max 5-8/255).
+constexpr double kMinPSNRSingle = 80.0;
+constexpr int kMaxDiffSingle = 1;
 // Against vtkMultiBlockVolumeMapper (vtkGPUVolumeRayCastMapper per block) at the same sample
 // distance: the single-image comparison of TestSpaceSkippingVolumeVsGPU keeps 45 dB too.
 constexpr double kMinPSNRMultiBlock = 40.0;
@@ -32,6 +38,28 @@ vtkSmartPointer<vtkImageData> Cut(vtkImageData* image, int x0, int x1, int y0, i
   voi->Update();
   auto out = vtkSmartPointer<vtkImageData>::New();
   out->ShallowCopy(voi->GetOutput());
+  return out;
+}
+
+// A block of the points [.., z0, z1] that reaches `ghostLo` / `ghostHi` cell layers into its
+// neighbours in z, those cells marked DUPLICATECELL (as a partitioned reader with ghost levels
+// delivers them).
+vtkSmartPointer<vtkImageData> CutWithGhosts(vtkImageData* image, int z0, int z1, int ghostLo, int ghostHi)
+{
+  auto out = Cut(image, -32, 31, -32, 31, z0 - ghostLo, z1 + ghostHi);
+  out->AllocateCellGhostArray();
+  vtkUnsignedCharArray* g = out->GetCellGhostArray();
+  int ext[6];
+  out->GetExtent(ext);
+  for (vtkIdType c = 0; c < out->GetNumberOfCells(); ++c)
+  {
+    int ijk[3];
+    vtkStructuredData::ComputeCellStructuredCoordsForExtent(c, ext, ijk);
+    if (ijk[2] < z0 || ijk[2] >= z1)
+    {
+      g->SetValue(c, g->GetValue(c) | vtkDataSetAttributes::DUPLICATECELL);
+    }
+  }
   return out;
 }
 }
@@ -62,6 +90,19 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
   collection->SetPartition(0, 0, Cut(image, -32, 31, -32, 31, -32, -10));
   collection->SetPartition(0, 1, Cut(image, -32, 31, -32, 31, -10, 10));
   collection->SetPartition(1, 0, Cut(image, -32, 31, -32, 31, 10, 31));
+
+  // Blocks that do not share their face points: a gap of one cell between neighbours (2 x 2 in
+  // x and y, so a corner cell reads four blocks).
+  vtkNew<vtkPartitionedDataSet> gaps;
+  gaps->SetPartition(0, Cut(image, -32, -1, -32, -1, -32, 31));
+  gaps->SetPartition(1, Cut(image, 0, 31, -32, -1, -32, 31));
+  gaps->SetPartition(2, Cut(image, -32, -1, 0, 31, -32, 31));
+  gaps->SetPartition(3, Cut(image, 0, 31, 0, 31, -32, 31));
+  // Slabs in z with ghost layers (1 and 2 cells) reaching into their neighbours.
+  vtkNew<vtkPartitionedDataSet> ghosts;
+  ghosts->SetPartition(0, CutWithGhosts(image, -32, -5, 0, 2));
+  ghosts->SetPartition(1, CutWithGhosts(image, -5, 12, 1, 1));
+  ghosts->SetPartition(2, CutWithGhosts(image, 12, 31, 2, 0));
 
   // The two blocks plus a rectilinear grid and a nested multiblock holding nothing drawable.
   vtkNew<vtkRectilinearGrid> grid;
@@ -94,7 +135,8 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
     int blocks;
   };
   const Case cases[] = { { "multiblock-2", two, 2 }, { "partitioned-4", four, 4 },
-    { "collection-3", collection, 3 }, { "mixed-2+grid", mixed, 2 } };
+    { "collection-3", collection, 3 }, { "gaps-4", gaps, 4 }, { "ghosts-3", ghosts, 3 },
+    { "mixed-2+grid", mixed, 2 } };
   struct View
   {
     const char* name;
@@ -102,12 +144,14 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
     double azimuth, elevation;
   };
   const View views[] = { { "perspective", false, 35, 25 }, { "parallel", true, 100, -30 },
-    { "front-x", false, 50, 0 } };
+    { "front-x", false, 50, 0 }, { "shaded", false, 20, 15 } };
 
   bool ok = true;
   bool mixedSeen = false; // the rectilinear block is warned about once per mapper
   for (const View& v : views)
   {
+    // Shading reads one voxel past a block's cells (its gradients): padded copies.
+    scene.Property->SetShade(std::string(v.name) == "shaded" ? 1 : 0);
     scene.Camera()->SetParallelProjection(v.parallel ? 1 : 0);
     scene.Camera()->Azimuth(v.azimuth);
     scene.Camera()->Elevation(v.elevation);
@@ -137,12 +181,14 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
       // Every block got its own hierarchy; the statistics add them up.
       if (blocks->GetFrameCount() != framesBefore + 1 || blocks->GetNodeCount() <= 0 ||
         std::string(blocks->GetBuilderUsed()) != "KdTreeCPU" || blocks->GetBuildCount() < c.blocks ||
-        !(blocks->GetOccupancy() > 0 && blocks->GetOccupancy() < 1))
+        !(blocks->GetOccupancy() > 0 && blocks->GetOccupancy() < 1) ||
+        std::string(blocks->GetCompositePathUsed()) != "host")
       {
         std::cerr << name << ": statistics: frames " << blocks->GetFrameCount() << " (before "
                   << framesBefore << "), nodes " << blocks->GetNodeCount() << ", builder "
                   << blocks->GetBuilderUsed() << ", builds " << blocks->GetBuildCount()
-                  << ", occupancy " << blocks->GetOccupancy() << "\n";
+                  << ", occupancy " << blocks->GetOccupancy() << ", composite path "
+                  << blocks->GetCompositePathUsed() << "\n";
         ok = false;
       }
       // The bounds are the union of the blocks' (the camera and clipping range rely on them).
@@ -157,6 +203,9 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
         }
       }
       const bool isMixed = c.input == mixed.GetPointer();
+      // vtkMultiBlockVolumeMapper (VTK 9.2) draws each block whole: the cells between blocks
+      // with a gap and the ghost cells are not drawn as one image would: printed, not checked.
+      const bool vtkDrawsIt = c.input != gaps.GetPointer() && c.input != ghosts.GetPointer();
       const bool warns = isMixed && !mixedSeen;
       mixedSeen = mixedSeen || isMixed;
       if (messages->ErrorCount != 0 || messages->WarningCount != (warns ? 1 : 0) ||
@@ -174,7 +223,7 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
         const double psnrRef = sstest::PrintComparison(
           name, theirs, ours, "vtkMultiBlockVolumeMapper", "multiblock");
         std::cout << "\n";
-        if (!(psnrRef >= kMinPSNRMultiBlock))
+        if (vtkDrawsIt && !(psnrRef >= kMinPSNRMultiBlock))
         {
           std::cerr << name << ": PSNR against vtkMultiBlockVolumeMapper " << psnrRef << " < "
                     << kMinPSNRMultiBlock << " dB\n";
@@ -184,6 +233,65 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
       }
     }
   }
+  // Later frames of padded blocks (shading, gaps) build nothing again: the copies are made once.
+  blocks->SetInputDataObject(gaps);
+  scene.Window->Render();
+  const int builds = blocks->GetBuildCount();
+  scene.Camera()->Azimuth(10);
+  scene.Window->Render();
+  scene.Window->Render();
+  if (blocks->GetBuildCount() != builds)
+  {
+    std::cerr << "padded blocks rebuilt on a camera change: builds " << builds << " -> "
+              << blocks->GetBuildCount() << "\n";
+    ok = false;
+  }
+  scene.Property->SetShade(0);
+
+  // Blocks off one lattice: one warning naming it, each block drawn on its own (the image is
+  // another volume here: only that it draws). Overlapping blocks without ghost arrays likewise.
+  auto wide = Cut(image, 0, 31, -32, 31, -32, 31);
+  wide->SetSpacing(1.5, 1, 1);
+  vtkNew<vtkMultiBlockDataSet> offLattice;
+  offLattice->SetBlock(0, left);
+  offLattice->SetBlock(1, wide);
+  vtkNew<vtkMultiBlockDataSet> overlapping;
+  overlapping->SetBlock(0, Cut(image, -32, 4, -32, 31, -32, 31));
+  overlapping->SetBlock(1, right);
+  struct OffCase
+  {
+    const char* name;
+    vtkDataObject* input;
+    const char* reason;
+  };
+  for (const OffCase& c : { OffCase{ "different spacing", offLattice, "different spacing" },
+         OffCase{ "overlapping", overlapping, "overlap" } })
+  {
+    vtkNew<vtkSpaceSkippingVolumeMapper> fresh; // warnings are said once per mapper
+    fresh->SetBuilder(vtkSpaceSkippingVolumeMapper::KdTreeCPU);
+    fresh->SetSampleDistance(sampleDistance);
+    vtkNew<sstest::MessageCollector> said;
+    sstest::Observe(fresh, said);
+    fresh->SetInputDataObject(c.input);
+    auto img = sstest::RenderWith(scene.Window, scene.Volume, fresh);
+    const double lit =
+      static_cast<double>(sstest::CountNonBackground(img, sstest::kBlack)) / (256.0 * 256.0);
+    std::cout << c.name << ": warnings [" << said->Warnings << "], " << 100 * lit << "% lit\n";
+    if (said->ErrorCount != 0 || said->WarningCount != 1 ||
+      said->Warnings.find("not drawn on one sample lattice") == std::string::npos ||
+      said->Warnings.find(c.reason) == std::string::npos || !(lit > 0.1) ||
+      fresh->GetFrameCount() != 1)
+    {
+      std::cerr << c.name << ": expected one warning naming '" << c.reason
+                << "' and an image, got errors [" << said->Errors << "] warnings ["
+                << said->Warnings << "], " << lit << " lit, frames " << fresh->GetFrameCount()
+                << "\n";
+      ok = false;
+    }
+  }
+
+  scene.Volume->SetMapper(blocks);
+
   // The mixed case warned once, not once per frame: the next frames of it add nothing.
   messages->Clear();
   blocks->SetInputDataObject(mixed);
