@@ -1,5 +1,6 @@
 // Sparse residency on the device: needed pool bricks, LRU bookkeeping (host) and uploads.
 #include "DevicePool.cuh"
+#include "spaceskip/PoolPlan.h"
 
 #include <algorithm>
 #include <chrono>
@@ -63,41 +64,27 @@ void DevicePool::update(const PoolNeedRule& r, const uint8_t* d_occ, uint64_t ge
   SS_CUDA_CHECK_LAUNCH(neededKernel);
   SS_CUDA_CHECK(cudaMemcpyAsync(needed_.data(), d_needed_.get(), size_t(n), cudaMemcpyDeviceToHost, stream));
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-  const BrickResidency::Demand demand = res_.demand(needed_.data());
-  stats_.needed = demand.needed;
-  if (demand.needed > maxCapacity_) {
-    valid_ = false;
-    throw BackendError(poolOverflowMessage(vol_, layout_, demand.needed, stats_.budgetBytes));
-  }
   const int64_t slotBytes = layout_.slotVoxels() * int64_t(voxelSize(vol_.type));
-  const int64_t cap = grownCapacity(demand, res_.capacity(), maxCapacity_);
-  if (cap > res_.capacity()) {
-    // A larger pool keeps the resident slots (one device copy). When the device cannot hold
-    // both, the pool stays as it is and evicts instead, if the needed bricks fit it.
-    DeviceBuffer<unsigned char> bigger;
-    bool grown = false;
-    try {
-      bigger.reserve(size_t(cap * slotBytes));
-      grown = true;
-    } catch (const BackendError&) {
-      if (demand.needed > res_.capacity()) throw;
-    }
-    if (grown) {
-      if (res_.capacity() > 0)
-        SS_CUDA_CHECK(cudaMemcpyAsync(bigger.get(), d_pool_.get(), size_t(res_.capacity() * slotBytes),
-                                      cudaMemcpyDeviceToDevice, stream));
-      SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-      d_pool_.swap(bigger);
-      res_.grow(cap);
-    }
-  }
-  stats_.capacity = res_.capacity();
-  stats_.poolBytes = res_.capacity() * slotBytes;
-  const BrickResidency::Plan plan = res_.update(needed_.data());
-  if (!plan.fits) {
-    valid_ = false;
-    throw BackendError(poolOverflowMessage(vol_, layout_, plan.needed, stats_.budgetBytes));
-  }
+  valid_ = false;  // until the uploads are done
+  const BrickResidency::Plan plan = planPoolUpdate(
+      res_, needed_.data(), maxCapacity_, vol_, layout_, stats_,
+      [&](int64_t slots) {
+        // A larger pool keeps the resident slots (one device copy). When the device cannot hold
+        // both, the pool stays as it is and evicts instead (if the needed bricks fit it).
+        DeviceBuffer<unsigned char> bigger;
+        try {
+          bigger.reserve(size_t(slots * slotBytes));
+        } catch (const BackendError&) {
+          return false;
+        }
+        if (res_.capacity() > 0)
+          SS_CUDA_CHECK(cudaMemcpyAsync(bigger.get(), d_pool_.get(), size_t(res_.capacity() * slotBytes),
+                                        cudaMemcpyDeviceToDevice, stream));
+        SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+        d_pool_.swap(bigger);
+        return true;
+      },
+      [](const std::string& m) { throw BackendError(m); });
   // Uploads: gather runs of bricks into one pinned buffer while the other one's copies run.
   const size_t perStage = std::max<size_t>(1, kStageBytes / size_t(slotBytes));
   if (!plan.bricks.empty()) {
@@ -129,10 +116,7 @@ void DevicePool::update(const PoolNeedRule& r, const uint8_t* d_occ, uint64_t ge
   rule_ = r;
   generation_ = generation;
   valid_ = true;
-  stats_.uploaded = int64_t(plan.bricks.size());
-  stats_.evicted = plan.evicted;
-  stats_.resident = res_.resident();
-  stats_.updateSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  finishPoolUpdate(res_, plan, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), stats_);
 }
 
 }  // namespace spaceskip::cuda

@@ -1,6 +1,7 @@
 // Sparse residency on the host: the pool layout, the rule a frame's blend mode needs, brick
 // gathering (oneTBB) and the slot bookkeeping with LRU eviction (BrickPool.h).
 #include "spaceskip/BrickPool.h"
+#include "spaceskip/PoolPlan.h"
 
 #include <tbb/parallel_for.h>
 
@@ -218,26 +219,15 @@ void HostPool::update(const PoolNeedRule& r, const uint8_t* occ, uint64_t genera
   tbb::parallel_for(int64_t(0), n, [&](int64_t p) {
     needed_[size_t(p)] = poolBrickNeeded(p, layout_, cdims, cbrick, occ, vmin, vmax, r) ? 1 : 0;
   });
-  const BrickResidency::Demand demand = res_.demand(needed_.data());
-  if (demand.needed > maxCapacity_) {
-    valid_ = false;
-    stats_.needed = demand.needed;
-    throw std::runtime_error(poolOverflowMessage(vol_, layout_, demand.needed, stats_.budgetBytes));
-  }
-  const int64_t cap = grownCapacity(demand, res_.capacity(), maxCapacity_);
-  if (cap > res_.capacity()) {
-    const size_t bytes = size_t(cap * layout_.slotVoxels()) * voxelSize(vol_.type);
-    pool_.resize((bytes + sizeof(double) - 1) / sizeof(double), 0.0);  // keeps the resident slots
-    res_.grow(cap);
-  }
-  stats_.capacity = res_.capacity();
-  stats_.poolBytes = res_.capacity() * layout_.slotVoxels() * int64_t(voxelSize(vol_.type));
-  const BrickResidency::Plan plan = res_.update(needed_.data());
-  stats_.needed = plan.needed;
-  if (!plan.fits) {
-    valid_ = false;
-    throw std::runtime_error(poolOverflowMessage(vol_, layout_, plan.needed, stats_.budgetBytes));
-  }
+  valid_ = false;  // until the uploads are done
+  const BrickResidency::Plan plan = planPoolUpdate(
+      res_, needed_.data(), maxCapacity_, vol_, layout_, stats_,
+      [&](int64_t slots) {
+        const size_t bytes = size_t(slots * layout_.slotVoxels()) * voxelSize(vol_.type);
+        pool_.resize((bytes + sizeof(double) - 1) / sizeof(double), 0.0);  // keeps the resident slots
+        return true;
+      },
+      [](const std::string& m) { throw std::runtime_error(m); });
   dispatchVoxelType(vol_.type, [&](auto t) {
     using T = decltype(t);
     T* pool = reinterpret_cast<T*>(pool_.data());
@@ -249,10 +239,35 @@ void HostPool::update(const PoolNeedRule& r, const uint8_t* occ, uint64_t genera
   rule_ = r;
   generation_ = generation;
   valid_ = true;
-  stats_.uploaded = int64_t(plan.bricks.size());
-  stats_.evicted = plan.evicted;
-  stats_.resident = res_.resident();
-  stats_.updateSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  finishPoolUpdate(res_, plan, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), stats_);
+}
+
+BrickResidency::Plan planPoolUpdate(BrickResidency& res, const uint8_t* needed, int64_t maxCapacity, const Volume& v,
+                                    const PoolLayout& L, ResidencyStats& stats,
+                                    const std::function<bool(int64_t)>& grow,
+                                    const std::function<void(const std::string&)>& overflow) {
+  const BrickResidency::Demand demand = res.demand(needed);
+  stats.needed = demand.needed;
+  if (demand.needed > maxCapacity) overflow(poolOverflowMessage(v, L, demand.needed, stats.budgetBytes));
+  const int64_t cap = grownCapacity(demand, res.capacity(), maxCapacity);
+  if (cap > res.capacity()) {
+    if (grow(cap)) res.grow(cap);
+    else if (demand.needed > res.capacity()) overflow(poolOverflowMessage(v, L, demand.needed, stats.budgetBytes));
+  }
+  const int64_t slotBytes = L.slotVoxels() * int64_t(voxelSize(v.type));
+  stats.capacity = res.capacity();
+  stats.poolBytes = res.capacity() * slotBytes;
+  BrickResidency::Plan plan = res.update(needed);
+  if (!plan.fits) overflow(poolOverflowMessage(v, L, plan.needed, stats.budgetBytes));
+  return plan;
+}
+
+void finishPoolUpdate(const BrickResidency& res, const BrickResidency::Plan& plan, double seconds,
+                      ResidencyStats& stats) {
+  stats.uploaded = int64_t(plan.bricks.size());
+  stats.evicted = plan.evicted;
+  stats.resident = res.resident();
+  stats.updateSeconds = seconds;
 }
 
 }  // namespace spaceskip
