@@ -54,9 +54,7 @@ void DevicePool::release() {
 
 void DevicePool::update(const PoolNeedRule& r, const uint8_t* d_occ, uint64_t generation, const float* d_vmin,
                         const float* d_vmax, vec3i cdims, int cbrick, cudaStream_t stream) {
-  stats_.uploaded = stats_.evicted = 0;
-  stats_.updateSeconds = 0;
-  if (valid_ && r == rule_ && (r.need != PoolNeed::Occupancy || generation == generation_)) return;
+  if (!beginPoolUpdate(valid_, rule_, generation_, r, generation, stats_)) return;
   const auto t0 = std::chrono::steady_clock::now();
   const int64_t n = layout_.count();
   neededKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(layout_, cdims, cbrick, d_occ, d_vmin, d_vmax, r,

@@ -89,7 +89,6 @@ class Engine {
   /// `poolBrick`: cells per pool brick edge (a multiple of the classification brick; smaller
   /// bricks fit sparse data tighter, at (brick+1)^3/brick^3 voxels per slot and a larger table).
   void setMemoryBudget(int64_t bytes, int poolBrick = 16);
-  int64_t memoryBudget() const;
 
   const BuildStats& buildStats() const;
   /// Builder Auto: true while it measures its candidates (one or two frames each, Engine.cpp),

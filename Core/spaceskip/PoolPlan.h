@@ -10,6 +10,13 @@
 
 namespace spaceskip {
 
+/// Starts a frame's residency update: clears the last frame's upload figures in `stats` and
+/// says whether anything is to do: not when the last update (`valid`) was for the same rule and,
+/// for the occupancy rule, the same classification `generation` (the value-range rules depend on
+/// the volume's ranges only).
+bool beginPoolUpdate(bool valid, const PoolNeedRule& lastRule, uint64_t lastGeneration, const PoolNeedRule& r,
+                     uint64_t generation, ResidencyStats& stats);
+
 /// Plans the update for `needed` (one byte per pool brick of `L`). `overflow(message)` is called,
 /// and must throw, when the needed bricks exceed `maxCapacity` (the budget's slots) or a pool
 /// that could not grow. `grow(slots)` is asked for a larger pool when grownCapacity says so; it

@@ -211,9 +211,7 @@ void HostPool::init(const Volume& v, int classBrick, int poolBrick, int64_t budg
 
 void HostPool::update(const PoolNeedRule& r, const uint8_t* occ, uint64_t generation, const float* vmin,
                       const float* vmax, vec3i cdims, int cbrick) {
-  stats_.uploaded = stats_.evicted = 0;
-  stats_.updateSeconds = 0;
-  if (valid_ && r == rule_ && (r.need != PoolNeed::Occupancy || generation == generation_)) return;
+  if (!beginPoolUpdate(valid_, rule_, generation_, r, generation, stats_)) return;
   const auto t0 = std::chrono::steady_clock::now();
   const int64_t n = layout_.count();
   tbb::parallel_for(int64_t(0), n, [&](int64_t p) {
@@ -240,6 +238,13 @@ void HostPool::update(const PoolNeedRule& r, const uint8_t* occ, uint64_t genera
   generation_ = generation;
   valid_ = true;
   finishPoolUpdate(res_, plan, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), stats_);
+}
+
+bool beginPoolUpdate(bool valid, const PoolNeedRule& lastRule, uint64_t lastGeneration, const PoolNeedRule& r,
+                     uint64_t generation, ResidencyStats& stats) {
+  stats.uploaded = stats.evicted = 0;
+  stats.updateSeconds = 0;
+  return !(valid && r == lastRule && (r.need != PoolNeed::Occupancy || generation == lastGeneration));
 }
 
 BrickResidency::Plan planPoolUpdate(BrickResidency& res, const uint8_t* needed, int64_t maxCapacity, const Volume& v,

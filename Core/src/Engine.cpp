@@ -905,7 +905,6 @@ void Engine::setMemoryBudget(int64_t bytes, int poolBrick) {
   impl_->backend->setMemoryBudget(bytes, poolBrick);
   impl_->rangesDirty = true;  // in core or sparse is decided when the volume is set
 }
-int64_t Engine::memoryBudget() const { return impl_->memoryBudget; }
 
 const BuildStats& Engine::buildStats() const { return impl_->stats; }
 bool Engine::exploring() const {
