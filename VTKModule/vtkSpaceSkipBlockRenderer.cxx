@@ -533,8 +533,9 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
     this->Compositor.reset(new vtkSpaceSkipCompositor);
   }
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  const int whole[4] = { 0, 0, width, height };
   if (!renWin ||
-    !this->Compositor->Draw(renWin, sum, width, height, parent->GetEightBitComposite() != 0))
+    !this->Compositor->Draw(renWin, sum, width, height, parent->GetEightBitComposite() != 0, whole))
   {
     problem = "could not compile the compositing shader: nothing drawn";
     return false;

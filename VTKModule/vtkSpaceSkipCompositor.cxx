@@ -2,6 +2,7 @@
 #include "vtkSpaceSkipCompositor.h"
 
 #include "vtkActor2D.h"
+#include "vtkImageData.h"
 #include "vtkLogger.h"
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
@@ -17,6 +18,7 @@
 #include "vtkVolume.h"
 #include "vtk_glew.h"
 
+#include "spaceskip/DeviceImageCopy.h"
 #include "spaceskip/Engine.h"
 
 #include <tbb/blocked_range.h>
@@ -29,7 +31,19 @@
 #endif
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
+
+namespace
+{
+// A measurement switch (read per frame), "1": on.
+bool EnvOn(const char* name)
+{
+  const char* v = std::getenv(name);
+  return v && v[0] == '1';
+}
+} // namespace
 
 //------------------------------------------------------------------------------
 vtkSpaceSkipCompositor::vtkSpaceSkipCompositor() = default;
@@ -142,10 +156,80 @@ const float* vtkSpaceSkipCompositor::ReadDepth(
 }
 
 //------------------------------------------------------------------------------
-bool vtkSpaceSkipCompositor::CopyDeviceImage(
-  vtkOpenGLRenderWindow* renWin, const void* image, int width, int height)
+void vtkSpaceSkipCompositor::VisibleRect(const spaceskip::Camera& camera, vtkImageData* input,
+  double pad, int width, int height, int rect[4])
 {
-  if (this->CopyToInteropTexture(renWin, image, width, height))
+  rect[0] = rect[1] = 0;
+  rect[2] = width;
+  rect[3] = height;
+  if (!input || EnvOn("SPACESKIP_COMPOSITE_FULL"))
+  {
+    return;
+  }
+  int ext[6];
+  input->GetExtent(ext);
+  // clip = proj * view * (x, y, z, 1): Core's matrices are column-major, m[c * 4 + r].
+  const double* P = camera.proj.m;
+  const double* V = camera.view.m;
+  double pv[16];
+  for (int r = 0; r < 4; ++r)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      double sum = 0;
+      for (int k = 0; k < 4; ++k)
+      {
+        sum += P[k * 4 + r] * V[c * 4 + k];
+      }
+      pv[c * 4 + r] = sum;
+    }
+  }
+  double lo[2] = { 1e300, 1e300 }, hi[2] = { -1e300, -1e300 };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    const double i = (corner & 1) ? ext[1] + pad : ext[0] - pad;
+    const double j = (corner & 2) ? ext[3] + pad : ext[2] - pad;
+    const double k = (corner & 4) ? ext[5] + pad : ext[4] - pad;
+    double x[3];
+    input->TransformContinuousIndexToPhysicalPoint(i, j, k, x);
+    double clip[4];
+    for (int r = 0; r < 4; ++r)
+    {
+      clip[r] = pv[r] * x[0] + pv[4 + r] * x[1] + pv[8 + r] * x[2] + pv[12 + r];
+    }
+    if (!(clip[3] > 1e-9) || !std::isfinite(clip[0] + clip[1] + clip[3]))
+    {
+      return; // behind the eye (or not finite): the whole frame
+    }
+    for (int a = 0; a < 2; ++a)
+    {
+      const double ndc = clip[a] / clip[3];
+      lo[a] = std::min(lo[a], ndc);
+      hi[a] = std::max(hi[a], ndc);
+    }
+  }
+  // Pixel p's centre is at ndc (p + 0.5) / n * 2 - 1 (render/RayGen.h).
+  const int n[2] = { width, height };
+  for (int a = 0; a < 2; ++a)
+  {
+    const double p0 = std::floor((lo[a] + 1) * 0.5 * n[a] - 0.5) - 2;
+    const double p1 = std::ceil((hi[a] + 1) * 0.5 * n[a] - 0.5) + 2;
+    const int first = static_cast<int>(std::max(0.0, std::min(p0, double(n[a]))));
+    const int last = static_cast<int>(std::max(-1.0, std::min(p1, double(n[a] - 1))));
+    rect[a] = first;
+    rect[2 + a] = std::max(0, last - first + 1);
+  }
+  if (rect[2] == 0 || rect[3] == 0)
+  {
+    rect[2] = rect[3] = 0;
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image,
+  void* stream, int width, int height, const int rect[4], bool eightBit)
+{
+  if (this->CopyToInteropTexture(renWin, image, stream, width, height, rect, eightBit))
   {
     this->Interop = true;
     this->CompositePath = "gpu";
@@ -163,7 +247,7 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(
 
 //------------------------------------------------------------------------------
 bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip::Image& image,
-  int width, int height, bool eightBit)
+  int width, int height, bool eightBit, const int rect[4])
 {
   vtkTextureObject* texture = this->Interop ? this->InteropTexture.GetPointer() : nullptr;
   this->Interop = false;
@@ -173,7 +257,7 @@ bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip
     texture = this->Texture;
     this->CompositePath = "host";
   }
-  return this->Blend(renWin, texture);
+  return this->Blend(renWin, texture, rect);
 }
 
 //------------------------------------------------------------------------------
@@ -223,8 +307,13 @@ void vtkSpaceSkipCompositor::UploadHostImage(vtkOpenGLRenderWindow* renWin,
 //------------------------------------------------------------------------------
 // A full-screen quad drawing `texture` as premultiplied RGBA over what is drawn,
 // (ONE, ONE_MINUS_SRC_ALPHA), depth untouched; false when the shader does not compile.
-bool vtkSpaceSkipCompositor::Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture)
+bool vtkSpaceSkipCompositor::Blend(
+  vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture, const int rect[4])
 {
+  if (rect[2] <= 0 || rect[3] <= 0)
+  {
+    return true; // no pixel of the frame can be coloured
+  }
   if (!this->Quad)
   {
     std::string fs = vtkOpenGLRenderUtilities::GetFullScreenQuadFragmentShaderTemplate();
@@ -248,6 +337,33 @@ bool vtkSpaceSkipCompositor::Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObje
   vtkOpenGLState::ScopedglEnableDisable depthSaver(ostate, GL_DEPTH_TEST);
   vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(ostate);
   vtkOpenGLState::ScopedglDepthMask depthMaskSaver(ostate);
+  const bool scissorTest = ostate->GetEnumState(GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglEnableDisable scissorTestSaver(ostate, GL_SCISSOR_TEST);
+  vtkOpenGLState::ScopedglScissor scissorSaver(ostate);
+  // Only the pixels the rays can colour (VisibleRect, in the viewport), within the scissor box
+  // in force (VTK's viewport).
+  int vp[4], box[4] = { rect[0], rect[1], rect[2], rect[3] };
+  ostate->vtkglGetIntegerv(GL_VIEWPORT, vp);
+  box[0] += vp[0];
+  box[1] += vp[1];
+  if (scissorTest)
+  {
+    int cur[4];
+    ostate->vtkglGetIntegerv(GL_SCISSOR_BOX, cur);
+    const int x0 = std::max(box[0], cur[0]), y0 = std::max(box[1], cur[1]);
+    const int x1 = std::min(box[0] + box[2], cur[0] + cur[2]);
+    const int y1 = std::min(box[1] + box[3], cur[1] + cur[3]);
+    if (x1 <= x0 || y1 <= y0)
+    {
+      return true;
+    }
+    box[0] = x0;
+    box[1] = y0;
+    box[2] = x1 - x0;
+    box[3] = y1 - y0;
+  }
+  ostate->vtkglEnable(GL_SCISSOR_TEST);
+  ostate->vtkglScissor(box[0], box[1], box[2], box[3]);
   ostate->vtkglEnable(GL_BLEND);
   ostate->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   ostate->vtkglDisable(GL_DEPTH_TEST);
@@ -265,6 +381,8 @@ void vtkSpaceSkipCompositor::ReleaseInterop()
 #ifdef SPACESKIP_HAVE_CUDA
   if (this->InteropResource)
   {
+    // A copy into the texture may still be queued on the engine's stream.
+    cudaDeviceSynchronize();
     cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->InteropResource));
     cudaGetLastError(); // a failure here (context gone) must not reach the engine's checks
   }
@@ -275,8 +393,8 @@ void vtkSpaceSkipCompositor::ReleaseInterop()
 
 //------------------------------------------------------------------------------
 // Copies the engine's device image into InteropTexture; false (with the reason) on any failure.
-bool vtkSpaceSkipCompositor::CopyToInteropTexture(
-  vtkOpenGLRenderWindow* renWin, const void* image, int w, int h)
+bool vtkSpaceSkipCompositor::CopyToInteropTexture(vtkOpenGLRenderWindow* renWin,
+  const void* image, void* stream, int w, int h, const int rect[4], bool eightBit)
 {
 #ifdef SPACESKIP_HAVE_CUDA
   auto failed = [this](const char* what, cudaError_t e) {
@@ -284,7 +402,8 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(
     cudaGetLastError();
     return false;
   };
-  if (!this->InteropTexture || this->InteropSize[0] != w || this->InteropSize[1] != h)
+  if (!this->InteropTexture || this->InteropSize[0] != w || this->InteropSize[1] != h ||
+    this->InteropEightBit != eightBit)
   {
     this->ReleaseInterop();
     // Only NVIDIA's GL can share with CUDA: do not even ask another (the failing call would
@@ -305,10 +424,10 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(
     this->InteropTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
     this->InteropTexture->SetWrapS(vtkTextureObject::ClampToEdge);
     this->InteropTexture->SetWrapT(vtkTextureObject::ClampToEdge);
-    if (!this->InteropTexture->Allocate2D(
-          static_cast<unsigned>(w), static_cast<unsigned>(h), 4, VTK_FLOAT))
+    if (!this->InteropTexture->Allocate2D(static_cast<unsigned>(w), static_cast<unsigned>(h), 4,
+          eightBit ? VTK_UNSIGNED_CHAR : VTK_FLOAT))
     {
-      this->InteropProblem = "could not allocate the float texture";
+      this->InteropProblem = "could not allocate the texture";
       return false;
     }
     cudaGraphicsResource_t r = nullptr;
@@ -321,9 +440,21 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(
     this->InteropResource = r;
     this->InteropSize[0] = w;
     this->InteropSize[1] = h;
+    this->InteropEightBit = eightBit;
   }
+  if (rect[2] <= 0 || rect[3] <= 0)
+  {
+    return true; // nothing to copy (Blend draws nothing either)
+  }
+  if (!this->ImageCopy)
+  {
+    this->ImageCopy.reset(new spaceskip::DeviceImageCopy);
+  }
+  // On the engine's stream, after its frame; GL's work after the unmap waits for the copy on
+  // the GPU. Measurement switch: the default stream, the engine having waited for its frame.
+  const cudaStream_t s = EnvOn("SPACESKIP_SYNC_FRAME") ? nullptr : static_cast<cudaStream_t>(stream);
   cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(this->InteropResource);
-  cudaError_t e = cudaGraphicsMapResources(1, &r, nullptr);
+  cudaError_t e = cudaGraphicsMapResources(1, &r, s);
   if (e != cudaSuccess)
   {
     return failed("cudaGraphicsMapResources", e);
@@ -332,11 +463,10 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(
   e = cudaGraphicsSubResourceGetMappedArray(&array, r, 0, 0);
   if (e == cudaSuccess)
   {
-    const size_t row = static_cast<size_t>(w) * 4 * sizeof(float);
-    e = cudaMemcpy2DToArray(
-      array, 0, 0, image, row, row, static_cast<size_t>(h), cudaMemcpyDeviceToDevice);
+    e = static_cast<cudaError_t>(
+      this->ImageCopy->copy(image, w, h, array, rect[0], rect[1], rect[2], rect[3], eightBit, s));
   }
-  const cudaError_t u = cudaGraphicsUnmapResources(1, &r, nullptr);
+  const cudaError_t u = cudaGraphicsUnmapResources(1, &r, s);
   if (e != cudaSuccess)
   {
     return failed("copy into the GL texture", e);
@@ -349,8 +479,11 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(
 #else
   (void)renWin;
   (void)image;
+  (void)stream;
   (void)w;
   (void)h;
+  (void)rect;
+  (void)eightBit;
   this->InteropProblem = "built without CUDA";
   return false;
 #endif

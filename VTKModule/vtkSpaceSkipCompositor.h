@@ -10,6 +10,7 @@
 #include <string> // For the problem and path texts
 #include <vector> // For the buffers
 
+class vtkImageData;
 class vtkOpenGLFramebufferObject;
 class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
@@ -18,6 +19,8 @@ class vtkTextureObject;
 class vtkWindow;
 namespace spaceskip
 {
+class DeviceImageCopy;
+struct Camera;
 struct Image;
 }
 
@@ -47,19 +50,36 @@ public:
   bool CanUseDeviceImage(bool gpuComposite) const { return gpuComposite && !this->InteropFailed; }
 
   /**
-   * Copies the engine's device image (float4 RGBA) into a GL texture registered with CUDA, the
-   * one Draw() then blends. False on any failure (not NVIDIA's GL, another device, a CUDA
-   * error): said once at INFO verbosity, and the host path is used from then on.
+   * The pixels of a `width` x `height` frame its rays can colour, as x, y, w, h (w or h 0: none):
+   * the projection of `input`'s box grown by `pad` cells on each side, plus 2 pixels; a ray
+   * through a pixel centre outside it misses the box, and its pixel is transparent black, which
+   * the blend leaves unchanged. The whole frame when a corner lies behind the eye, or with
+   * SPACESKIP_COMPOSITE_FULL=1 (a measurement switch).
    */
-  bool CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image, int width, int height);
+  static void VisibleRect(const spaceskip::Camera& camera, vtkImageData* input, double pad, int width,
+    int height, int rect[4]);
 
   /**
-   * Blends the image over what is drawn as premultiplied RGBA (ONE, ONE_MINUS_SRC_ALPHA): the
-   * texture CopyDeviceImage() filled this frame, else `image` uploaded from host memory (rounded
-   * to 8 bits per channel when `eightBit`). False when the compositing shader does not compile.
+   * Copies `rect` (VisibleRect) of the engine's device image (float4 RGBA) into a GL texture
+   * registered with CUDA, the one Draw() then blends: float texels, or with `eightBit` RGBA8
+   * rounded as the host path rounds (a quarter of the bytes for the blend to read). The map,
+   * copy and unmap are queued on `stream` (the engine's, Engine::deviceImageStream()) after the
+   * frame, so GL waits for the image on the GPU and the host not at all (SPACESKIP_SYNC_FRAME=1,
+   * a measurement switch: on the default stream after the engine waited, as before). False on
+   * any failure (not NVIDIA's GL, another device, a CUDA error): said once at INFO verbosity,
+   * and the host path is used from then on.
+   */
+  bool CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int width,
+    int height, const int rect[4], bool eightBit);
+
+  /**
+   * Blends the image over what is drawn as premultiplied RGBA (ONE, ONE_MINUS_SRC_ALPHA), within
+   * `rect` of the viewport (VisibleRect): the texture CopyDeviceImage() filled this frame, else
+   * `image` uploaded from host memory (rounded to 8 bits per channel when `eightBit`). False when
+   * the compositing shader does not compile.
    */
   bool Draw(vtkOpenGLRenderWindow* renWin, const spaceskip::Image& image, int width, int height,
-    bool eightBit);
+    bool eightBit, const int rect[4]);
 
   /// "gpu", "host" or "none": how the last image reached the window.
   const std::string& GetCompositePath() const { return this->CompositePath; }
@@ -73,9 +93,10 @@ public:
 private:
   void UploadHostImage(vtkOpenGLRenderWindow* renWin, const spaceskip::Image* image, int width,
     int height, bool eightBit);
-  bool Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture);
+  bool Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture, const int rect[4]);
   void ReleaseInterop();
-  bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, int w, int h);
+  bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,
+    int h, const int rect[4], bool eightBit);
 
   std::vector<float> Depth;
   vtkSmartPointer<vtkOpenGLFramebufferObject> Resolve; // single-sample copy of an MSAA depth
@@ -89,6 +110,8 @@ private:
   vtkSmartPointer<vtkTextureObject> InteropTexture;
   void* InteropResource = nullptr; // cudaGraphicsResource_t
   int InteropSize[2] = { 0, 0 };
+  bool InteropEightBit = false; // InteropTexture holds RGBA8 (else float RGBA)
+  std::unique_ptr<spaceskip::DeviceImageCopy> ImageCopy; // the device image into the texture
   bool InteropFailed = false; // once failed (e.g. GL on Mesa, another GPU): host path from then on
   bool Interop = false;       // this frame's image is InteropTexture
   std::string InteropProblem;

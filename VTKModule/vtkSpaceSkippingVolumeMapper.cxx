@@ -27,7 +27,9 @@
 #include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
@@ -204,6 +206,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   double EngineSeconds = 0;
   double CompositeSeconds = 0;
   double MapperSeconds = 0;
+  int CompositeRect[4] = { 0, 0, 0, 0 }; // the viewport rectangle the last frame blended
 
   spaceskip::Image Image;
   bool DeferredReady = false; // DeferDraw: Image holds this Render()'s frame
@@ -227,8 +230,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   bool UpdateEngine();
   void RenderFrame(vtkOpenGLRenderWindow* renWin, bool sceneHasDepth, const spaceskip::Camera& camera, int x0, int y0,
     int width, int height);
-  bool Composite(vtkOpenGLRenderWindow* renWin, const spaceskip::Camera& camera, int width,
-    int height);
+  bool Composite(vtkOpenGLRenderWindow* renWin, vtkImageData* input,
+    const spaceskip::Camera& camera, int width, int height);
   void ReportPaths();
 
   spaceskip::Counters Counts() const
@@ -357,13 +360,16 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWind
       static_cast<long long>(bs.nodes), bs.height, static_cast<long long>(bs.leaves),
       bs.occupancy);
   }
+  // frameStats(false): a frame left on the device is not waited for (its kernel time is read
+  // when asked for, GetLastKernelSeconds).
+  const spaceskip::FrameStats& fs = engine.frameStats(false);
   vtkVLogF(vtkLogger::VERBOSITY_TRACE, "vtkSpaceSkippingVolumeMapper: %dx%d frame in %.6f s on %s",
-    width, height, engine.frameStats().seconds, engine.frameStats().backend.c_str());
-  this->BackendUsed = engine.frameStats().backend;
+    width, height, fs.seconds, fs.backend.c_str());
+  this->BackendUsed = fs.backend;
   this->BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
   this->SampleDistanceUsed = engine.sampleDistance();
   this->BuilderChoice = engine.buildStats().choice;
-  const spaceskip::ResidencyStats& rs = engine.frameStats().residency;
+  const spaceskip::ResidencyStats& rs = fs.residency;
   this->ResidentBricks = rs.sparse ? static_cast<vtkIdType>(rs.resident) : 0;
   char text[160];
   std::snprintf(text, sizeof text, "sparse: %lld of %lld bricks resident (%.0f MiB pool)",
@@ -375,20 +381,32 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWind
 // The image into the window: through CUDA-GL interop when it stayed on the device (else this
 // frame again through host memory), blended over what is drawn; false (said) when it cannot.
 bool vtkSpaceSkippingVolumeMapper::vtkInternals::Composite(vtkOpenGLRenderWindow* renWin,
-  const spaceskip::Camera& camera, int width, int height)
+  vtkImageData* input, const spaceskip::Camera& camera, int width, int height)
 {
   const auto t0 = std::chrono::steady_clock::now();
   spaceskip::Engine& engine = *this->Engine;
+  // The pixels the rays can colour: the box grown by a sample step and a voxel (a ray's last
+  // sample may lie up to a step past the box, clamped onto it).
+  int rect[4];
+  const double* spacing = input ? input->GetSpacing() : nullptr;
+  const double minSpacing = spacing
+    ? std::min({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) })
+    : 0.0;
+  vtkSpaceSkipCompositor::VisibleRect(camera, minSpacing > 0 ? input : nullptr,
+    2.0 + engine.sampleDistance() / std::max(minSpacing, 1e-300), width, height, rect);
+  std::copy(rect, rect + 4, this->CompositeRect);
+  const bool eightBit = this->Self->EightBitComposite != 0;
   if (const void* deviceImage = engine.deviceImage())
   {
-    if (!this->Compositor.CopyDeviceImage(renWin, deviceImage, width, height))
+    if (!this->Compositor.CopyDeviceImage(
+          renWin, deviceImage, engine.deviceImageStream(), width, height, rect, eightBit))
     {
       engine.setImageOnDevice(false);
       engine.render(camera, width, height, this->Image, this->FrameDepth);
     }
   }
   this->ReportPaths();
-  if (!this->Compositor.Draw(renWin, this->Image, width, height, this->Self->EightBitComposite != 0))
+  if (!this->Compositor.Draw(renWin, this->Image, width, height, eightBit, rect))
   {
     this->Fail("could not compile the compositing shader: nothing drawn");
     return false;
@@ -464,7 +482,7 @@ double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
   {
     return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds);
   }
-  return this->Internals->Engine ? this->Internals->Engine->frameStats().seconds : 0.0;
+  return this->Internals->Engine ? this->Internals->Engine->frameStats(false).seconds : 0.0;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
 {
@@ -582,6 +600,10 @@ const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
     return this->Internals->Blocks.GetCompositePath(); // the blended blocks' way to the window
   }
   return this->Internals->Compositor.GetCompositePath().c_str();
+}
+void vtkSpaceSkippingVolumeMapper::GetLastCompositeRect(int rect[4])
+{
+  std::copy(this->Internals->CompositeRect, this->Internals->CompositeRect + 4, rect);
 }
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderChoice()
 {
@@ -779,7 +801,7 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
       d.LastProblem.clear();
       return;
     }
-    if (!d.Composite(renWin, camera, width, height))
+    if (!d.Composite(renWin, vtkImageData::SafeDownCast(this->GetInput()), camera, width, height))
     {
       return;
     }

@@ -195,7 +195,8 @@ public:
   /**
    * Upload the image to the window rounded to 8 bits per channel (default on: the window's
    * colour buffer has 8 bits, and the upload is a quarter of the 32-bit float image's); off
-   * uploads 32-bit floats and blends those.
+   * uploads 32-bit floats and blends those. With the image kept on the GPU (GPUComposite) it
+   * picks the interop texture's format alike: RGBA8 rounded by CUDA, or 32-bit float.
    */
   vtkSetMacro(EightBitComposite, vtkTypeBool);
   vtkGetMacro(EightBitComposite, vtkTypeBool);
@@ -219,7 +220,10 @@ public:
   /**
    * Keep the image on the GPU (default on): with the CUDA backend and the window's OpenGL on the
    * same NVIDIA device, the frame is copied from CUDA memory into a GL texture (CUDA-GL interop)
-   * instead of going down to host memory and up again. When interop is not possible (another GL
+   * instead of going down to host memory and up again. The copy is queued on the engine's CUDA
+   * stream behind the kernel and GL waits for it on the GPU, so Render() returns without waiting
+   * for the frame; only the rectangle of the window the volume's box covers is copied and
+   * blended (rounded to 8 bits on the GPU with EightBitComposite, as the host path rounds). When interop is not possible (another GL
    * such as Mesa, another device, a CUDA error) the mapper says so once at INFO verbosity and
    * uses host memory from then on. GetCompositePathUsed(): "gpu", "host" or "none".
    */
@@ -227,6 +231,12 @@ public:
   vtkGetMacro(GPUComposite, vtkTypeBool);
   vtkBooleanMacro(GPUComposite, vtkTypeBool);
   const char* GetCompositePathUsed();
+  /**
+   * The rectangle of the renderer's viewport the last frame copied and blended (x, y, width,
+   * height in pixels): where the volume's box projects (width or height 0 when it projects
+   * nowhere in the viewport), the whole viewport when the box reaches behind the eye.
+   */
+  void GetLastCompositeRect(int rect[4]);
   ///@}
 
   ///@{
@@ -316,9 +326,12 @@ public:
    *   edit) and hierarchy build (see GetLastBuildSeconds/GetLastClassifySeconds);
    * - DepthRead: reading the window's depth buffer (waits for the GL work before it);
    * - EngineRender: the engine's frame: depth upload, kernel, image readback (CUDA), or the
-   *   CPU ray march; GetLastRenderSeconds() is the same frame as the engine timed it;
-   * - Kernel: the render kernel alone (CUDA events), or the CPU frame on the CPU backend;
-   * - Composite: image texture upload and the blending quad;
+   *   CPU ray march; GetLastRenderSeconds() is the same frame as the engine timed it. With the
+   *   image kept on the GPU (GPUComposite) the host does not wait for the kernel: this is its
+   *   launch, and the GPU finishes the frame after Render() returns;
+   * - Kernel: the render kernel alone (CUDA events; with the image kept on the GPU asking for it
+   *   waits for the frame), or the CPU frame on the CPU backend;
+   * - Composite: image texture upload (or the interop copy's submission) and the blending quad;
    * - Mapper: the whole of Render().
    */
   double GetLastScalarRangeSeconds();

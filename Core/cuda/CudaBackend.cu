@@ -129,6 +129,9 @@ class CudaBackend final : public Backend {
 
   bool setImageOnDevice(bool on) override { return exec_.setImageOnDevice(on); }
   const void* deviceImage() const override { return exec_.deviceImage(); }
+  void* deviceImageStream() const override {
+    return exec_.deviceImage() ? static_cast<void*>(static_cast<cudaStream_t>(stream_)) : nullptr;
+  }
   void setLaunchParams(const LaunchParams& p) override { exec_.setLaunchParams(p); }
   double lastFrameDeviceSeconds() const override { return exec_.lastFrameDeviceSeconds(); }
 

@@ -137,9 +137,23 @@ void CudaExecutor::setTransferTable(const std::vector<vec4f>& t, float lo, float
   table_ = TransferFunctionView{d_table_.get(), int(t.size()), lo, scale};
 }
 
+double CudaExecutor::lastFrameDeviceSeconds() const {
+  if (timingPending_) {
+    timingPending_ = false;
+    float ms = 0;
+    // A getter does not throw: an error of the frame surfaces at the next checked call.
+    const bool ok = cudaEventSynchronize(ev1_) == cudaSuccess && cudaEventElapsedTime(&ms, ev0_, ev1_) == cudaSuccess;
+    if (!ok) (void)cudaGetLastError();
+    lastDeviceSeconds_ = ok ? double(ms) * 1e-3 : -1.0;
+  }
+  return lastDeviceSeconds_;
+}
+
 void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol,
                           const PoolView* pool, Image& out, cudaStream_t stream) {
   const size_t pixels = size_t(f.width) * size_t(f.height);
+  timingPending_ = false;  // the last frame's time, if nobody asked for it, is not kept
+  lastDeviceSeconds_ = -1;
   f.tf = table_;
   f.depth = nullptr;
   if (depth) {
@@ -192,8 +206,16 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   out.height = f.height;
   float ms = 0;
   if (imageOnDevice_ && !hostCounts) {
-    // The caller draws d_image_ itself (CUDA-GL interop): no download.
+    // The caller draws d_image_ itself (CUDA-GL interop), queuing its copy on `stream`: no
+    // download, and no wait here, so that the host's work for the frame overlaps the kernel.
+    // SPACESKIP_SYNC_FRAME=1 (read per frame, a measurement switch) waits as before this change.
     out.rgba.clear();
+    const char* sync = std::getenv("SPACESKIP_SYNC_FRAME");
+    if (!(sync && sync[0] == '1')) {
+      timingPending_ = true;
+      deviceImageValid_ = true;
+      return;
+    }
     SS_CUDA_CHECK(cudaStreamSynchronize(stream));
     SS_CUDA_CHECK(cudaEventElapsedTime(&ms, ev0_, ev1_));
     lastDeviceSeconds_ = double(ms) * 1e-3;

@@ -32,7 +32,9 @@ class CudaExecutor {
     return true;
   }
   const void* deviceImage() const { return deviceImageValid_ ? d_image_.get() : nullptr; }
-  double lastFrameDeviceSeconds() const { return lastDeviceSeconds_; }
+  /// The last frame's kernel time (CUDA events). A frame left on the device is not waited for by
+  /// render(): this waits for it, the first time it is asked.
+  double lastFrameDeviceSeconds() const;
 
  private:
   template <class Sampler>
@@ -52,7 +54,8 @@ class CudaExecutor {
   PinnedBuffer h_stage_;           ///< pinned copy of the last frame's image on its way to the caller
   bool imageOnDevice_ = false;     ///< setImageOnDevice(): leave the image in d_image_
   bool deviceImageValid_ = false;  ///< the last render() left its image in d_image_
-  double lastDeviceSeconds_ = -1;
+  mutable double lastDeviceSeconds_ = -1;
+  mutable bool timingPending_ = false;  ///< ev1_ of a frame not waited for: read on demand
 };
 
 }  // namespace spaceskip::cuda

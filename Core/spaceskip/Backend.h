@@ -35,9 +35,14 @@ class Backend {
   /// The last frame's premultiplied RGBA (one float4 per pixel, row 0 at the bottom) in device
   /// memory while setImageOnDevice(true) is in effect, else nullptr.
   virtual const void* deviceImage() const { return nullptr; }
+  /// The CUDA stream (a cudaStream_t) deviceImage() is written on, or nullptr. render() does not
+  /// wait for a frame it leaves on the device: work the caller queues on this stream after
+  /// render() sees the finished image, and the next render() overwrites it only after that work.
+  virtual void* deviceImageStream() const { return nullptr; }
   /// The launch shape of the render kernels (the CUDA backend; others ignore it).
   virtual void setLaunchParams(const LaunchParams& /*p*/) {}
-  /// Seconds the last render() spent in device work (CUDA events), -1 when not measured.
+  /// Seconds the last render() spent in device work (CUDA events), -1 when not measured. For a
+  /// frame left on the device (not waited for by render()) this waits for the frame.
   virtual double lastFrameDeviceSeconds() const { return -1; }
   /// The most memory the voxels may take (bytes; 0: the backend's default, for CUDA the free
   /// device memory less what the rest needs; the CPU backend holds the volume in host memory

@@ -78,6 +78,11 @@ class Engine {
   /// The last frame's premultiplied RGBA, float4 per pixel, row 0 at the bottom, in device memory
   /// (valid until the next render), or nullptr when the image went to the host.
   const void* deviceImage() const;
+  /// The CUDA stream (a cudaStream_t) deviceImage() is written on, nullptr without a device
+  /// image. render() does not wait for a frame it leaves on the device: work queued on this
+  /// stream after render() sees the finished image (e.g. the CUDA-GL interop copy), and the next
+  /// render() overwrites the image only after that work.
+  void* deviceImageStream() const;
   /// CUDA: the launch shape of the render kernels (LaunchParams.h); other backends ignore it.
   void setLaunchParams(const LaunchParams& p);
   /// The most memory the voxels may take on the backend, in bytes (0, the default: CUDA takes
@@ -94,7 +99,10 @@ class Engine {
   /// Builder Auto: true while it measures its candidates (one or two frames each, Engine.cpp),
   /// at first or when it re-checks its choice at a new, still view.
   bool exploring() const;
-  const FrameStats& frameStats() const;
+  /// The last frame's statistics. A frame left on the device (setImageOnDevice) is not waited
+  /// for by render(): its deviceSeconds is read here, which waits for the frame's device work;
+  /// with `waitForDevice` false nothing waits and deviceSeconds is -1 until someone waits.
+  const FrameStats& frameStats(bool waitForDevice = true) const;
   const Counters& counters() const;
   /// Host copies for tests and statistics (downloaded from the device if needed).
   const OccupancyGrid& occupancy();

@@ -84,7 +84,18 @@ struct Engine::Impl {
   bool cropClipDirty = false;
   BuildStats stats;
   FrameStats frame;
+  /// frame.deviceSeconds is still to be read from the backend (it waits for a frame left on the
+  /// device, so only a caller who asks for it waits: frameStats()).
+  bool deviceSecondsPending = false;
   Counters counters;
+
+  double frameDeviceSeconds() {
+    if (deviceSecondsPending) {
+      deviceSecondsPending = false;
+      frame.deviceSeconds = backend->lastFrameDeviceSeconds();
+    }
+    return frame.deviceSeconds;
+  }
 
   // Builder Auto ("never slower than naive"): skipping is lossless, so every candidate draws the
   // same image and only its speed differs. Measuring: every candidate renders a frame, in turn
@@ -242,9 +253,10 @@ struct Engine::Impl {
     t = a.frames[size_t(a.current)]++ == 0 ? seconds : std::min(t, seconds);
   }
 
-  /// After a frame of `seconds` at width x height seen from `view`: records it and picks the
-  /// next build.
-  void autoFrameDone(double seconds, int width, int height, const ViewKey& view) {
+  /// After a frame of `seconds()` at width x height seen from `view`: records it and picks the
+  /// next build. `seconds` is called only when a time is recorded (it may wait for the device).
+  template <class Seconds>
+  void autoFrameDone(const Seconds& seconds, int width, int height, const ViewKey& view) {
     AutoState& a = autoState;
     const ViewKey previous = a.lastView;
     a.lastView = view;
@@ -280,7 +292,7 @@ struct Engine::Impl {
       std::vector<int> queue{a.kept};
       queue.insert(queue.end(), q.begin(), q.end());
       beginMeasuring(queue, true);
-      record(seconds);  // the frame just drawn: the kept one at this view
+      record(seconds());  // the frame just drawn: the kept one at this view
       a.queue.erase(a.queue.begin());
       a.current = a.queue.front();
       buildDirty = true;
@@ -302,7 +314,7 @@ struct Engine::Impl {
       a.height = height;
       a.measuredAt = view;
     }
-    record(seconds);
+    record(seconds());
     a.queue.erase(a.queue.begin());
     if (a.queue.empty() && a.round == 1) {
       // Round 2: the candidates within kAutoPrune of round 1's fastest, in the reverse order.
@@ -876,7 +888,8 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     d.backend->render(f, d.render.filter, depth, out);
   }
   d.frame.seconds = since(t0);
-  d.frame.deviceSeconds = d.backend->lastFrameDeviceSeconds();
+  d.frame.deviceSeconds = -1;
+  d.deviceSecondsPending = true;
   d.frame.samples = -1;
   if (d.render.countSamples) {
     d.frame.samples = 0;
@@ -890,11 +903,13 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     d.warn("the bricks this view needs exceed the memory budget: sampled from the whole volume in host memory");
   ++d.counters.frames;
   if (d.build.builder == BuilderKind::Auto)
-    d.autoFrameDone(d.frame.deviceSeconds > 0 ? d.frame.deviceSeconds : d.frame.seconds, width, height, d.viewKey(cam));
+    d.autoFrameDone([&d] { return d.frameDeviceSeconds() > 0 ? d.frame.deviceSeconds : d.frame.seconds; }, width,
+                    height, d.viewKey(cam));
 }
 
 bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }
 const void* Engine::deviceImage() const { return impl_->backend->deviceImage(); }
+void* Engine::deviceImageStream() const { return impl_->backend->deviceImageStream(); }
 void Engine::setLaunchParams(const LaunchParams& p) { impl_->backend->setLaunchParams(p); }
 void Engine::setMemoryBudget(int64_t bytes, int poolBrick) {
   bytes = bytes > 0 ? bytes : 0;
@@ -910,7 +925,10 @@ const BuildStats& Engine::buildStats() const { return impl_->stats; }
 bool Engine::exploring() const {
   return impl_->build.builder == BuilderKind::Auto && (impl_->autoState.exploring || impl_->autoState.candidates.empty());
 }
-const FrameStats& Engine::frameStats() const { return impl_->frame; }
+const FrameStats& Engine::frameStats(bool waitForDevice) const {
+  if (waitForDevice) impl_->frameDeviceSeconds();
+  return impl_->frame;
+}
 const Counters& Engine::counters() const { return impl_->counters; }
 const OccupancyGrid& Engine::occupancy() {
   update();

@@ -11,6 +11,11 @@
 #   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
 #          bench-ert bench-hw (N-body 2048^3, the mapper's FilterMode Hardware (texture unit)
 #          against Exact: HW_ITEMS, default DistanceGrid,DistanceGrid:hw,Auto,Auto:hw)
+#          bench-frame (issue 13, the frame around the kernel: N-body 2048^3 Auto:hw with the
+#          window benchmark's switches :sync (host waits for the kernel, as before), :full (whole
+#          window blended), :float (float interop texture), alone and all together, twice in one
+#          process: FRAME_ITEMS) interop-memcheck (compute-sanitizer memcheck on the window
+#          benchmark with the image kept on the GPU, 8-bit and float: memcheck.log)
 #          bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
 #          volume-only scene skips) bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
 #          shading, window and CLI, N-body and Menger 1024^3: modes.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
@@ -198,7 +203,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
 # vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -227,6 +232,20 @@ has bench-depth && ITEMS=Grid,DistanceGrid,DistanceGrid:brick4 window_bench nbod
 # The mapper's hardware filter (FilterMode Hardware: the texture unit's trilinear filter) against
 # exact sampling, N-body 2048^3 (issue 13's window goal: >= 700 fps, TF edit <= 3 ms).
 has bench-hw && ITEMS=${HW_ITEMS:-DistanceGrid,DistanceGrid:hw,Auto,Auto:hw} window_bench nbody 2048 "${v2[@]}"
+# The frame around the kernel (issue 13): each change against the state before it, in one process.
+has bench-frame && ITEMS=${FRAME_ITEMS:-Auto:hw,Auto:hw:sync:full:float,Auto:hw:sync,Auto:hw:full,Auto:hw:float,Auto:hw,Auto:hw:sync:full:float} \
+  window_bench nbody 2048 "${v2[@]}"
+# The interop path under compute-sanitizer (the mapper tests draw through host memory on Mesa).
+if has interop-memcheck && ! late; then
+  log "interop memcheck"
+  SPACESKIP_BACKEND=cuda timeout 400 compute-sanitizer --tool memcheck --error-exitcode 99 "$bench" --shape nbody \
+    --dims 128 --frames 4 --size 256 --builders Auto:hw,Auto:hw:float,Grid,Grid:sync "${v2[@]}" --edits 2 \
+    > "$work/interop-memcheck.log" 2>&1
+  rc=$?
+  log "interop memcheck rc=$rc"
+  [ $rc -eq 0 ] || status=1
+  { echo "==== interop memcheck rc=$rc"; grep -E "ERROR SUMMARY|Invalid|image on the GPU|through host|^Auto|^Grid" "$work/interop-memcheck.log" | head -30; } >> "$out/memcheck.log"
+fi
 # Early ray termination on (VTK's mapper cannot turn it off): like for like with its rows above.
 if has bench-ert; then
   ITEMS=Naive,Grid,KdTreeGPUFast:mls32,DistanceGrid:brick4 window_bench nbody 1024 "${v2[@]}" --ert

@@ -6,7 +6,8 @@
 // occupied cells to the end of the first new frame. Run by Testing/gpu/run-gpu-vtk.sh.
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
-//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact]] [--vtk-gpu]
+//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:sync|:full|:float]]
+//       [--vtk-gpu]
 //       [--csv FILE] [--filter hw|exact (the mapper's FilterMode for every item without :hw or
 //        :exact; default exact)]
 //       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
@@ -14,6 +15,12 @@
 //       [--shade (gradient shading, VTK's default headlight and material)]
 //       [--depth-actor (an opaque point actor outside the volume: the mapper reads the window's
 //        depth as with geometry in the scene; without it a volume-only scene skips the readback)]
+// Item suffixes for measuring the frame around the kernel in one process (issue 13): :sync sets
+// SPACESKIP_SYNC_FRAME=1 for the item (the host waits for the kernel and copies on the default
+// stream, as before the asynchronous interop), :full SPACESKIP_COMPOSITE_FULL=1 (copy and blend
+// the whole window, not the volume's rectangle), :float the mapper's EightBitComposite off (a
+// float texture). Columns render_ms and finish_ms split the frame into the time in Render() and
+// the wait in glFinish() after it.
 // --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
 // headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
 // config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
@@ -226,11 +233,16 @@ std::vector<std::string> Split(const std::string& s, char c)
   return out;
 }
 
-// Render and wait for the GL work: the frame as the user sees it.
-double TimedRender(vtkRenderWindow* win)
+// Render and wait for the GL work: the frame as the user sees it. `inRender` (if given) gets
+// the part spent in Render(), the rest being the wait in glFinish().
+double TimedRender(vtkRenderWindow* win, double* inRender = nullptr)
 {
   const auto t0 = Clock::now();
   win->Render();
+  if (inRender)
+  {
+    *inRender = Since(t0);
+  }
   glFinish();
   return Since(t0);
 }
@@ -261,6 +273,9 @@ struct Item
   int mls = 0;
   int brick = 8;
   int filter = -1; ///< vtkSpaceSkippingVolumeMapper::FilterModeTypes; -1: --filter's
+  bool sync = false;  ///< SPACESKIP_SYNC_FRAME=1
+  bool full = false;  ///< SPACESKIP_COMPOSITE_FULL=1
+  bool floatComposite = false;
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -306,6 +321,18 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i] == "exact")
     {
       it.filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
+    }
+    else if (parts[i] == "sync")
+    {
+      it.sync = true;
+    }
+    else if (parts[i] == "full")
+    {
+      it.full = true;
+    }
+    else if (parts[i] == "float")
+    {
+      it.floatComposite = true;
     }
     else
     {
@@ -534,29 +561,34 @@ int main(int argc, char* argv[])
     csv.open(csvPath, std::ios::app);
     csv << "dataset,dims,item,builder_used,backend,frames,frame_ms,fps,mapper_ms,update_ms,depth_ms,"
            "engine_ms,kernel_ms,composite_ms,other_ms,kernel_fps,first_frame_s,build_s,classify_s,"
-           "nodes,occupancy,edit_ms,edit_classify_ms,edit_build_ms\n";
+           "nodes,occupancy,edit_ms,edit_classify_ms,edit_build_ms,render_ms,finish_ms\n";
   }
   const std::string ds = shape + std::to_string(n);
 
   // The empty window's frame.
-  double empty = 0;
+  double empty = 0, emptyCall = 0;
   for (int f = 0; f < frames; ++f)
   {
     Orbit(ren, b, 360.0 * f / frames, 15);
-    empty += TimedRender(win);
+    double call = 0;
+    empty += TimedRender(win, &call);
+    emptyCall += call;
   }
   empty /= frames;
-  std::printf("empty window: %.3f ms/frame\n", empty * 1e3);
+  emptyCall /= frames;
+  std::printf("empty window: %.3f ms/frame (in Render() %.3f ms, glFinish() %.3f ms)\n",
+    empty * 1e3, emptyCall * 1e3, (empty - emptyCall) * 1e3);
   if (csv.is_open())
   {
     csv << ds << "," << n << ",empty,,," << frames << "," << empty * 1e3 << "," << 1 / empty
-        << ",,,,,,,,,,,,,,,,\n";
+        << ",,,,,,,,,,,,,,,," << emptyCall * 1e3 << "," << (empty - emptyCall) * 1e3 << "\n";
   }
 
-  std::printf("%-22s %-13s %-5s %8s %7s %8s %8s %8s %8s %8s %8s %8s %8s %9s %8s %8s %8s %9s %7s\n",
+  std::printf("%-22s %-13s %-5s %8s %7s %8s %8s %8s %8s %8s %8s %8s %8s %9s %8s %8s %8s %9s %7s "
+              "%8s %8s\n",
     "item", "used", "bk", "frame_ms", "fps", "mapper", "update", "depth", "engine", "kernel",
     "compos", "other", "kern_fps", "first_s", "build_ms", "class_ms", "nodes", "occupancy",
-    "edit_ms");
+    "edit_ms", "render", "finish");
   vtkNew<vtkVolume> volume;
   volume->SetProperty(prop);
   ren->AddVolume(volume);
@@ -597,6 +629,15 @@ int main(int argc, char* argv[])
     mapper->SetMaxLeafSize(it.mls);
     mapper->SetMacroCellSize(it.brick);
     mapper->SetFilterMode(it.filter);
+    mapper->SetEightBitComposite(!(floatComposite || it.floatComposite));
+    auto setSwitch = [](const char* name, bool on) {
+      if (on)
+        setenv(name, "1", 1);
+      else
+        unsetenv(name);
+    };
+    setSwitch("SPACESKIP_SYNC_FRAME", it.sync);
+    setSwitch("SPACESKIP_COMPOSITE_FULL", it.full);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
@@ -618,11 +659,13 @@ int main(int argc, char* argv[])
     }
     const double buildS = mapper->GetLastBuildSeconds(), classifyS = mapper->GetLastClassifySeconds();
     TimedRender(win); // warm-up of the steady state
-    double wall = 0, m = 0, up = 0, dep = 0, eng = 0, ker = 0, comp = 0;
+    double wall = 0, m = 0, up = 0, dep = 0, eng = 0, ker = 0, comp = 0, call = 0;
     for (int f = 0; f < frames; ++f)
     {
       Orbit(ren, b, 360.0 * f / frames, 15);
-      wall += TimedRender(win);
+      double c = 0;
+      wall += TimedRender(win, &c);
+      call += c;
       m += mapper->GetLastMapperSeconds();
       up += mapper->GetLastUpdateSeconds();
       dep += mapper->GetLastDepthReadSeconds();
@@ -670,11 +713,11 @@ int main(int argc, char* argv[])
     }
     const double ke = edits > 0 ? 1e3 / edits : 0;
     std::printf("%-22s %-13s %-5s %8.3f %7.1f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.1f %9.3f "
-                "%8.3f %8.3f %8lld %9.5f %7.3f\n",
+                "%8.3f %8.3f %8lld %9.5f %7.3f %8.3f %8.3f\n",
       it.label.c_str(), mapper->GetBuilderUsed(), mapper->GetBackendUsed(), wall * k,
       frames / wall, m * k, up * k, dep * k, eng * k, ker * k, comp * k, (wall - m) * k,
       frames / ker, first, buildS * 1e3, classifyS * 1e3, static_cast<long long>(mapper->GetNodeCount()),
-      mapper->GetOccupancy(), edit * ke);
+      mapper->GetOccupancy(), edit * ke, call * k, (wall - call) * k);
     std::fflush(stdout);
     if (csv.is_open())
     {
@@ -684,10 +727,12 @@ int main(int argc, char* argv[])
           << "," << comp * k << "," << (wall - m) * k << "," << frames / ker << "," << first << ","
           << buildS << "," << classifyS << "," << mapper->GetNodeCount() << ","
           << mapper->GetOccupancy() << "," << edit * ke << "," << editClassify * ke << ","
-          << editBuild * ke << "\n";
+          << editBuild * ke << "," << call * k << "," << (wall - call) * k << "\n";
     }
   }
 
+  unsetenv("SPACESKIP_SYNC_FRAME");
+  unsetenv("SPACESKIP_COMPOSITE_FULL");
   if (vtkGpu)
   {
     // VTK's own GPU ray caster in the same window: same property, sample distance half a voxel
@@ -723,7 +768,7 @@ int main(int argc, char* argv[])
     {
       csv << ds << "," << n << ",vtkGPUVolumeRayCastMapper,,gl," << frames << ","
           << wall * 1e3 / frames << "," << frames / wall << ",,,,,,,,," << first << ",,,,,"
-          << (edits ? edit * 1e3 / edits : 0.0) << ",,\n";
+          << (edits ? edit * 1e3 / edits : 0.0) << ",,,,\n";
     }
     volume->SetMapper(mapper);
   }
