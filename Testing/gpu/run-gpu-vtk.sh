@@ -16,6 +16,9 @@
 #          window blended), :float (float interop texture), alone and all together, twice in one
 #          process: FRAME_ITEMS) interop-memcheck (compute-sanitizer memcheck on the window
 #          benchmark with the image kept on the GPU, 8-bit and float: memcheck.log)
+#          nsys-frame (Nsight Systems timeline of the window benchmark, N-body 2048^3 Auto:hw and
+#          :sync:full:float, 8 frames and 2 edits each: CUDA API and GPU work per call, OpenGL
+#          calls, waits; summaries in nsys.log, the CUDA/GL traces as CSV in logs.tgz)
 #          bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
 #          volume-only scene skips) bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
 #          shading, window and CLI, N-body and Menger 1024^3: modes.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
@@ -203,7 +206,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
 # vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -245,6 +248,26 @@ if has interop-memcheck && ! late; then
   log "interop memcheck rc=$rc"
   [ $rc -eq 0 ] || status=1
   { echo "==== interop memcheck rc=$rc"; grep -E "ERROR SUMMARY|Invalid|image on the GPU|through host|^Auto|^Grid" "$work/interop-memcheck.log" | head -30; } >> "$out/memcheck.log"
+fi
+# Where the frame's time goes on the GPU and the host, call by call (Nsight Systems, when installed).
+if has nsys-frame && ! late; then
+  if command -v nsys > /dev/null; then
+    log "nsys frame profile"
+    SPACESKIP_BACKEND=cuda timeout 420 nsys profile --trace=cuda,opengl,osrt --sample=none --cpuctxsw=none \
+      --force-overwrite=true -o "$work/frame" "$bench" --shape nbody --dims "${BENCH_N:-2048}" --frames 8 \
+      --size 1024 --builders Auto:hw,Auto:hw:sync:full:float --edits 2 "${v2[@]}" > "$work/nsys-run.log" 2>&1
+    log "nsys rc=$?"
+    for r in cuda_api_sum cuda_gpu_sum osrt_sum opengl_khr_range_sum; do
+      nsys stats --report $r --format column "$work/frame.nsys-rep" >> "$work/nsys.log" 2>&1
+    done
+    nsys stats --report cuda_gpu_trace --report cuda_api_trace --format csv --output "$work/nsys" \
+      "$work/frame.nsys-rep" >> "$work/nsys-run.log" 2>&1
+    rm -f "$work/frame.nsys-rep" "$work/frame.sqlite"
+    { grep -E "^item|^Auto|^empty" "$work/nsys-run.log"; cat "$work/nsys.log"; } > "$out/nsys.log"
+  else
+    log "nsys-frame: no nsys on this machine"
+    echo "no nsys on this machine" > "$out/nsys.log"
+  fi
 fi
 # Early ray termination on (VTK's mapper cannot turn it off): like for like with its rows above.
 if has bench-ert; then
