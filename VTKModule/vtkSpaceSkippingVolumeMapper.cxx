@@ -482,7 +482,19 @@ double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
   {
     return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds);
   }
-  return this->Internals->Engine ? this->Internals->Engine->frameStats(false).seconds : 0.0;
+  spaceskip::Engine* engine = this->Internals->Engine.get();
+  if (!engine)
+  {
+    return 0.0;
+  }
+  // With the image kept on the GPU the engine returns once the kernel is launched: the pass is
+  // the kernel's time (this waits for it).
+  if (engine->deviceImage())
+  {
+    const spaceskip::FrameStats& f = engine->frameStats();
+    return f.deviceSeconds > 0 ? f.deviceSeconds : f.seconds;
+  }
+  return engine->frameStats(false).seconds;
 }
 double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
 {

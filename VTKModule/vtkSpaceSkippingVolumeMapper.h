@@ -328,7 +328,8 @@ public:
    * - EngineRender: the engine's frame: depth upload, kernel, image readback (CUDA), or the
    *   CPU ray march; GetLastRenderSeconds() is the same frame as the engine timed it. With the
    *   image kept on the GPU (GPUComposite) the host does not wait for the kernel: this is its
-   *   launch, and the GPU finishes the frame after Render() returns;
+   *   launch, the GPU finishes the frame after Render() returns, and GetLastRenderSeconds() is
+   *   the kernel's time (asking for it waits for the frame);
    * - Kernel: the render kernel alone (CUDA events; with the image kept on the GPU asking for it
    *   waits for the frame), or the CPU frame on the CPU backend;
    * - Composite: image texture upload (or the interop copy's submission) and the blending quad;
