@@ -3,6 +3,7 @@
 #include "vtkSpaceSkipBlockRenderer.h"
 
 #include "spaceskip/PieceOrder.h"
+#include "vtkSpaceSkipPieceCompositing.h"
 
 #include "vtkCamera.h"
 #include "vtkCellData.h"
@@ -272,6 +273,10 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   std::string& problem)
 {
   this->Active = true;
+  if (this->SumImage)
+  {
+    this->SumImage->rgba.clear(); // DrawSum() draws this frame's blocks or nothing
+  }
   auto* cds = vtkCompositeDataSet::SafeDownCast(input);
   std::vector<vtkImageData*> images;
   std::set<std::string> others;
@@ -479,7 +484,13 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   // Composite and isosurface blending accumulate opacity along the ray; the other modes'
   // blocks are blended over one another (not exact across block faces: see README).
   const int mode = parent->EffectiveBlendMode();
-  const bool carry = this->OnLattice &&
+  const int* given = parent->GetWholeExtent();
+  const bool anchored = given[0] <= given[1] && given[2] <= given[3] && given[4] <= given[5];
+  // MPI with a piece exchange: each block's image goes to the exchange on its own (another
+  // rank's blocks may lie between two of ours along a ray), without the carried opacity.
+  std::vector<vtkSpaceSkippingVolumeMapper::PieceImage>* pieces =
+    this->OnLattice && anchored ? this->ExchangePieces : nullptr;
+  const bool carry = this->OnLattice && !pieces &&
     (mode == vtkVolumeMapper::COMPOSITE_BLEND || mode == vtkVolumeMapper::ISOSURFACE_BLEND);
   bool drew = false;
   for (size_t i : order)
@@ -495,6 +506,10 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
       continue;
     }
     drew = true;
+    if (pieces)
+    {
+      pieces->push_back(vtkSpaceSkipPieceCompositing::Crop(img, w, h, this->Blocks[i].Owned));
+    }
     spaceskip::vec4f* out = sum.rgba.data();
     float* alpha = this->Alpha.data();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, size_t(1) << 14),
@@ -517,8 +532,11 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   {
     return true; // the blocks said why (or none was in view)
   }
-  const int* given = parent->GetWholeExtent();
-  if (this->OnLattice && carry && given[0] <= given[1] && given[2] <= given[3] && given[4] <= given[5])
+  if (pieces)
+  {
+    return true; // the parent hands them to the exchange (DrawSum() if that is off)
+  }
+  if (this->OnLattice && carry && anchored)
   {
     // Under MPI IceT blends the ranks' images in 8 bits and truncates: where a ray goes on into
     // another rank's blocks, this rank's colour is raised by half a unit, as a single piece's is
@@ -842,6 +860,32 @@ bool vtkSpaceSkipBlockRenderer::PlanLattice(
   }
   std::copy(whole, whole + 6, this->WholeExtent);
   return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipBlockRenderer::ExchangeCamera(
+  vtkRenderer* ren, vtkVolume* vol, double eye[3], double dir[3], bool& parallel) const
+{
+  const int none[3] = { 0, 0, 0 };
+  if (this->Lattice && ren && vol && ren->GetActiveCamera())
+  {
+    vtkSpaceSkipPieceCompositing::CameraInIndexSpace(ren, vol, this->Lattice, none, eye, dir, parallel);
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipBlockRenderer::DrawSum(vtkRenderer* ren)
+{
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (!this->SumImage || this->SumImage->rgba.empty() || !renWin)
+  {
+    return;
+  }
+  if (!this->Compositor)
+  {
+    this->Compositor.reset(new vtkSpaceSkipCompositor);
+  }
+  this->Compositor->Draw(renWin, *this->SumImage, this->SumImage->width, this->SumImage->height, false);
 }
 
 //------------------------------------------------------------------------------

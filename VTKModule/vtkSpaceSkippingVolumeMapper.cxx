@@ -6,6 +6,8 @@
 
 #include "vtkCellData.h"
 #include "vtkDataSetAttributes.h"
+#include "vtkFloatArray.h"
+#include "vtkPointData.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkStructuredData.h"
@@ -22,6 +24,7 @@
 #include "vtkSpaceSkipBlockRenderer.h"
 #include "vtkSpaceSkipCompositor.h"
 #include "vtkSpaceSkipInputConverter.h"
+#include "vtkSpaceSkipPieceCompositing.h"
 #include "vtkSpaceSkipPropertyTranslator.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
@@ -29,7 +32,6 @@
 
 #include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
-#include "spaceskip/PieceOrder.h"
 
 #include <chrono>
 #include <cstdio>
@@ -214,6 +216,10 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   spaceskip::VolumePiece LastPiece; // the piece the last frame drew (inactive: the whole input)
   // Float compositing across processes (SetPieceExchange), and the image it hands back.
   std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange> Exchange;
+  double WholeBounds[6] = { 1, -1, 1, -1, 1, -1 };
+  // GetInput() of a process with an empty piece (see there), and the array name it carries.
+  vtkSmartPointer<vtkImageData> EmptyPiece;
+  std::string EmptyPieceArray;
   spaceskip::Image Exchanged;
   const float* FrameDepth = nullptr; // this frame's depth (the compositor's buffer), or null
   // Last, so that it goes (with its CUDA-GL interop registration) before the engine.
@@ -709,6 +715,14 @@ void vtkSpaceSkippingVolumeMapper::SetPieceExchange(const std::shared_ptr<PieceE
     this->Modified();
   }
 }
+void vtkSpaceSkippingVolumeMapper::SetWholeBounds(const double bounds[6])
+{
+  if (!std::equal(bounds, bounds + 6, this->Internals->WholeBounds))
+  {
+    std::copy(bounds, bounds + 6, this->Internals->WholeBounds);
+    this->Modified();
+  }
+}
 const std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange>&
 vtkSpaceSkippingVolumeMapper::GetPieceExchange() const
 {
@@ -717,173 +731,120 @@ vtkSpaceSkippingVolumeMapper::GetPieceExchange() const
 
 namespace
 {
-// Whether the mapper draws a vtkImageData piece of a larger image (WholeExtent given).
-bool IsImagePiece(vtkSpaceSkippingVolumeMapper* self, const int whole[6])
+// Whether the mapper draws a piece of a larger image (WholeExtent given): a vtkImageData piece
+// (`blocks` false) or composite input whose blocks lie on its lattice (`blocks` true).
+bool IsPiece(vtkSpaceSkippingVolumeMapper* self, const int whole[6], bool& blocks)
 {
   vtkDataObject* input =
     self->GetNumberOfInputConnections(0) > 0 ? self->GetInputDataObject(0, 0) : nullptr;
-  return whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5] &&
-    !vtkSpaceSkipBlockRenderer::IsComposite(input);
+  blocks = vtkSpaceSkipBlockRenderer::IsComposite(input);
+  return whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5];
 }
 }
 
 //------------------------------------------------------------------------------
-// With a piece exchange (MPI): every process draws its piece exactly into a float image, the
-// exchange composites them in float on one process, which draws the sum; the others draw
-// nothing. Every call reaches Finish(), whatever the piece drew (the others wait for it).
+// With a piece exchange (MPI): every process draws its piece (or each of its blocks) exactly
+// into a float image, the exchange composites them all in float on one process, which draws the
+// sum; the others draw nothing. Every call reaches Finish(), whatever the piece drew (the
+// others wait for it).
 void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
   vtkInternals& d = *this->Internals;
   const std::shared_ptr<PieceExchange> exchange = d.Exchange;
-  if (!exchange || !IsImagePiece(this, this->WholeExtent))
+  bool blocks = false;
+  if (!exchange || !ren || !IsPiece(this, this->WholeExtent, blocks))
   {
     this->RenderLocal(ren, vol);
     return;
   }
+  namespace pc = vtkSpaceSkipPieceCompositing;
   exchange->Begin();
-  const bool defer = this->DeferDraw;
-  this->DeferDraw = true;
-  this->ExactPiece = true;
-  d.LastPiece = spaceskip::VolumePiece();
-  this->RenderLocal(ren, vol);
-  this->DeferDraw = defer;
-  this->ExactPiece = false;
-
-  int width = 0, height = 0;
-  const float* image = this->GetDeferredImage(width, height);
-  auto* input = vtkImageData::SafeDownCast(this->GetInput());
-  vtkCamera* cam = ren ? ren->GetActiveCamera() : nullptr;
-  if (!image || !input || !cam || !vol)
+  std::vector<PieceImage> mine;
+  double eye[3] = { 0, 0, 0 }, dir[3] = { 0, 0, 1 };
+  bool parallel = false;
+  const float* image = nullptr; // an image piece's own frame (drawn if the exchange is off)
+  if (blocks)
   {
-    image = nullptr;
-    int x0 = 0, y0 = 0;
-    if (ren)
+    // The block renderer leaves its blocks' images (on the whole image's lattice) to us.
+    d.Blocks.SetExchangePieces(&mine);
+    this->RenderLocal(ren, vol);
+    d.Blocks.SetExchangePieces(nullptr);
+    d.Blocks.ExchangeCamera(ren, vol, eye, dir, parallel);
+  }
+  else
+  {
+    const bool defer = this->DeferDraw;
+    this->DeferDraw = true;
+    this->ExactPiece = true;
+    d.LastPiece = spaceskip::VolumePiece();
+    d.DeferredReady = false;
+    auto* data = vtkDataSet::SafeDownCast(this->GetInputDataObject(0, 0));
+    if (data && data->GetNumberOfPoints() > 0)
     {
-      ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+      this->RenderLocal(ren, vol); // an empty piece draws nothing (and says nothing)
+    }
+    this->DeferDraw = defer;
+    this->ExactPiece = false;
+    int w = 0, h = 0;
+    image = this->GetDeferredImage(w, h);
+    auto* input = vtkImageData::SafeDownCast(this->GetInput());
+    if (image && input && vol && ren->GetActiveCamera())
+    {
+      // The cells drawn and the camera, in the whole extent's index space (less its first index).
+      const spaceskip::VolumePiece& p = d.LastPiece;
+      int ext[6], owned[6];
+      input->GetExtent(ext);
+      const int shift[3] = { this->WholeExtent[0], this->WholeExtent[2], this->WholeExtent[4] };
+      for (int a = 0; a < 3; ++a)
+      {
+        owned[2 * a] = p.active() ? static_cast<int>(p.ownedLo[a]) : ext[2 * a] - shift[a];
+        owned[2 * a + 1] = p.active() ? static_cast<int>(p.ownedHi[a])
+                                      : std::max(ext[2 * a + 1], ext[2 * a] + 1) - shift[a];
+      }
+      mine.push_back(pc::Crop(image, w, h, owned));
+      pc::CameraInIndexSpace(ren, vol, input, shift, eye, dir, parallel);
+    }
+    else
+    {
+      image = nullptr;
     }
   }
-  PieceImage mine;
-  if (image)
-  {
-    // The cells drawn, in the whole extent's index space (the piece's own cells, or all of it).
-    const spaceskip::VolumePiece& p = d.LastPiece;
-    int ext[6];
-    input->GetExtent(ext);
-    for (int a = 0; a < 3; ++a)
-    {
-      mine.Owned[2 * a] =
-        p.active() ? static_cast<int>(p.ownedLo[a]) : ext[2 * a] - this->WholeExtent[2 * a];
-      mine.Owned[2 * a + 1] = p.active()
-        ? static_cast<int>(p.ownedHi[a])
-        : std::max(ext[2 * a + 1], ext[2 * a] + 1) - this->WholeExtent[2 * a];
-    }
-    // The rectangle of the pixels drawn (often a small part of the viewport).
-    int x0 = width, y0 = height, x1 = -1, y1 = -1;
-    for (int y = 0; y < height; ++y)
-    {
-      const float* c = image + 4 * size_t(y) * size_t(width);
-      for (int x = 0; x < width; ++x, c += 4)
-      {
-        if (c[0] != 0.f || c[1] != 0.f || c[2] != 0.f || c[3] != 0.f)
-        {
-          x0 = std::min(x0, x);
-          x1 = std::max(x1, x);
-          y0 = std::min(y0, y);
-          y1 = std::max(y1, y);
-        }
-      }
-    }
-    if (x1 >= x0)
-    {
-      mine.X = x0;
-      mine.Y = y0;
-      mine.Width = x1 - x0 + 1;
-      mine.Height = y1 - y0 + 1;
-      mine.Pixels.resize(4 * size_t(mine.Width) * size_t(mine.Height));
-      for (int y = 0; y < mine.Height; ++y)
-      {
-        const float* src = image + 4 * (size_t(y0 + y) * size_t(width) + size_t(x0));
-        std::copy(src, src + 4 * size_t(mine.Width), mine.Pixels.data() + 4 * size_t(y) * size_t(mine.Width));
-      }
-    }
-  }
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
   std::vector<PieceImage> others;
   const int draw = exchange->Finish(width, height, mine, others);
-  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren ? ren->GetRenderWindow() : nullptr);
-  if (draw == 0 || !renWin || width <= 0 || height <= 0 || (draw == -1 && !image))
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (draw == 0 || !renWin || width <= 0 || height <= 0)
   {
     return;
   }
   spaceskip::Image& img = d.Exchanged;
-  img.width = width;
-  img.height = height;
-  const size_t pixels = size_t(width) * size_t(height);
   if (draw == -1)
   {
+    // The exchange is off: this process's own pieces, as without it.
+    if (blocks)
+    {
+      d.Blocks.DrawSum(ren);
+      return;
+    }
+    if (!image)
+    {
+      return;
+    }
+    img.width = width;
+    img.height = height;
     img.rgba.assign(reinterpret_cast<const spaceskip::vec4f*>(image),
-      reinterpret_cast<const spaceskip::vec4f*>(image) + pixels);
+      reinterpret_cast<const spaceskip::vec4f*>(image) + size_t(width) * size_t(height));
   }
   else
   {
-    // Every piece front to back in the order the rays meet them (the camera in the whole
-    // extent's index space), blended in float: one rounding to 8 bits, as the serial image.
-    double eye[3] = { 0, 0, 0 }, dir[3] = { 0, 0, 1 };
-    const bool parallel = cam && cam->GetParallelProjection() != 0;
-    if (cam && vol && input)
+    // Every piece front to back in the order the rays meet them, blended in float: one
+    // rounding to 8 bits, as the serial image.
+    for (PieceImage& p : mine)
     {
-      double e[4], f[4], dop[3];
-      cam->GetPosition(e);
-      cam->GetDirectionOfProjection(dop);
-      e[3] = f[3] = 1.0;
-      for (int a = 0; a < 3; ++a)
-      {
-        f[a] = e[a] + dop[a];
-      }
-      vtkNew<vtkMatrix4x4> toData;
-      vtkMatrix4x4::Invert(vol->GetMatrix(), toData);
-      toData->MultiplyPoint(e, e);
-      toData->MultiplyPoint(f, f);
-      double ei[3], fi[3];
-      input->TransformPhysicalPointToContinuousIndex(e, ei);
-      input->TransformPhysicalPointToContinuousIndex(f, fi);
-      for (int a = 0; a < 3; ++a)
-      {
-        eye[a] = ei[a] - this->WholeExtent[2 * a];
-        dir[a] = fi[a] - ei[a];
-      }
+      others.push_back(std::move(p));
     }
-    others.push_back(std::move(mine));
-    std::vector<spaceskip::PieceBox> boxes;
-    std::vector<const PieceImage*> parts;
-    for (const PieceImage& p : others)
-    {
-      const int* o = p.Owned;
-      if (p.Width > 0 && p.Height > 0 && o[0] < o[1] && o[2] < o[3] && o[4] < o[5] && p.X >= 0 &&
-        p.Y >= 0 && p.X + p.Width <= width && p.Y + p.Height <= height &&
-        p.Pixels.size() == 4 * size_t(p.Width) * size_t(p.Height))
-      {
-        boxes.push_back({ double(o[0]), double(o[1]), double(o[2]), double(o[3]), double(o[4]), double(o[5]) });
-        parts.push_back(&p);
-      }
-    }
-    img.rgba.assign(pixels, spaceskip::vec4f{ 0, 0, 0, 0 });
-    for (size_t i : spaceskip::visibilityOrder(boxes, eye, dir, parallel))
-    {
-      const PieceImage& p = *parts[i];
-      for (int y = 0; y < p.Height; ++y)
-      {
-        const float* src = p.Pixels.data() + 4 * size_t(y) * size_t(p.Width);
-        spaceskip::vec4f* dst = img.rgba.data() + size_t(p.Y + y) * size_t(width) + size_t(p.X);
-        for (int x = 0; x < p.Width; ++x, src += 4, ++dst)
-        {
-          const float t = 1.f - dst->w;
-          dst->x += t * src[0];
-          dst->y += t * src[1];
-          dst->z += t * src[2];
-          dst->w += t * src[3];
-        }
-      }
-    }
+    pc::Blend(others, eye, dir, parallel, width, height, img);
   }
   if (!d.Compositor.Draw(renWin, img, width, height, this->EightBitComposite != 0))
   {
@@ -1008,23 +969,11 @@ double* vtkSpaceSkippingVolumeMapper::GetBounds()
   // Exchanging pieces, every process must draw every frame: its volume reports the whole
   // image's bounds, so that no renderer culls a piece that is out of view (or empty) while the
   // others wait for it.
-  auto* image = this->Internals->Exchange && IsImagePiece(this, this->WholeExtent)
-    ? vtkImageData::SafeDownCast(this->GetInputDataObject(0, 0))
-    : nullptr;
-  if (image)
+  bool blocks = false;
+  if (this->Internals->Exchange && IsPiece(this, this->WholeExtent, blocks) &&
+    vtkMath::AreBoundsInitialized(this->Internals->WholeBounds))
   {
-    vtkMath::UninitializeBounds(this->Bounds);
-    const int* w = this->WholeExtent;
-    for (int c = 0; c < 8; ++c)
-    {
-      double p[3];
-      image->TransformIndexToPhysicalPoint(w[(c & 1) ? 1 : 0], w[(c & 2) ? 3 : 2], w[(c & 4) ? 5 : 4], p);
-      for (int a = 0; a < 3; ++a)
-      {
-        this->Bounds[2 * a] = c == 0 ? p[a] : std::min(this->Bounds[2 * a], p[a]);
-        this->Bounds[2 * a + 1] = c == 0 ? p[a] : std::max(this->Bounds[2 * a + 1], p[a]);
-      }
-    }
+    std::copy(this->Internals->WholeBounds, this->Internals->WholeBounds + 6, this->Bounds);
     return this->Bounds;
   }
   if (this->GetNumberOfInputConnections(0) == 0 ||
@@ -1042,11 +991,42 @@ vtkDataSet* vtkSpaceSkippingVolumeMapper::GetInput()
 {
   vtkDataObject* input =
     this->GetNumberOfInputConnections(0) > 0 ? this->GetInputDataObject(0, 0) : nullptr;
-  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
+  vtkDataSet* data = vtkSpaceSkipBlockRenderer::IsComposite(input)
+    ? vtkSpaceSkipBlockRenderer::FirstImage(input)
+    : this->Superclass::GetInput();
+  bool blocks = false;
+  if (!this->Internals->Exchange || !IsPiece(this, this->WholeExtent, blocks))
   {
-    return vtkSpaceSkipBlockRenderer::FirstImage(input);
+    return data;
   }
-  return this->Superclass::GetInput();
+  // Exchanging pieces, a process with an empty piece must still draw every frame (the others
+  // wait for it), and ParaView's vtkPVLODVolume draws a mapper only when GetInput() has the
+  // selected scalars: an empty image with an empty array of that name stands in.
+  int unused = 0;
+  if (data && vtkAbstractMapper::GetScalars(data, this->ScalarMode, this->ArrayAccessMode,
+                this->ArrayId, this->ArrayName, unused))
+  {
+    return data;
+  }
+  vtkInternals& d = *this->Internals;
+  const std::string name = this->ArrayName ? this->ArrayName : "";
+  if (!d.EmptyPiece || d.EmptyPieceArray != name)
+  {
+    d.EmptyPiece = vtkSmartPointer<vtkImageData>::New();
+    for (vtkDataSetAttributes* attributes : { static_cast<vtkDataSetAttributes*>(d.EmptyPiece->GetPointData()),
+           static_cast<vtkDataSetAttributes*>(d.EmptyPiece->GetCellData()) })
+    {
+      for (int i = 0; i <= std::max(this->ArrayId, 0) && i < 16; ++i)
+      {
+        vtkNew<vtkFloatArray> array;
+        array->SetName(i == 0 && !name.empty() ? name.c_str() : ("empty piece " + std::to_string(i)).c_str());
+        attributes->AddArray(array);
+      }
+      attributes->SetActiveScalars(attributes->GetAbstractArray(0)->GetName());
+    }
+    d.EmptyPieceArray = name;
+  }
+  return d.EmptyPiece;
 }
 
 //------------------------------------------------------------------------------

@@ -376,9 +376,10 @@ public:
   /**
    * Float compositing of the pieces of several processes (ParaView's ranks under MPI; set by
    * vtkSpaceSkipVolumeRepresentation with its MPI implementation). While one is set and the input
-   * is a vtkImageData piece of a larger image (WholeExtent), every Render() calls Begin(),
-   * renders the piece exactly (no 8-bit rounding bias) into a float image and hands it to
-   * Finish(), whose answer says what this process draws: the pieces of all processes composited
+   * is a piece of a larger image (WholeExtent: a vtkImageData piece, or composite input whose
+   * blocks lie on the whole image's lattice), every Render() calls Begin(), renders the piece (or
+   * each block) exactly (no 8-bit rounding bias) into a float image and hands them to Finish(),
+   * whose answer says what this process draws: the pieces of all processes composited
    * in float on one of them, nothing on the others, so that the 8-bit compositing that follows
    * (IceT) only adds empty images to one exact image.
    */
@@ -398,14 +399,19 @@ public:
     /// At the start of Render(), before the piece is drawn.
     virtual void Begin() = 0;
     /**
-     * Hands over this process's piece of a `width` x `height` viewport. Returns 1 with the
-     * other processes' pieces in `others` (this process composites and draws them all), 0 (draw
-     * nothing here: another process draws this piece), or -1 (the exchange is off: draw the
-     * piece here, the 8-bit path).
+     * Hands over this process's pieces (one for an image piece, one per block for partitioned
+     * input) of a `width` x `height` viewport. Returns 1 with the other processes' pieces in
+     * `others` (this process composites and draws them all), 0 (draw nothing here: another
+     * process draws these pieces), or -1 (the exchange is off: draw them here, the 8-bit path).
      */
-    virtual int Finish(int width, int height, PieceImage& mine, std::vector<PieceImage>& others) = 0;
+    virtual int Finish(int width, int height, std::vector<PieceImage>& mine,
+      std::vector<PieceImage>& others) = 0;
   };
   void SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange);
+  /// The whole image's bounds, the same on every process: while a PieceExchange is set the
+  /// volume reports them (GetBounds()), so that no renderer culls a piece that is out of view
+  /// or empty while the others wait for it. Uninitialized (the default): the input's own.
+  void SetWholeBounds(const double bounds[6]);
   const std::shared_ptr<PieceExchange>& GetPieceExchange() const;
 #endif
 

@@ -10,10 +10,13 @@ namespace
 {
 // Tags on the exchange's own communicator.
 constexpr int kBeginTag = 11;   // {frame}: a rank began drawing the frame
-constexpr int kHeaderTag = 12;  // {frame, width, height, x, y, w, h, owned[6]}: its image's rectangle
-constexpr int kDataTag = 13;    // the rectangle's RGBA floats, rows bottom up
+constexpr int kHeaderTag = 12;  // {frame, width, height, pieces}
+constexpr int kBoxesTag = 15;   // per piece {x, y, w, h, owned[6]}: its rectangle and cells
+constexpr int kDataTag = 13;    // the rectangles' RGBA floats, rows bottom up, piece after piece
 constexpr int kVerdictTag = 14; // {frame, 1: composited | 0: gave up}, rank 0 to the others
-constexpr int kHeaderInts = 13;
+constexpr int kHeaderInts = 4;
+constexpr int kBoxInts = 10;
+constexpr int kMaxPieces = 1 << 16;
 
 using Clock = std::chrono::steady_clock;
 using Request = vtkMPICommunicator::Request;
@@ -185,7 +188,7 @@ void vtkSpaceSkipMPIExchange::Begin()
 
 //------------------------------------------------------------------------------
 int vtkSpaceSkipMPIExchange::Finish(
-  int width, int height, PieceImage& mine, std::vector<PieceImage>& others)
+  int width, int height, std::vector<PieceImage>& mine, std::vector<PieceImage>& others)
 {
   if (this->Failed)
   {
@@ -195,13 +198,23 @@ int vtkSpaceSkipMPIExchange::Finish(
   {
     return this->FinishRoot(width, height, others);
   }
-  std::vector<int> header = { static_cast<int>(this->Frame), width, height, mine.X, mine.Y,
-    mine.Width, mine.Height };
-  header.insert(header.end(), mine.Owned, mine.Owned + 6);
-  this->Send(std::move(header), {}, 0, kHeaderTag);
-  if (!mine.Pixels.empty())
+  std::vector<int> boxes;
+  std::vector<float> pixels;
+  for (PieceImage& p : mine)
   {
-    this->Send({}, std::move(mine.Pixels), 0, kDataTag);
+    boxes.insert(boxes.end(), { p.X, p.Y, p.Width, p.Height });
+    boxes.insert(boxes.end(), p.Owned, p.Owned + 6);
+    pixels.insert(pixels.end(), p.Pixels.begin(), p.Pixels.end());
+  }
+  this->Send({ static_cast<int>(this->Frame), width, height, static_cast<int>(mine.size()) }, {}, 0,
+    kHeaderTag);
+  if (!boxes.empty())
+  {
+    this->Send(std::move(boxes), {}, 0, kBoxesTag);
+  }
+  if (!pixels.empty())
+  {
+    this->Send({}, std::move(pixels), 0, kDataTag);
   }
   this->VerdictPending = true;
   return 0;
@@ -235,7 +248,7 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
       return -1;
     }
   }
-  // Their rectangles and cells, then the pixels.
+  // What each rank drew: its header, its pieces' rectangles and cells, then their pixels.
   std::vector<int> headers(size_t(n) * kHeaderInts, 0);
   for (int r = 1; r < this->Size; ++r)
   {
@@ -246,39 +259,77 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
     this->GiveUp("a rank did not send its image");
     return -1;
   }
-  others.assign(n, PieceImage());
-  std::vector<Request> dataReqs;
+  std::vector<std::vector<int>> boxes(n);
+  reqs.clear();
   for (int r = 1; r < this->Size; ++r)
   {
     const int* h = &headers[size_t(r - 1) * kHeaderInts];
-    if (h[0] != this->Frame || h[1] != width || h[2] != height)
+    if (h[0] != this->Frame || h[1] != width || h[2] != height || h[3] < 0 || h[3] > kMaxPieces)
     {
       this->GiveUp(h[0] != this->Frame ? "the ranks are on different frames"
-                                       : "the ranks' viewports differ");
+          : h[3] < 0 || h[3] > kMaxPieces ? "a rank sent a bad piece count"
+                                          : "the ranks' viewports differ");
       return -1;
     }
-    PieceImage& p = others[r - 1];
-    p.X = h[3];
-    p.Y = h[4];
-    p.Width = h[5];
-    p.Height = h[6];
-    std::copy(h + 7, h + 13, p.Owned);
-    if (p.Width > 0 && p.Height > 0)
+    if (h[3] > 0)
     {
-      if (p.X < 0 || p.Y < 0 || p.X + p.Width > width || p.Y + p.Height > height)
+      boxes[r - 1].resize(size_t(h[3]) * kBoxInts);
+      reqs.emplace_back();
+      comm->NoBlockReceive(boxes[r - 1].data(), static_cast<int>(boxes[r - 1].size()), r, kBoxesTag,
+        reqs.back());
+    }
+  }
+  if (!WaitAll(reqs, After(this->ImageSeconds)))
+  {
+    this->GiveUp("a rank did not send its pieces");
+    return -1;
+  }
+  std::vector<std::vector<float>> pixels(n);
+  reqs.clear();
+  for (int r = 1; r < this->Size; ++r)
+  {
+    size_t total = 0;
+    for (size_t k = 0; k < boxes[r - 1].size(); k += kBoxInts)
+    {
+      const int* b = &boxes[r - 1][k];
+      if (b[2] < 0 || b[3] < 0 || (b[2] > 0 && b[3] > 0 &&
+        (b[0] < 0 || b[1] < 0 || b[0] + b[2] > width || b[1] + b[3] > height)))
       {
         this->GiveUp("a rank sent a rectangle outside the viewport");
         return -1;
       }
-      p.Pixels.resize(4 * size_t(p.Width) * size_t(p.Height));
-      dataReqs.emplace_back();
-      comm->NoBlockReceive(p.Pixels.data(), static_cast<int>(p.Pixels.size()), r, kDataTag, dataReqs.back());
+      total += 4 * size_t(b[2]) * size_t(b[3]);
+    }
+    if (total > 0)
+    {
+      pixels[r - 1].resize(total);
+      reqs.emplace_back();
+      comm->NoBlockReceive(pixels[r - 1].data(), static_cast<int>(total), r, kDataTag, reqs.back());
     }
   }
-  if (!WaitAll(dataReqs, After(this->ImageSeconds)))
+  if (!WaitAll(reqs, After(this->ImageSeconds)))
   {
     this->GiveUp("a rank's image did not arrive");
     return -1;
+  }
+  others.clear();
+  for (int r = 1; r < this->Size; ++r)
+  {
+    const float* px = pixels[r - 1].data();
+    for (size_t k = 0; k < boxes[r - 1].size(); k += kBoxInts)
+    {
+      const int* b = &boxes[r - 1][k];
+      PieceImage p;
+      p.X = b[0];
+      p.Y = b[1];
+      p.Width = b[2];
+      p.Height = b[3];
+      std::copy(b + 4, b + 10, p.Owned);
+      const size_t count = 4 * size_t(std::max(p.Width, 0)) * size_t(std::max(p.Height, 0));
+      p.Pixels.assign(px, px + count);
+      px += count;
+      others.push_back(std::move(p));
+    }
   }
   for (int r = 1; r < this->Size; ++r)
   {

@@ -44,7 +44,8 @@ public:
 
   using PieceImage = vtkSpaceSkippingVolumeMapper::PieceImage;
   void Begin() override;
-  int Finish(int width, int height, PieceImage& mine, std::vector<PieceImage>& others) override;
+  int Finish(int width, int height, std::vector<PieceImage>& mine,
+    std::vector<PieceImage>& others) override;
 
   /// Whether it gave up (the ranks draw their own pieces).
   bool GaveUp() const { return this->Failed; }

@@ -140,6 +140,29 @@ bool GatherLattice(vtkMultiProcessController* controller, const std::vector<vtkI
   }
   return true;
 }
+
+// The bounds of all ranks' data (collective; uninitialized when no rank has data).
+void GatherBounds(vtkMultiProcessController* controller, const double local[6], double global[6])
+{
+  double lo[6], out[6];
+  const bool have = vtkMath::AreBoundsInitialized(local);
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = have ? local[2 * a] : VTK_DOUBLE_MAX;
+    lo[3 + a] = have ? -local[2 * a + 1] : VTK_DOUBLE_MAX;
+  }
+  controller->AllReduce(lo, out, 6, vtkCommunicator::MIN_OP);
+  vtkMath::UninitializeBounds(global);
+  if (out[0] == VTK_DOUBLE_MAX)
+  {
+    return;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    global[2 * a] = out[a];
+    global[2 * a + 1] = -out[3 + a];
+  }
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -242,6 +265,12 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   this->WholeRanges.clear();
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   this->UpdateExchange(controller);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    double whole[6];
+    GatherBounds(controller, this->DataBounds, whole);
+    this->SpaceSkipMapper->SetWholeBounds(whole);
+  }
   vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
     ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
@@ -370,6 +399,13 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
   this->SpaceSkipMapper->SetWholeExtent(wholeExtent);
 
   cache->GetBounds(this->DataBounds);
+  this->UpdateExchange(controller);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    double whole[6];
+    GatherBounds(controller, this->DataBounds, whole);
+    this->SpaceSkipMapper->SetWholeBounds(whole);
+  }
   if (vtkMath::AreBoundsInitialized(this->DataBounds))
   {
     this->OutlineSource->SetBounds(this->DataBounds);

@@ -64,17 +64,26 @@ int main(int argc, char* argv[])
   // Frame 1: both draw; rank 0 gets rank 1's piece bit for bit and draws the sum.
   {
     ex->Begin();
-    auto mine = Piece(rank);
+    // Rank 1 has two pieces (as blocks of partitioned input), the second drew nothing.
+    std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> mine{ Piece(rank) };
+    if (rank == 1)
+    {
+      mine.push_back(Piece(1));
+      mine.back().Width = mine.back().Height = 0;
+      mine.back().Pixels.clear();
+      mine.back().Owned[4] = 64;
+    }
     std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> others;
     const int r = ex->Finish(300, 200, mine, others);
     if (rank == 0)
     {
       const auto expected = Piece(1);
-      const bool same = others.size() == 1 && others[0].X == expected.X &&
+      const bool same = others.size() == 2 && others[0].X == expected.X &&
         others[0].Y == expected.Y && others[0].Width == expected.Width &&
         others[0].Height == expected.Height && others[0].Pixels == expected.Pixels &&
-        std::equal(expected.Owned, expected.Owned + 6, others[0].Owned);
-      Check(r == 1 && same, rank, "frame 1: rank 0 composites and has rank 1's piece as sent");
+        std::equal(expected.Owned, expected.Owned + 6, others[0].Owned) &&
+        others[1].Width == 0 && others[1].Pixels.empty() && others[1].Owned[4] == 64;
+      Check(r == 1 && same, rank, "frame 1: rank 0 composites and has rank 1's 2 pieces as sent");
     }
     else
     {
@@ -86,7 +95,7 @@ int main(int argc, char* argv[])
   {
     const auto t0 = Clock::now();
     ex->Begin();
-    auto mine = Piece(0);
+    std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> mine{ Piece(0) };
     std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> others;
     const int r = ex->Finish(300, 200, mine, others);
     const double waited = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -104,7 +113,7 @@ int main(int argc, char* argv[])
     for (int frame = 0; frame < 2 && r != -1; ++frame)
     {
       ex->Begin();
-      auto mine = Piece(1);
+      std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> mine{ Piece(1) };
       std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> others;
       r = ex->Finish(300, 200, mine, others);
     }
@@ -115,7 +124,7 @@ int main(int argc, char* argv[])
   {
     const auto t0 = Clock::now();
     ex->Begin();
-    auto mine = Piece(rank);
+    std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> mine{ Piece(rank) };
     std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> others;
     const int r = ex->Finish(300, 200, mine, others);
     const double waited = std::chrono::duration<double>(Clock::now() - t0).count();
