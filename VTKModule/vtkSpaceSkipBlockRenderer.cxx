@@ -1015,28 +1015,10 @@ std::vector<size_t> vtkSpaceSkipBlockRenderer::VisibilityOrder(vtkRenderer* ren,
     return ids;
   }
   // The camera in the blocks' index space.
-  vtkCamera* cam = ren->GetActiveCamera();
-  const bool parallel = cam->GetParallelProjection() != 0;
-  double eye[4], ahead[4], dop[3];
-  cam->GetPosition(eye);
-  cam->GetDirectionOfProjection(dop);
-  eye[3] = ahead[3] = 1.0;
-  for (int a = 0; a < 3; ++a)
-  {
-    ahead[a] = eye[a] + dop[a];
-  }
-  vtkNew<vtkMatrix4x4> toData;
-  vtkMatrix4x4::Invert(vol->GetMatrix(), toData);
-  toData->MultiplyPoint(eye, eye);
-  toData->MultiplyPoint(ahead, ahead);
-  vtkImageData* ref = this->Lattice;
-  double e[3], f[3], d[3];
-  ref->TransformPhysicalPointToContinuousIndex(eye, e);
-  ref->TransformPhysicalPointToContinuousIndex(ahead, f);
-  for (int a = 0; a < 3; ++a)
-  {
-    d[a] = f[a] - e[a];
-  }
+  double e[3], d[3];
+  bool parallel = false;
+  const int none[3] = { 0, 0, 0 };
+  vtkSpaceSkipPieceCompositing::CameraInIndexSpace(ren, vol, this->Lattice, none, e, d, parallel);
   // A binary space partition of the owned boxes by axis planes (spaceskip::visibilityOrder):
   // exact for any arrangement such planes separate (grids, k-d splits); else the box centres.
   std::vector<spaceskip::PieceBox> boxes;
