@@ -103,8 +103,11 @@ struct Engine::Impl {
   // once the camera has moved far (kAutoFarDegrees, or a zoom of kAutoFarZoom) from where the
   // choice was measured and then stays still, the kept structure is re-checked there against the
   // contenders (those within kAutoPrune of it when it was measured, at least the runner-up), two
-  // frames each; a moving
-  // camera (an orbit) never triggers a re-check, and one that moves during it cancels it.
+  // frames each; a moving camera (an orbit) never triggers a re-check, and one that moves during
+  // it cancels it. A frame that carries a TF or crop/clip change never builds a contender: it
+  // cancels a re-check under way and starts none, so an edit under Auto costs what the kept
+  // structure's edit costs (a user editing at a resting view would otherwise pay a contender's
+  // build on the frames that show the edits).
   struct ViewKey {
     double dir[3] = {0, 0, 0};  ///< the camera's backward axis in world space
     double zoom = 0;            ///< |proj[0][0]|
@@ -118,8 +121,10 @@ struct Engine::Impl {
     std::vector<int> frames;      ///< frames measured per candidate in the current measuring
     std::vector<int> queue;       ///< the candidates still to render in this measuring, in order
     bool standIn = false;         ///< this frame draws Grid while the kept one waits (refinement)
+    bool tfEdit = false;          ///< this frame carries a transfer-function (or crop/clip) change
     bool refined = false;         ///< the kept structure was rebuilt after a stand-in frame
-    int current = -1;             ///< the candidate built now
+    int current = -1;             ///< the candidate to draw with (built when it differs from `built`)
+    int built = -1;               ///< the candidate the backend holds, -1: none (or stale)
     int kept = -1;                ///< the kept structure (during a re-check: the one before it)
     bool exploring = false;       ///< measuring (all candidates, or a re-check)
     bool rechecking = false;      ///< this measuring is a re-check of the kept one at a new view
@@ -221,7 +226,6 @@ struct Engine::Impl {
     a.exploring = true;
     a.rechecking = recheck;
     a.round = recheck ? 0 : 1;
-    if (a.current != a.queue.front()) buildDirty = true;
     a.current = a.queue.front();
   }
 
@@ -242,7 +246,7 @@ struct Engine::Impl {
     if (afterEdit && grid > 0) std::rotate(all.begin(), all.begin() + grid, all.begin() + grid + 1);
     beginMeasuring(all, false);
     a.choice = "Auto: measuring " + std::to_string(a.candidates.size()) + " structures";
-    buildDirty = true;
+    a.built = -1;  // the candidates are new: build whatever is current
   }
 
   /// Ends a re-check without a decision: the kept structure draws the next frame.
@@ -251,7 +255,6 @@ struct Engine::Impl {
     if (!a.rechecking) return;
     a.exploring = a.rechecking = false;
     a.queue.clear();
-    if (a.current != a.kept) buildDirty = true;
     a.current = a.kept;
   }
 
@@ -277,6 +280,8 @@ struct Engine::Impl {
     AutoState& a = autoState;
     const ViewKey previous = a.lastView;
     a.lastView = view;
+    const bool tfEdit = a.tfEdit;
+    a.tfEdit = false;
     if (a.standIn) return;  // Grid stood in for the kept structure: not its frame time
     if (!a.exploring) {
       if (width != a.width || height != a.height) {
@@ -284,8 +289,10 @@ struct Engine::Impl {
         return;
       }
       // Settled: the kept structure's frame at a view far from the measured one, with the camera
-      // still since the previous frame, starts a re-check here (this frame is its first).
-      if (near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) || !near(view, previous, kAutoStillDegrees, kAutoStillZoom))
+      // still since the previous frame and no edit in this frame, starts a re-check here (this
+      // frame is its first).
+      if (tfEdit || near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) ||
+          !near(view, previous, kAutoStillDegrees, kAutoStillZoom))
         return;
       // The contenders: those within kAutoPrune of the kept one where it was measured, at least
       // the runner-up (the likeliest to overtake it at another view).
@@ -312,7 +319,6 @@ struct Engine::Impl {
       record(seconds);  // the frame just drawn: the kept one at this view
       a.queue.erase(a.queue.begin());
       a.current = a.queue.front();
-      buildDirty = true;
       return;
     }
     const bool first = !a.rechecking && a.frames == std::vector<int>(a.frames.size(), 0);
@@ -349,7 +355,6 @@ struct Engine::Impl {
       a.round = 2;
     }
     if (!a.queue.empty()) {
-      if (a.queue.front() != a.current) buildDirty = true;
       a.current = a.queue.front();
       return;
     }
@@ -370,7 +375,6 @@ struct Engine::Impl {
     a.round = 0;
     a.measuredAt = view;
     a.occupancy = backend->occupiedFraction();
-    if (best != a.current) buildDirty = true;
     a.current = a.kept = best;
     describeAutoChoice();
   }
@@ -531,6 +535,11 @@ struct Engine::Impl {
       opacityDirty = true;
       buildDirty = true;
     }
+    if (opacityDirty || colorDirty || cropClipDirty) {
+      // A TF (or crop/clip) edit: no contender is built on the frame that shows it.
+      autoState.tfEdit = true;
+      cancelRecheck();
+    }
     if (opacityDirty || cropClipDirty) {
       auto t0 = Clock::now();
       bool changed = backend->classify(scaledTF(), cropClip);
@@ -539,7 +548,6 @@ struct Engine::Impl {
       if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
       opacityDirty = cropClipDirty = false;
       if (changed) buildDirty = edited = true;
-      if (changed) cancelRecheck();  // its frames were drawn over the old occupancy
       if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
           std::fabs(backend->occupiedFraction() - autoState.occupancy) > kAutoReexplore)
         startAutoExploration(true);
@@ -556,6 +564,9 @@ struct Engine::Impl {
       tableDirty = colorDirty = false;
     }
     if (refineNow && !buildDirty) buildDirty = true;
+    // Auto: the structure to draw with is built when the backend holds another (measuring moves
+    // `current`; a cancelled re-check whose contender was never built rebuilds nothing).
+    if (build.builder == BuilderKind::Auto && autoState.current != autoState.built) buildDirty = true;
     if (buildDirty) {
       const bool isAuto = build.builder == BuilderKind::Auto;
       int use = isAuto ? autoState.current : -1;
@@ -592,6 +603,7 @@ struct Engine::Impl {
       s.classifySeconds = stats.classifySeconds;
       s.occupancy = backend->occupiedFraction();
       if (isAuto) {
+        autoState.built = use;
         autoState.buildSeconds[size_t(use)] = s.seconds;
         s.choice = autoState.choice;
         if (autoState.standIn)

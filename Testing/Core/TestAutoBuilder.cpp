@@ -269,6 +269,46 @@ TEST(AutoBuilder, AStillCameraAtAFarViewReChecksTheChoiceAnOrbitDoesNot) {
   EXPECT_EQ(kept.find(std::string("Auto: ") + builderName(e.buildStats().builder)), 0u) << kept;
 }
 
+TEST(AutoBuilder, EditsAtAStillNewViewBuildNoContender) {
+  // A user who turned the view and rests there while editing the TF: the frames showing edits
+  // draw with the kept structure (or Grid standing in for it) and build nothing else; a re-check
+  // the camera's rest started is cancelled by the edit, never finished on edit frames.
+  Scene s;
+  Engine& e = s.e;
+  Image& img = s.img;
+  auto ramp = [](float zeroUpTo, float red) {
+    return TransferFunction::fromPoints({{0, 1, 1, 1, 0.f}, {zeroUpTo, 1, 1, 1, 0.f}, {255, red, 0, 0, 0.8f}}, 0, 255, 256);
+  };
+  e.setTransferFunction(ramp(30, 1));
+  s.settle(48, 48);
+  e.render(s.cam, 48, 48, img);  // the kept one's build, when measuring ended on another
+  const std::string choice = e.buildStats().choice;
+  const std::string kept = choice.substr(6, choice.find(" (") - 6);
+  const Camera side = test::orbit(s.v, 120, 20);
+  e.render(side, 48, 48, img);
+  e.render(side, 48, 48, img);
+  ASSERT_TRUE(e.exploring()) << "test premise: a still camera far from the measured view re-checks";
+  // Edits, each followed by a quiet frame (which may start a re-check again): opacity edits that
+  // move the occupancy a little, an opacity edit that keeps it, a colour-only edit.
+  const TransferFunction edits[] = {ramp(40, 1), ramp(30, 1), ramp(31, 1), ramp(31, 0.5f), ramp(44, 0.5f)};
+  for (const TransferFunction& tf : edits) {
+    const Image naive = test::renderWith(s.v, tf, test::builder(BuilderKind::Naive), 120, 20, false, 48);
+    const int builds = e.counters().builds;
+    e.setTransferFunction(tf);
+    e.render(side, 48, 48, img);
+    const std::string used = builderName(e.buildStats().builder);
+    EXPECT_TRUE(used == kept || used == "Grid") << used << " drew an edit frame; kept " << kept;
+    EXPECT_LE(e.counters().builds, builds + 1) << "the kept structure's rebuild at most";
+    EXPECT_FALSE(e.exploring()) << "an edit frame starts no re-check";
+    EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f);
+    e.render(side, 48, 48, img);  // the quiet frame after it
+    EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f);
+  }
+  // Left alone at that view, the re-check runs to its end.
+  for (int i = 0; i < 20 && e.exploring(); ++i) e.render(side, 48, 48, img);
+  EXPECT_FALSE(e.exploring());
+}
+
 TEST(AutoBuilder, NeverSlowerThanNaiveOnEveryShapeAt256) {
   // Issue 13's CPU rule: on every generated shape at 256^3 (the paper's stand-ins among them),
   // Auto's settled frames are at least 0.95x as fast as Naive's. Ratios of frame times taken
