@@ -2,6 +2,8 @@
 // input, drawn back to front (vtkMultiBlockVolumeMapper's scheme).
 #include "vtkSpaceSkipBlockRenderer.h"
 
+#include "spaceskip/PieceOrder.h"
+
 #include "vtkCamera.h"
 #include "vtkCellData.h"
 #include "vtkCompositeDataIterator.h"
@@ -991,68 +993,19 @@ std::vector<size_t> vtkSpaceSkipBlockRenderer::VisibilityOrder(vtkRenderer* ren,
   {
     d[a] = f[a] - e[a];
   }
-  // A binary space partition of the owned boxes by axis planes: the side the rays reach first
-  // goes first. Exact for any arrangement such planes separate (grids, k-d splits); else the
-  // box centres by distance.
+  // A binary space partition of the owned boxes by axis planes (spaceskip::visibilityOrder):
+  // exact for any arrangement such planes separate (grids, k-d splits); else the box centres.
+  std::vector<spaceskip::PieceBox> boxes;
+  for (size_t k : ids)
+  {
+    const int* o = this->Blocks[k].Owned;
+    boxes.push_back({ double(o[0]), double(o[1]), double(o[2]), double(o[3]), double(o[4]), double(o[5]) });
+  }
   std::vector<size_t> out;
-  std::function<void(std::vector<size_t>&)> split = [&](std::vector<size_t>& set) {
-    if (set.size() <= 1)
-    {
-      out.insert(out.end(), set.begin(), set.end());
-      return;
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      for (size_t c : set)
-      {
-        for (int side = 0; side < 2; ++side)
-        {
-          const int plane = this->Blocks[c].Owned[2 * a + side];
-          std::vector<size_t> lo, hi;
-          bool separates = true;
-          for (size_t k : set)
-          {
-            const int* o = this->Blocks[k].Owned;
-            if (o[2 * a + 1] <= plane)
-            {
-              lo.push_back(k);
-            }
-            else if (o[2 * a] >= plane)
-            {
-              hi.push_back(k);
-            }
-            else
-            {
-              separates = false;
-              break;
-            }
-          }
-          if (!separates || lo.empty() || hi.empty())
-          {
-            continue;
-          }
-          const bool lowFirst = parallel ? d[a] > 0 : e[a] < plane;
-          split(lowFirst ? lo : hi);
-          split(lowFirst ? hi : lo);
-          return;
-        }
-      }
-    }
-    std::vector<double> dist(this->Blocks.size(), 0.0);
-    for (size_t k : set)
-    {
-      const int* o = this->Blocks[k].Owned;
-      double v[3];
-      for (int a = 0; a < 3; ++a)
-      {
-        v[a] = 0.5 * (o[2 * a] + o[2 * a + 1]) - e[a];
-      }
-      dist[k] = parallel ? vtkMath::Dot(v, d) : vtkMath::Norm(v);
-    }
-    std::stable_sort(set.begin(), set.end(), [&dist](size_t x, size_t y) { return dist[x] < dist[y]; });
-    out.insert(out.end(), set.begin(), set.end());
-  };
-  split(ids);
+  for (size_t i : spaceskip::visibilityOrder(boxes, e, d, parallel))
+  {
+    out.push_back(ids[i]);
+  }
   return out;
 }
 

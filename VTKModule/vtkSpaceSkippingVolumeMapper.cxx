@@ -9,6 +9,9 @@
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkStructuredData.h"
+#include "vtkCamera.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkLogger.h"
 #include "vtkMath.h"
@@ -26,6 +29,7 @@
 
 #include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
+#include "spaceskip/PieceOrder.h"
 
 #include <chrono>
 #include <cstdio>
@@ -64,7 +68,7 @@ int BackendFromEnvironment()
 // composite input: drawn exactly, composited in float). Inactive (the serial path, untouched)
 // when the input is the whole image without ghosts.
 spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
-  const std::function<void(const std::string&)>& warn)
+  bool exact, const std::function<void(const std::string&)>& warn)
 {
   spaceskip::VolumePiece piece;
   int ext[6], w[6];
@@ -151,7 +155,7 @@ spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const in
   // blend truncates (README, Parallel). SPACESKIP_PIECE_BIAS (in 1/255) overrides, for
   // measurements.
   const char* bias = std::getenv("SPACESKIP_PIECE_BIAS");
-  piece.followBias = owned ? 0.f : static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
+  piece.followBias = exact ? 0.f : static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
   return piece;
 }
 
@@ -207,6 +211,10 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
 
   spaceskip::Image Image;
   bool DeferredReady = false; // DeferDraw: Image holds this Render()'s frame
+  spaceskip::VolumePiece LastPiece; // the piece the last frame drew (inactive: the whole input)
+  // Float compositing across processes (SetPieceExchange), and the image it hands back.
+  std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange> Exchange;
+  spaceskip::Image Exchanged;
   const float* FrameDepth = nullptr; // this frame's depth (the compositor's buffer), or null
   // Last, so that it goes (with its CUDA-GL interop registration) before the engine.
   vtkSpaceSkipCompositor Compositor;
@@ -693,7 +701,198 @@ void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange)
+{
+  if (this->Internals->Exchange != exchange)
+  {
+    this->Internals->Exchange = exchange;
+    this->Modified();
+  }
+}
+const std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange>&
+vtkSpaceSkippingVolumeMapper::GetPieceExchange() const
+{
+  return this->Internals->Exchange;
+}
+
+namespace
+{
+// Whether the mapper draws a vtkImageData piece of a larger image (WholeExtent given).
+bool IsImagePiece(vtkSpaceSkippingVolumeMapper* self, const int whole[6])
+{
+  vtkDataObject* input =
+    self->GetNumberOfInputConnections(0) > 0 ? self->GetInputDataObject(0, 0) : nullptr;
+  return whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5] &&
+    !vtkSpaceSkipBlockRenderer::IsComposite(input);
+}
+}
+
+//------------------------------------------------------------------------------
+// With a piece exchange (MPI): every process draws its piece exactly into a float image, the
+// exchange composites them in float on one process, which draws the sum; the others draw
+// nothing. Every call reaches Finish(), whatever the piece drew (the others wait for it).
 void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  vtkInternals& d = *this->Internals;
+  const std::shared_ptr<PieceExchange> exchange = d.Exchange;
+  if (!exchange || !IsImagePiece(this, this->WholeExtent))
+  {
+    this->RenderLocal(ren, vol);
+    return;
+  }
+  exchange->Begin();
+  const bool defer = this->DeferDraw;
+  this->DeferDraw = true;
+  this->ExactPiece = true;
+  d.LastPiece = spaceskip::VolumePiece();
+  this->RenderLocal(ren, vol);
+  this->DeferDraw = defer;
+  this->ExactPiece = false;
+
+  int width = 0, height = 0;
+  const float* image = this->GetDeferredImage(width, height);
+  auto* input = vtkImageData::SafeDownCast(this->GetInput());
+  vtkCamera* cam = ren ? ren->GetActiveCamera() : nullptr;
+  if (!image || !input || !cam || !vol)
+  {
+    image = nullptr;
+    int x0 = 0, y0 = 0;
+    if (ren)
+    {
+      ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+    }
+  }
+  PieceImage mine;
+  if (image)
+  {
+    // The cells drawn, in the whole extent's index space (the piece's own cells, or all of it).
+    const spaceskip::VolumePiece& p = d.LastPiece;
+    int ext[6];
+    input->GetExtent(ext);
+    for (int a = 0; a < 3; ++a)
+    {
+      mine.Owned[2 * a] =
+        p.active() ? static_cast<int>(p.ownedLo[a]) : ext[2 * a] - this->WholeExtent[2 * a];
+      mine.Owned[2 * a + 1] = p.active()
+        ? static_cast<int>(p.ownedHi[a])
+        : std::max(ext[2 * a + 1], ext[2 * a] + 1) - this->WholeExtent[2 * a];
+    }
+    // The rectangle of the pixels drawn (often a small part of the viewport).
+    int x0 = width, y0 = height, x1 = -1, y1 = -1;
+    for (int y = 0; y < height; ++y)
+    {
+      const float* c = image + 4 * size_t(y) * size_t(width);
+      for (int x = 0; x < width; ++x, c += 4)
+      {
+        if (c[0] != 0.f || c[1] != 0.f || c[2] != 0.f || c[3] != 0.f)
+        {
+          x0 = std::min(x0, x);
+          x1 = std::max(x1, x);
+          y0 = std::min(y0, y);
+          y1 = std::max(y1, y);
+        }
+      }
+    }
+    if (x1 >= x0)
+    {
+      mine.X = x0;
+      mine.Y = y0;
+      mine.Width = x1 - x0 + 1;
+      mine.Height = y1 - y0 + 1;
+      mine.Pixels.resize(4 * size_t(mine.Width) * size_t(mine.Height));
+      for (int y = 0; y < mine.Height; ++y)
+      {
+        const float* src = image + 4 * (size_t(y0 + y) * size_t(width) + size_t(x0));
+        std::copy(src, src + 4 * size_t(mine.Width), mine.Pixels.data() + 4 * size_t(y) * size_t(mine.Width));
+      }
+    }
+  }
+  std::vector<PieceImage> others;
+  const int draw = exchange->Finish(width, height, mine, others);
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren ? ren->GetRenderWindow() : nullptr);
+  if (draw == 0 || !renWin || width <= 0 || height <= 0 || (draw == -1 && !image))
+  {
+    return;
+  }
+  spaceskip::Image& img = d.Exchanged;
+  img.width = width;
+  img.height = height;
+  const size_t pixels = size_t(width) * size_t(height);
+  if (draw == -1)
+  {
+    img.rgba.assign(reinterpret_cast<const spaceskip::vec4f*>(image),
+      reinterpret_cast<const spaceskip::vec4f*>(image) + pixels);
+  }
+  else
+  {
+    // Every piece front to back in the order the rays meet them (the camera in the whole
+    // extent's index space), blended in float: one rounding to 8 bits, as the serial image.
+    double eye[3] = { 0, 0, 0 }, dir[3] = { 0, 0, 1 };
+    const bool parallel = cam && cam->GetParallelProjection() != 0;
+    if (cam && vol && input)
+    {
+      double e[4], f[4], dop[3];
+      cam->GetPosition(e);
+      cam->GetDirectionOfProjection(dop);
+      e[3] = f[3] = 1.0;
+      for (int a = 0; a < 3; ++a)
+      {
+        f[a] = e[a] + dop[a];
+      }
+      vtkNew<vtkMatrix4x4> toData;
+      vtkMatrix4x4::Invert(vol->GetMatrix(), toData);
+      toData->MultiplyPoint(e, e);
+      toData->MultiplyPoint(f, f);
+      double ei[3], fi[3];
+      input->TransformPhysicalPointToContinuousIndex(e, ei);
+      input->TransformPhysicalPointToContinuousIndex(f, fi);
+      for (int a = 0; a < 3; ++a)
+      {
+        eye[a] = ei[a] - this->WholeExtent[2 * a];
+        dir[a] = fi[a] - ei[a];
+      }
+    }
+    others.push_back(std::move(mine));
+    std::vector<spaceskip::PieceBox> boxes;
+    std::vector<const PieceImage*> parts;
+    for (const PieceImage& p : others)
+    {
+      const int* o = p.Owned;
+      if (p.Width > 0 && p.Height > 0 && o[0] < o[1] && o[2] < o[3] && o[4] < o[5] && p.X >= 0 &&
+        p.Y >= 0 && p.X + p.Width <= width && p.Y + p.Height <= height &&
+        p.Pixels.size() == 4 * size_t(p.Width) * size_t(p.Height))
+      {
+        boxes.push_back({ double(o[0]), double(o[1]), double(o[2]), double(o[3]), double(o[4]), double(o[5]) });
+        parts.push_back(&p);
+      }
+    }
+    img.rgba.assign(pixels, spaceskip::vec4f{ 0, 0, 0, 0 });
+    for (size_t i : spaceskip::visibilityOrder(boxes, eye, dir, parallel))
+    {
+      const PieceImage& p = *parts[i];
+      for (int y = 0; y < p.Height; ++y)
+      {
+        const float* src = p.Pixels.data() + 4 * size_t(y) * size_t(p.Width);
+        spaceskip::vec4f* dst = img.rgba.data() + size_t(p.Y + y) * size_t(width) + size_t(p.X);
+        for (int x = 0; x < p.Width; ++x, src += 4, ++dst)
+        {
+          const float t = 1.f - dst->w;
+          dst->x += t * src[0];
+          dst->y += t * src[1];
+          dst->z += t * src[2];
+          dst->w += t * src[3];
+        }
+      }
+    }
+  }
+  if (!d.Compositor.Draw(renWin, img, width, height, this->EightBitComposite != 0))
+  {
+    d.Fail("could not compile the compositing shader: nothing drawn");
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
 {
   vtkInternals& d = *this->Internals;
   d.DeferredReady = false;
@@ -753,8 +952,10 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.RangeSeconds = d.Input.Update(engine, d.Warn);
     // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
     // composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
-    engine.setPiece(PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent,
-      this->UseBlockOwned ? this->BlockOwned : nullptr, d.Warn));
+    d.LastPiece = PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent,
+      this->UseBlockOwned ? this->BlockOwned : nullptr, this->UseBlockOwned || this->ExactPiece,
+      d.Warn);
+    engine.setPiece(d.LastPiece);
     const double* range = this->UseTableRange ? this->TableRange
       : this->WholeScalarRange[0] <= this->WholeScalarRange[1] ? this->WholeScalarRange
                                                                : d.Input.GetScalarRange();
@@ -804,6 +1005,28 @@ int vtkSpaceSkippingVolumeMapper::FillInputPortInformation(int port, vtkInformat
 //------------------------------------------------------------------------------
 double* vtkSpaceSkippingVolumeMapper::GetBounds()
 {
+  // Exchanging pieces, every process must draw every frame: its volume reports the whole
+  // image's bounds, so that no renderer culls a piece that is out of view (or empty) while the
+  // others wait for it.
+  auto* image = this->Internals->Exchange && IsImagePiece(this, this->WholeExtent)
+    ? vtkImageData::SafeDownCast(this->GetInputDataObject(0, 0))
+    : nullptr;
+  if (image)
+  {
+    vtkMath::UninitializeBounds(this->Bounds);
+    const int* w = this->WholeExtent;
+    for (int c = 0; c < 8; ++c)
+    {
+      double p[3];
+      image->TransformIndexToPhysicalPoint(w[(c & 1) ? 1 : 0], w[(c & 2) ? 3 : 2], w[(c & 4) ? 5 : 4], p);
+      for (int a = 0; a < 3; ++a)
+      {
+        this->Bounds[2 * a] = c == 0 ? p[a] : std::min(this->Bounds[2 * a], p[a]);
+        this->Bounds[2 * a + 1] = c == 0 ? p[a] : std::max(this->Bounds[2 * a + 1], p[a]);
+      }
+    }
+    return this->Bounds;
+  }
   if (this->GetNumberOfInputConnections(0) == 0 ||
     !vtkSpaceSkipBlockRenderer::IsComposite(this->GetInputDataObject(0, 0)))
   {

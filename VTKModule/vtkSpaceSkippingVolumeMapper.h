@@ -32,6 +32,7 @@
 
 #include <memory> // For std::unique_ptr
 #include <string> // For WarnOnce
+#include <vector> // For PieceExchange
 
 class vtkRenderer;
 class vtkVolume;
@@ -371,6 +372,43 @@ public:
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
   void ReleaseGraphicsResources(vtkWindow*) override;
 
+#ifndef __VTK_WRAP__
+  /**
+   * Float compositing of the pieces of several processes (ParaView's ranks under MPI; set by
+   * vtkSpaceSkipVolumeRepresentation with its MPI implementation). While one is set and the input
+   * is a vtkImageData piece of a larger image (WholeExtent), every Render() calls Begin(),
+   * renders the piece exactly (no 8-bit rounding bias) into a float image and hands it to
+   * Finish(), whose answer says what this process draws: the pieces of all processes composited
+   * in float on one of them, nothing on the others, so that the 8-bit compositing that follows
+   * (IceT) only adds empty images to one exact image.
+   */
+  /// A process's piece image: the rectangle of pixels it drew (premultiplied RGBA floats, rows
+  /// bottom up, at X, Y in the viewport) and the cells it drew, [lo, hi) per axis in the index
+  /// space of WholeExtent (lo == hi: none).
+  struct PieceImage
+  {
+    int Owned[6] = { 0, 0, 0, 0, 0, 0 };
+    int X = 0, Y = 0, Width = 0, Height = 0;
+    std::vector<float> Pixels;
+  };
+  class PieceExchange
+  {
+  public:
+    virtual ~PieceExchange() = default;
+    /// At the start of Render(), before the piece is drawn.
+    virtual void Begin() = 0;
+    /**
+     * Hands over this process's piece of a `width` x `height` viewport. Returns 1 with the
+     * other processes' pieces in `others` (this process composites and draws them all), 0 (draw
+     * nothing here: another process draws this piece), or -1 (the exchange is off: draw the
+     * piece here, the 8-bit path).
+     */
+    virtual int Finish(int width, int height, PieceImage& mine, std::vector<PieceImage>& others) = 0;
+  };
+  void SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange);
+  const std::shared_ptr<PieceExchange>& GetPieceExchange() const;
+#endif
+
   /**
    * Composite input (vtkMultiBlockDataSet, vtkPartitionedDataSet,
    * vtkPartitionedDataSetCollection of vtkImageData): the union of the image blocks' bounds.
@@ -464,6 +502,10 @@ private:
   const float* IncomingAlpha = nullptr;
   /// The last Render()'s premultiplied RGBA floats (row 0 at the bottom) when DeferDraw, else null.
   const float* GetDeferredImage(int& width, int& height);
+  // Render() without the piece exchange: draws this input (or keeps it, DeferDraw).
+  void RenderLocal(vtkRenderer* ren, vtkVolume* vol);
+  // Set while Render() draws a piece for the exchange: no 8-bit rounding bias.
+  bool ExactPiece = false;
 };
 
 #endif

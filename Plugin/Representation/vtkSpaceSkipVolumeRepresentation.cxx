@@ -16,8 +16,11 @@
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPVRenderView.h"
+#include "vtkPVView.h"
 #include "vtkPartitionedDataSet.h"
 #include "vtkScalarsToColors.h"
+#include "vtkSpaceSkipMPIExchange.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 
@@ -238,6 +241,7 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   // The colour array's range over all ranks (collective: every rank runs RequestData).
   this->WholeRanges.clear();
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  this->UpdateExchange(controller);
   vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
     ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
@@ -253,6 +257,51 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   }
   this->WholeRanges = GatherWholeRanges(controller, arrays);
   return ok;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::UpdateExchange(vtkMultiProcessController* controller)
+{
+  const bool want = this->FloatCompositing && controller && controller->GetNumberOfProcesses() > 1;
+  if (want && !this->Exchange)
+  {
+    // Collective (a communicator of its own): every rank runs RequestData. One that gave up
+    // stays off until the property is turned off and on (the same on every rank).
+    this->Exchange = vtkSpaceSkipMPIExchange::New(
+      controller, [](const std::string& m) { vtkGenericWarningMacro(<< "SpaceSkip: " << m); });
+  }
+  else if (!want)
+  {
+    this->Exchange.reset();
+  }
+  this->SpaceSkipMapper->SetPieceExchange(this->Exchange);
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::SetFloatCompositing(int on)
+{
+  if (this->FloatCompositing != on)
+  {
+    this->FloatCompositing = on;
+    this->MarkModified(); // RequestData (on every rank) makes or drops the exchange
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::ProcessViewRequest(
+  vtkInformationRequestKey* request_type, vtkInformation* inInfo, vtkInformation* outInfo)
+{
+  if (!this->Superclass::ProcessViewRequest(request_type, inInfo, outInfo))
+  {
+    return 0;
+  }
+  if (request_type == vtkPVView::REQUEST_UPDATE() && this->SpaceSkipMapper->GetPieceExchange())
+  {
+    // The exchange waits for every rank's piece: IceT must draw every rank in every frame, even
+    // one whose piece is out of the tile.
+    outInfo->Set(vtkPVRenderView::RENDER_EMPTY_IMAGES(), 1);
+  }
+  return 1;
 }
 
 //------------------------------------------------------------------------------
