@@ -147,7 +147,7 @@ struct Engine::Impl {
   /// A candidate's build time counts as if spread over this many frames (autoCost): an opacity
   /// edit about every second at 30 frames/s, as when a user drags a TF point. On the H100 (round
   /// 7, docs/results/round7-h100/auto) the k-d tree drew the first, axis-aligned view of aneurism,
-  /// stag beetle and kingsnake 3-8% faster than DistanceGrid and the orbit 3-11% slower, with
+  /// stag beetle and kingsnake 3-8% faster than DistanceGrid and the orbit 5-11% slower, with
   /// builds of 0.9-2.2 ms against 0.03-0.33 ms: this weight keeps DistanceGrid there, and the
   /// k-d tree where it is 17-58% faster (Menger, Richtmyer-Meshkov).
   static constexpr double kAutoFramesPerBuild = 30;
