@@ -2,6 +2,9 @@
 // input, drawn back to front (vtkMultiBlockVolumeMapper's scheme).
 #include "vtkSpaceSkipBlockRenderer.h"
 
+#include "spaceskip/PieceOrder.h"
+#include "vtkSpaceSkipPieceCompositing.h"
+
 #include "vtkCamera.h"
 #include "vtkCellData.h"
 #include "vtkCompositeDataIterator.h"
@@ -270,6 +273,10 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   std::string& problem)
 {
   this->Active = true;
+  if (this->SumImage)
+  {
+    this->SumImage->rgba.clear(); // DrawSum() draws this frame's blocks or nothing
+  }
   auto* cds = vtkCompositeDataSet::SafeDownCast(input);
   std::vector<vtkImageData*> images;
   std::set<std::string> others;
@@ -477,7 +484,13 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   // Composite and isosurface blending accumulate opacity along the ray; the other modes'
   // blocks are blended over one another (not exact across block faces: see README).
   const int mode = parent->EffectiveBlendMode();
-  const bool carry = this->OnLattice &&
+  const int* given = parent->GetWholeExtent();
+  const bool anchored = given[0] <= given[1] && given[2] <= given[3] && given[4] <= given[5];
+  // MPI with a piece exchange: each block's image goes to the exchange on its own (another
+  // rank's blocks may lie between two of ours along a ray), without the carried opacity.
+  std::vector<vtkSpaceSkippingVolumeMapper::PieceImage>* pieces =
+    this->OnLattice && anchored ? this->ExchangePieces : nullptr;
+  const bool carry = this->OnLattice && !pieces &&
     (mode == vtkVolumeMapper::COMPOSITE_BLEND || mode == vtkVolumeMapper::ISOSURFACE_BLEND);
   bool drew = false;
   for (size_t i : order)
@@ -493,6 +506,10 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
       continue;
     }
     drew = true;
+    if (pieces)
+    {
+      pieces->push_back(vtkSpaceSkipPieceCompositing::Crop(img, w, h, this->Blocks[i].Owned));
+    }
     spaceskip::vec4f* out = sum.rgba.data();
     float* alpha = this->Alpha.data();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, size_t(1) << 14),
@@ -515,8 +532,11 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   {
     return true; // the blocks said why (or none was in view)
   }
-  const int* given = parent->GetWholeExtent();
-  if (this->OnLattice && carry && given[0] <= given[1] && given[2] <= given[3] && given[4] <= given[5])
+  if (pieces)
+  {
+    return true; // the parent hands them to the exchange (DrawSum() if that is off)
+  }
+  if (this->OnLattice && carry && anchored)
   {
     // Under MPI IceT blends the ranks' images in 8 bits and truncates: where a ray goes on into
     // another rank's blocks, this rank's colour is raised by half a unit, as a single piece's is
@@ -533,9 +553,8 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
     this->Compositor.reset(new vtkSpaceSkipCompositor);
   }
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
-  const int whole[4] = { 0, 0, width, height };
   if (!renWin ||
-    !this->Compositor->Draw(renWin, sum, width, height, parent->GetEightBitComposite() != 0, whole))
+    !this->Compositor->Draw(renWin, sum, width, height, parent->GetEightBitComposite() != 0))
   {
     problem = "could not compile the compositing shader: nothing drawn";
     return false;
@@ -844,6 +863,32 @@ bool vtkSpaceSkipBlockRenderer::PlanLattice(
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkipBlockRenderer::ExchangeCamera(
+  vtkRenderer* ren, vtkVolume* vol, double eye[3], double dir[3], bool& parallel) const
+{
+  const int none[3] = { 0, 0, 0 };
+  if (this->Lattice && ren && vol && ren->GetActiveCamera())
+  {
+    vtkSpaceSkipPieceCompositing::CameraInIndexSpace(ren, vol, this->Lattice, none, eye, dir, parallel);
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipBlockRenderer::DrawSum(vtkRenderer* ren)
+{
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (!this->SumImage || this->SumImage->rgba.empty() || !renWin)
+  {
+    return;
+  }
+  if (!this->Compositor)
+  {
+    this->Compositor.reset(new vtkSpaceSkipCompositor);
+  }
+  this->Compositor->Draw(renWin, *this->SumImage, this->SumImage->width, this->SumImage->height, false);
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkipBlockRenderer::AddFollowBias(vtkRenderer* ren, vtkVolume* vol, float bias)
 {
   spaceskip::Image& sum = *this->SumImage;
@@ -970,90 +1015,23 @@ std::vector<size_t> vtkSpaceSkipBlockRenderer::VisibilityOrder(vtkRenderer* ren,
     return ids;
   }
   // The camera in the blocks' index space.
-  vtkCamera* cam = ren->GetActiveCamera();
-  const bool parallel = cam->GetParallelProjection() != 0;
-  double eye[4], ahead[4], dop[3];
-  cam->GetPosition(eye);
-  cam->GetDirectionOfProjection(dop);
-  eye[3] = ahead[3] = 1.0;
-  for (int a = 0; a < 3; ++a)
+  double e[3], d[3];
+  bool parallel = false;
+  const int none[3] = { 0, 0, 0 };
+  vtkSpaceSkipPieceCompositing::CameraInIndexSpace(ren, vol, this->Lattice, none, e, d, parallel);
+  // A binary space partition of the owned boxes by axis planes (spaceskip::visibilityOrder):
+  // exact for any arrangement such planes separate (grids, k-d splits); else the box centres.
+  std::vector<spaceskip::PieceBox> boxes;
+  for (size_t k : ids)
   {
-    ahead[a] = eye[a] + dop[a];
+    const int* o = this->Blocks[k].Owned;
+    boxes.push_back({ double(o[0]), double(o[1]), double(o[2]), double(o[3]), double(o[4]), double(o[5]) });
   }
-  vtkNew<vtkMatrix4x4> toData;
-  vtkMatrix4x4::Invert(vol->GetMatrix(), toData);
-  toData->MultiplyPoint(eye, eye);
-  toData->MultiplyPoint(ahead, ahead);
-  vtkImageData* ref = this->Lattice;
-  double e[3], f[3], d[3];
-  ref->TransformPhysicalPointToContinuousIndex(eye, e);
-  ref->TransformPhysicalPointToContinuousIndex(ahead, f);
-  for (int a = 0; a < 3; ++a)
-  {
-    d[a] = f[a] - e[a];
-  }
-  // A binary space partition of the owned boxes by axis planes: the side the rays reach first
-  // goes first. Exact for any arrangement such planes separate (grids, k-d splits); else the
-  // box centres by distance.
   std::vector<size_t> out;
-  std::function<void(std::vector<size_t>&)> split = [&](std::vector<size_t>& set) {
-    if (set.size() <= 1)
-    {
-      out.insert(out.end(), set.begin(), set.end());
-      return;
-    }
-    for (int a = 0; a < 3; ++a)
-    {
-      for (size_t c : set)
-      {
-        for (int side = 0; side < 2; ++side)
-        {
-          const int plane = this->Blocks[c].Owned[2 * a + side];
-          std::vector<size_t> lo, hi;
-          bool separates = true;
-          for (size_t k : set)
-          {
-            const int* o = this->Blocks[k].Owned;
-            if (o[2 * a + 1] <= plane)
-            {
-              lo.push_back(k);
-            }
-            else if (o[2 * a] >= plane)
-            {
-              hi.push_back(k);
-            }
-            else
-            {
-              separates = false;
-              break;
-            }
-          }
-          if (!separates || lo.empty() || hi.empty())
-          {
-            continue;
-          }
-          const bool lowFirst = parallel ? d[a] > 0 : e[a] < plane;
-          split(lowFirst ? lo : hi);
-          split(lowFirst ? hi : lo);
-          return;
-        }
-      }
-    }
-    std::vector<double> dist(this->Blocks.size(), 0.0);
-    for (size_t k : set)
-    {
-      const int* o = this->Blocks[k].Owned;
-      double v[3];
-      for (int a = 0; a < 3; ++a)
-      {
-        v[a] = 0.5 * (o[2 * a] + o[2 * a + 1]) - e[a];
-      }
-      dist[k] = parallel ? vtkMath::Dot(v, d) : vtkMath::Norm(v);
-    }
-    std::stable_sort(set.begin(), set.end(), [&dist](size_t x, size_t y) { return dist[x] < dist[y]; });
-    out.insert(out.end(), set.begin(), set.end());
-  };
-  split(ids);
+  for (size_t i : spaceskip::visibilityOrder(boxes, e, d, parallel))
+  {
+    out.push_back(ids[i]);
+  }
   return out;
 }
 

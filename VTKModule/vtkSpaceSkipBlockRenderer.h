@@ -73,6 +73,19 @@ public:
 
   void ReleaseGraphicsResources(vtkWindow* win);
 
+  ///@{
+  /// MPI with a piece exchange: while `pieces` is set, Render() on the whole image's lattice
+  /// leaves each block's image there (cropped, with its cells in the lattice's index space)
+  /// instead of drawing the blocks; ExchangeCamera() gives the camera in that index space and
+  /// DrawSum() draws this process's blocks after all (the exchange is off).
+  void SetExchangePieces(std::vector<vtkSpaceSkippingVolumeMapper::PieceImage>* pieces)
+  {
+    this->ExchangePieces = pieces;
+  }
+  void ExchangeCamera(vtkRenderer* ren, vtkVolume* vol, double eye[3], double dir[3], bool& parallel) const;
+  void DrawSum(vtkRenderer* ren);
+  ///@}
+
   /// Whether the last Render() drew blocks (the parent's statistics then add them up).
   bool IsActive() const { return this->Active; }
   /// Forgets the blocks (the input is no longer composite).
@@ -151,6 +164,7 @@ private:
   std::unique_ptr<vtkSpaceSkipCompositor> Compositor; // draws the blended blocks
   std::unique_ptr<spaceskip::Image> SumImage;          // the blended blocks, row 0 at the bottom
   std::vector<float> Alpha;                            // SumImage's opacity, for the next block
+  std::vector<vtkSpaceSkippingVolumeMapper::PieceImage>* ExchangePieces = nullptr;
 };
 
 #endif

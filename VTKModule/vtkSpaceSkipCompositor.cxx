@@ -257,7 +257,8 @@ bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip
     texture = this->Texture;
     this->CompositePath = "host";
   }
-  return this->Blend(renWin, texture, rect);
+  const int whole[4] = { 0, 0, width, height };
+  return this->Blend(renWin, texture, rect ? rect : whole);
 }
 
 //------------------------------------------------------------------------------

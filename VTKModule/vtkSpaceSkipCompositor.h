@@ -74,12 +74,12 @@ public:
 
   /**
    * Blends the image over what is drawn as premultiplied RGBA (ONE, ONE_MINUS_SRC_ALPHA), within
-   * `rect` of the viewport (VisibleRect): the texture CopyDeviceImage() filled this frame, else
-   * `image` uploaded from host memory (rounded to 8 bits per channel when `eightBit`). False when
-   * the compositing shader does not compile.
+   * `rect` of the viewport (VisibleRect; nullptr: all of it): the texture CopyDeviceImage()
+   * filled this frame, else `image` uploaded from host memory (rounded to 8 bits per channel
+   * when `eightBit`). False when the compositing shader does not compile.
    */
   bool Draw(vtkOpenGLRenderWindow* renWin, const spaceskip::Image& image, int width, int height,
-    bool eightBit, const int rect[4]);
+    bool eightBit, const int rect[4] = nullptr);
 
   /// "gpu", "host" or "none": how the last image reached the window.
   const std::string& GetCompositePath() const { return this->CompositePath; }

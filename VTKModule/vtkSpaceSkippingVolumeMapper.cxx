@@ -6,9 +6,14 @@
 
 #include "vtkCellData.h"
 #include "vtkDataSetAttributes.h"
+#include "vtkFloatArray.h"
+#include "vtkPointData.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkStructuredData.h"
+#include "vtkCamera.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkLogger.h"
 #include "vtkMath.h"
@@ -19,6 +24,7 @@
 #include "vtkSpaceSkipBlockRenderer.h"
 #include "vtkSpaceSkipCompositor.h"
 #include "vtkSpaceSkipInputConverter.h"
+#include "vtkSpaceSkipPieceCompositing.h"
 #include "vtkSpaceSkipPropertyTranslator.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
@@ -66,7 +72,7 @@ int BackendFromEnvironment()
 // composite input: drawn exactly, composited in float). Inactive (the serial path, untouched)
 // when the input is the whole image without ghosts.
 spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
-  const std::function<void(const std::string&)>& warn)
+  bool exact, const std::function<void(const std::string&)>& warn)
 {
   spaceskip::VolumePiece piece;
   int ext[6], w[6];
@@ -153,7 +159,7 @@ spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const in
   // blend truncates (README, Parallel). SPACESKIP_PIECE_BIAS (in 1/255) overrides, for
   // measurements.
   const char* bias = std::getenv("SPACESKIP_PIECE_BIAS");
-  piece.followBias = owned ? 0.f : static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
+  piece.followBias = exact ? 0.f : static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
   return piece;
 }
 
@@ -210,6 +216,14 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
 
   spaceskip::Image Image;
   bool DeferredReady = false; // DeferDraw: Image holds this Render()'s frame
+  spaceskip::VolumePiece LastPiece; // the piece the last frame drew (inactive: the whole input)
+  // Float compositing across processes (SetPieceExchange), and the image it hands back.
+  std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange> Exchange;
+  double WholeBounds[6] = { 1, -1, 1, -1, 1, -1 };
+  // GetInput() of a process with an empty piece (see there), and the array name it carries.
+  vtkSmartPointer<vtkImageData> EmptyPiece;
+  std::string EmptyPieceArray;
+  spaceskip::Image Exchanged;
   const float* FrameDepth = nullptr; // this frame's depth (the compositor's buffer), or null
   // Last, so that it goes (with its CUDA-GL interop registration) before the engine.
   vtkSpaceSkipCompositor Compositor;
@@ -727,7 +741,153 @@ void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange)
+{
+  if (this->Internals->Exchange != exchange)
+  {
+    this->Internals->Exchange = exchange;
+    this->Modified();
+  }
+}
+void vtkSpaceSkippingVolumeMapper::SetWholeBounds(const double bounds[6])
+{
+  if (!std::equal(bounds, bounds + 6, this->Internals->WholeBounds))
+  {
+    std::copy(bounds, bounds + 6, this->Internals->WholeBounds);
+    this->Modified();
+  }
+}
+const std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange>&
+vtkSpaceSkippingVolumeMapper::GetPieceExchange() const
+{
+  return this->Internals->Exchange;
+}
+
+namespace
+{
+// Whether the mapper draws a piece of a larger image (WholeExtent given): a vtkImageData piece
+// (`blocks` false) or composite input whose blocks lie on its lattice (`blocks` true).
+bool IsPiece(vtkSpaceSkippingVolumeMapper* self, const int whole[6], bool& blocks)
+{
+  vtkDataObject* input =
+    self->GetNumberOfInputConnections(0) > 0 ? self->GetInputDataObject(0, 0) : nullptr;
+  blocks = vtkSpaceSkipBlockRenderer::IsComposite(input);
+  return whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5];
+}
+}
+
+//------------------------------------------------------------------------------
+// With a piece exchange (MPI): every process draws its piece (or each of its blocks) exactly
+// into a float image, the exchange composites them all in float on one process, which draws the
+// sum; the others draw nothing. Every call reaches Finish(), whatever the piece drew (the
+// others wait for it).
 void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+{
+  vtkInternals& d = *this->Internals;
+  const std::shared_ptr<PieceExchange> exchange = d.Exchange;
+  bool blocks = false;
+  if (!exchange || !ren || !IsPiece(this, this->WholeExtent, blocks))
+  {
+    this->RenderLocal(ren, vol);
+    return;
+  }
+  namespace pc = vtkSpaceSkipPieceCompositing;
+  exchange->Begin();
+  std::vector<PieceImage> mine;
+  double eye[3] = { 0, 0, 0 }, dir[3] = { 0, 0, 1 };
+  bool parallel = false;
+  const float* image = nullptr; // an image piece's own frame (drawn if the exchange is off)
+  if (blocks)
+  {
+    // The block renderer leaves its blocks' images (on the whole image's lattice) to us.
+    d.Blocks.SetExchangePieces(&mine);
+    this->RenderLocal(ren, vol);
+    d.Blocks.SetExchangePieces(nullptr);
+    d.Blocks.ExchangeCamera(ren, vol, eye, dir, parallel);
+  }
+  else
+  {
+    const bool defer = this->DeferDraw;
+    this->DeferDraw = true;
+    this->ExactPiece = true;
+    d.LastPiece = spaceskip::VolumePiece();
+    d.DeferredReady = false;
+    auto* data = vtkDataSet::SafeDownCast(this->GetInputDataObject(0, 0));
+    if (data && data->GetNumberOfPoints() > 0)
+    {
+      this->RenderLocal(ren, vol); // an empty piece draws nothing (and says nothing)
+    }
+    this->DeferDraw = defer;
+    this->ExactPiece = false;
+    int w = 0, h = 0;
+    image = this->GetDeferredImage(w, h);
+    auto* input = vtkImageData::SafeDownCast(this->GetInput());
+    if (image && input && vol && ren->GetActiveCamera())
+    {
+      // The cells drawn and the camera, in the whole extent's index space (less its first index).
+      const spaceskip::VolumePiece& p = d.LastPiece;
+      int ext[6], owned[6];
+      input->GetExtent(ext);
+      const int shift[3] = { this->WholeExtent[0], this->WholeExtent[2], this->WholeExtent[4] };
+      for (int a = 0; a < 3; ++a)
+      {
+        owned[2 * a] = p.active() ? static_cast<int>(p.ownedLo[a]) : ext[2 * a] - shift[a];
+        owned[2 * a + 1] = p.active() ? static_cast<int>(p.ownedHi[a])
+                                      : std::max(ext[2 * a + 1], ext[2 * a] + 1) - shift[a];
+      }
+      mine.push_back(pc::Crop(image, w, h, owned));
+      pc::CameraInIndexSpace(ren, vol, input, shift, eye, dir, parallel);
+    }
+    else
+    {
+      image = nullptr;
+    }
+  }
+  int width = 0, height = 0, x0 = 0, y0 = 0;
+  ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
+  std::vector<PieceImage> others;
+  const int draw = exchange->Finish(width, height, mine, others);
+  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  if (draw == 0 || !renWin || width <= 0 || height <= 0)
+  {
+    return;
+  }
+  spaceskip::Image& img = d.Exchanged;
+  if (draw == -1)
+  {
+    // The exchange is off: this process's own pieces, as without it.
+    if (blocks)
+    {
+      d.Blocks.DrawSum(ren);
+      return;
+    }
+    if (!image)
+    {
+      return;
+    }
+    img.width = width;
+    img.height = height;
+    img.rgba.assign(reinterpret_cast<const spaceskip::vec4f*>(image),
+      reinterpret_cast<const spaceskip::vec4f*>(image) + size_t(width) * size_t(height));
+  }
+  else
+  {
+    // Every piece front to back in the order the rays meet them, blended in float: one
+    // rounding to 8 bits, as the serial image.
+    for (PieceImage& p : mine)
+    {
+      others.push_back(std::move(p));
+    }
+    pc::Blend(others, eye, dir, parallel, width, height, img);
+  }
+  if (!d.Compositor.Draw(renWin, img, width, height, this->EightBitComposite != 0))
+  {
+    d.Fail("could not compile the compositing shader: nothing drawn");
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
 {
   vtkInternals& d = *this->Internals;
   d.DeferredReady = false;
@@ -787,8 +947,10 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     d.RangeSeconds = d.Input.Update(engine, d.Warn);
     // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
     // composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
-    engine.setPiece(PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent,
-      this->UseBlockOwned ? this->BlockOwned : nullptr, d.Warn));
+    d.LastPiece = PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent,
+      this->UseBlockOwned ? this->BlockOwned : nullptr, this->UseBlockOwned || this->ExactPiece,
+      d.Warn);
+    engine.setPiece(d.LastPiece);
     const double* range = this->UseTableRange ? this->TableRange
       : this->WholeScalarRange[0] <= this->WholeScalarRange[1] ? this->WholeScalarRange
                                                                : d.Input.GetScalarRange();
@@ -838,6 +1000,16 @@ int vtkSpaceSkippingVolumeMapper::FillInputPortInformation(int port, vtkInformat
 //------------------------------------------------------------------------------
 double* vtkSpaceSkippingVolumeMapper::GetBounds()
 {
+  // Exchanging pieces, every process must draw every frame: its volume reports the whole
+  // image's bounds, so that no renderer culls a piece that is out of view (or empty) while the
+  // others wait for it.
+  bool blocks = false;
+  if (this->Internals->Exchange && IsPiece(this, this->WholeExtent, blocks) &&
+    vtkMath::AreBoundsInitialized(this->Internals->WholeBounds))
+  {
+    std::copy(this->Internals->WholeBounds, this->Internals->WholeBounds + 6, this->Bounds);
+    return this->Bounds;
+  }
   if (this->GetNumberOfInputConnections(0) == 0 ||
     !vtkSpaceSkipBlockRenderer::IsComposite(this->GetInputDataObject(0, 0)))
   {
@@ -853,11 +1025,42 @@ vtkDataSet* vtkSpaceSkippingVolumeMapper::GetInput()
 {
   vtkDataObject* input =
     this->GetNumberOfInputConnections(0) > 0 ? this->GetInputDataObject(0, 0) : nullptr;
-  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
+  vtkDataSet* data = vtkSpaceSkipBlockRenderer::IsComposite(input)
+    ? vtkSpaceSkipBlockRenderer::FirstImage(input)
+    : this->Superclass::GetInput();
+  bool blocks = false;
+  if (!this->Internals->Exchange || !IsPiece(this, this->WholeExtent, blocks))
   {
-    return vtkSpaceSkipBlockRenderer::FirstImage(input);
+    return data;
   }
-  return this->Superclass::GetInput();
+  // Exchanging pieces, a process with an empty piece must still draw every frame (the others
+  // wait for it), and ParaView's vtkPVLODVolume draws a mapper only when GetInput() has the
+  // selected scalars: an empty image with an empty array of that name stands in.
+  int unused = 0;
+  if (data && vtkAbstractMapper::GetScalars(data, this->ScalarMode, this->ArrayAccessMode,
+                this->ArrayId, this->ArrayName, unused))
+  {
+    return data;
+  }
+  vtkInternals& d = *this->Internals;
+  const std::string name = this->ArrayName ? this->ArrayName : "";
+  if (!d.EmptyPiece || d.EmptyPieceArray != name)
+  {
+    d.EmptyPiece = vtkSmartPointer<vtkImageData>::New();
+    for (vtkDataSetAttributes* attributes : { static_cast<vtkDataSetAttributes*>(d.EmptyPiece->GetPointData()),
+           static_cast<vtkDataSetAttributes*>(d.EmptyPiece->GetCellData()) })
+    {
+      for (int i = 0; i <= std::max(this->ArrayId, 0) && i < 16; ++i)
+      {
+        vtkNew<vtkFloatArray> array;
+        array->SetName(i == 0 && !name.empty() ? name.c_str() : ("empty piece " + std::to_string(i)).c_str());
+        attributes->AddArray(array);
+      }
+      attributes->SetActiveScalars(attributes->GetAbstractArray(0)->GetName());
+    }
+    d.EmptyPieceArray = name;
+  }
+  return d.EmptyPiece;
 }
 
 //------------------------------------------------------------------------------

@@ -32,6 +32,7 @@
 
 #include <memory> // For std::unique_ptr
 #include <string> // For WarnOnce
+#include <vector> // For PieceExchange
 
 class vtkRenderer;
 class vtkVolume;
@@ -385,6 +386,49 @@ public:
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
   void ReleaseGraphicsResources(vtkWindow*) override;
 
+#ifndef __VTK_WRAP__
+  /**
+   * Float compositing of the pieces of several processes (ParaView's ranks under MPI; set by
+   * vtkSpaceSkipVolumeRepresentation with its MPI implementation). While one is set and the input
+   * is a piece of a larger image (WholeExtent: a vtkImageData piece, or composite input whose
+   * blocks lie on the whole image's lattice), every Render() calls Begin(), renders the piece (or
+   * each block) exactly (no 8-bit rounding bias) into a float image and hands them to Finish(),
+   * whose answer says what this process draws: the pieces of all processes composited
+   * in float on one of them, nothing on the others, so that the 8-bit compositing that follows
+   * (IceT) only adds empty images to one exact image.
+   */
+  /// A process's piece image: the rectangle of pixels it drew (premultiplied RGBA floats, rows
+  /// bottom up, at X, Y in the viewport) and the cells it drew, [lo, hi) per axis in the index
+  /// space of WholeExtent (lo == hi: none).
+  struct PieceImage
+  {
+    int Owned[6] = { 0, 0, 0, 0, 0, 0 };
+    int X = 0, Y = 0, Width = 0, Height = 0;
+    std::vector<float> Pixels;
+  };
+  class PieceExchange
+  {
+  public:
+    virtual ~PieceExchange() = default;
+    /// At the start of Render(), before the piece is drawn.
+    virtual void Begin() = 0;
+    /**
+     * Hands over this process's pieces (one for an image piece, one per block for partitioned
+     * input) of a `width` x `height` viewport. Returns 1 with the other processes' pieces in
+     * `others` (this process composites and draws them all), 0 (draw nothing here: another
+     * process draws these pieces), or -1 (the exchange is off: draw them here, the 8-bit path).
+     */
+    virtual int Finish(int width, int height, std::vector<PieceImage>& mine,
+      std::vector<PieceImage>& others) = 0;
+  };
+  void SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange);
+  /// The whole image's bounds, the same on every process: while a PieceExchange is set the
+  /// volume reports them (GetBounds()), so that no renderer culls a piece that is out of view
+  /// or empty while the others wait for it. Uninitialized (the default): the input's own.
+  void SetWholeBounds(const double bounds[6]);
+  const std::shared_ptr<PieceExchange>& GetPieceExchange() const;
+#endif
+
   /**
    * Composite input (vtkMultiBlockDataSet, vtkPartitionedDataSet,
    * vtkPartitionedDataSetCollection of vtkImageData): the union of the image blocks' bounds.
@@ -478,6 +522,10 @@ private:
   const float* IncomingAlpha = nullptr;
   /// The last Render()'s premultiplied RGBA floats (row 0 at the bottom) when DeferDraw, else null.
   const float* GetDeferredImage(int& width, int& height);
+  // Render() without the piece exchange: draws this input (or keeps it, DeferDraw).
+  void RenderLocal(vtkRenderer* ren, vtkVolume* vol);
+  // Set while Render() draws a piece for the exchange: no 8-bit rounding bias.
+  bool ExactPiece = false;
 };
 
 #endif

@@ -193,7 +193,7 @@ int cmdRender(const Options& o) {
   Image img;
   Camera cam = makeCamera(o, v, w, h);
   engine.render(cam, w, h, img);  // first frame (warm-up)
-  for (int i = 0; i < 16 && engine.exploring(); ++i) engine.render(cam, w, h, img);  // Auto measures
+  for (int i = 0; i < 40 && engine.exploring(); ++i) engine.render(cam, w, h, img);  // Auto measures
   engine.render(cam, w, h, img);
   const BuildStats& s = engine.buildStats();
   if (!s.choice.empty()) std::printf("%s\n", s.choice.c_str());
@@ -272,7 +272,7 @@ int cmdSparse(const Options& o) {
       auto t0 = Clock::now();
       e.render(cam(0), w, h, img);  // ranges, classification, build, residency, one frame
       out.firstMs = 1e3 * since(t0);
-      for (int i = 0; i < 16 && e.exploring(); ++i) e.render(cam(0), w, h, img);
+      for (int i = 0; i < 40 && e.exploring(); ++i) e.render(cam(0), w, h, img);
       double total = 0, dev = 0;
       for (int f = 0; f < frames; ++f) {
         e.render(cam(f), w, h, img);
@@ -371,8 +371,8 @@ BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemTex
   v.worldBounds(b6);
   Image img;
   engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);  // warm-up
-  // Auto: its measuring frames (one per candidate) are not timed; then what it chose is.
-  for (int i = 0; i < 16 && engine.exploring(); ++i)
+  // Auto: its measuring frames (one to four per candidate) are not timed; then what it chose is.
+  for (int i = 0; i < 40 && engine.exploring(); ++i)
     engine.render(orbitCamera(b6, 0, 0, 1, false, double(w) / h), w, h, img);
   if (bp.builder == BuilderKind::Auto) {
     engine.update();  // builds the kept structure when it was not the last one measured

@@ -1,8 +1,11 @@
 // DistanceGrid's distance field on the device: the three passes of DistanceField.h, one thread
-// per brick per pass (the same per-brick function as the oneTBB build, so both fields agree).
+// per line per pass (the same distanceLine as the oneTBB build, so both fields agree).
 #pragma once
 #include "CudaCommon.cuh"
+#include "spaceskip/Classification.h"
 #include "spaceskip/Math.h"
+
+#include <vector>
 
 namespace spaceskip::cuda {
 
@@ -14,5 +17,7 @@ struct DistanceWorkspace {
 /// returns ws.b's pointer. Synchronizes `stream`.
 const uint8_t* computeDistanceField(const uint8_t* occ, vec3i dims, int cap, DistanceWorkspace& ws,
                                     cudaStream_t stream);
+/// The same from a host grid to a host field, on the default stream (for the tests).
+std::vector<uint8_t> fieldOnDevice(const OccupancyGrid& occ, int cap);
 
 }  // namespace spaceskip::cuda

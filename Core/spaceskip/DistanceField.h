@@ -18,7 +18,9 @@ constexpr int kMaxSkipDistance = 64;
 /// One pass of the separable L-infinity distance transform along one axis of the brick grid:
 /// out[i] = min(cap, min_j max(|j|, in[i + j*stride])) over the line through i (n bricks,
 /// `pos` = i's position on it). Pass 1 reads 0 (occupied) / cap (empty); passes 2 and 3 read the
-/// previous pass. Shared by the oneTBB and CUDA builds so both produce the same field.
+/// previous pass. This per-brick form costs O(distance) a brick (up to 2 * cap reads where the
+/// data is sparse); the builds use distanceLine below, the same values in O(1) a brick, and the
+/// tests check the two against each other.
 SS_FUNC uint8_t distancePass(const uint8_t* in, int64_t i, int64_t stride, int pos, int n, int cap) {
   int best = in[i];
   for (int j = 1; j < best; ++j) {
@@ -37,7 +39,48 @@ SS_FUNC uint8_t distancePass(const uint8_t* in, int64_t i, int64_t stride, int p
   return uint8_t(best < cap ? best : cap);
 }
 
+/// One sweep of distanceLine: along `n` bricks from `first` in steps of `step` (+-stride),
+/// L = min(cap, min over the bricks j already passed, this one included, of max(|i - j|, in[j]))
+/// at each brick i, in O(1) a brick; `combine`: out = min(out, L), else out = L.
+/// The recurrence: from one brick to the next every passed term either stays or grows by one,
+/// so L grows by one unless a passed brick j with in[j] <= L lies within L of the next brick;
+/// `p` is the last passed brick with in[j] <= L, `last[v * lastStep]` the last with in[j] == v
+/// (v <= cap) and feeds p when L grows.
+SS_FUNC void distanceSweep(const uint8_t* in, uint8_t* out, int64_t first, int64_t step, int n, int cap, int* last,
+                           int lastStep, bool combine) {
+  const int none = -(1 << 30);
+  for (int v = 0; v <= cap; ++v) last[v * lastStep] = none;
+  int L = cap + 1, p = none;  // nothing passed yet: "infinitely" far
+  for (int i = 0; i < n; ++i) {
+    const int64_t at = first + step * i;
+    const int v = in[at] < cap ? in[at] : cap;
+    const int c = p >= i - L ? L : L + 1;  // the passed bricks' best at brick i
+    if (v <= c) {
+      L = v;
+      p = i;
+    } else {
+      if (c > L) p = p > last[c * lastStep] ? p : last[c * lastStep];  // c < v <= cap
+      L = c;
+    }
+    last[v * lastStep] = i;
+    const uint8_t d = uint8_t(L);
+    out[at] = combine && out[at] < d ? out[at] : d;
+  }
+}
+
+/// distancePass over a whole line in O(n) (two sweeps): out[k] = distancePass(in, k, ...) for
+/// every brick k of the line of `n` bricks starting at `first` (stride `stride`). `last`:
+/// scratch of cap + 1 ints, `lastStep` apart.
+SS_FUNC void distanceLine(const uint8_t* in, uint8_t* out, int64_t first, int64_t stride, int n, int cap, int* last,
+                          int lastStep) {
+  distanceSweep(in, out, first, stride, n, cap, last, lastStep, false);
+  distanceSweep(in, out, first + stride * (n - 1), -stride, n, cap, last, lastStep, true);
+}
+
 /// The distance field of `occ` (0 for occupied bricks, >= 1 for empty ones), oneTBB.
 std::vector<uint8_t> computeDistanceField(const OccupancyGrid& occ, int cap = kMaxSkipDistance);
+/// The same field computed by the CUDA backend's kernels (for the tests); throws BackendError
+/// without CUDA or a usable device.
+std::vector<uint8_t> computeDistanceFieldCuda(const OccupancyGrid& occ, int cap = kMaxSkipDistance);
 
 }  // namespace spaceskip

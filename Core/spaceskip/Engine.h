@@ -96,7 +96,7 @@ class Engine {
   void setMemoryBudget(int64_t bytes, int poolBrick = 16);
 
   const BuildStats& buildStats() const;
-  /// Builder Auto: true while it measures its candidates (one or two frames each, Engine.cpp),
+  /// Builder Auto: true while it measures its candidates (one to four frames each, Engine.cpp),
   /// at first or when it re-checks its choice at a new, still view.
   bool exploring() const;
   /// The last frame's statistics. A frame left on the device (setImageOnDevice) is not waited

@@ -181,6 +181,9 @@ bool cudaAvailable(std::string* why) {
   return false;
 }
 int64_t cudaDeviceBytesInUse() { return 0; }
+std::vector<uint8_t> computeDistanceFieldCuda(const OccupancyGrid&, int) {
+  throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
+}
 
 struct DeviceImageCopy::Impl {};
 DeviceImageCopy::DeviceImageCopy() = default;

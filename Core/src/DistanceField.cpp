@@ -1,4 +1,4 @@
-// The DistanceGrid's distance field on the CPU: three separable passes, oneTBB over lines.
+// The DistanceGrid's distance field on the CPU: three separable passes (distanceLine), oneTBB over lines.
 #include "spaceskip/DistanceField.h"
 
 #include <tbb/blocked_range.h>
@@ -15,16 +15,17 @@ std::vector<uint8_t> computeDistanceField(const OccupancyGrid& occ, int cap) {
   for (int64_t i = 0; i < n; ++i) a[size_t(i)] = occ.occ[size_t(i)] ? 0 : uint8_t(cap);
   const vec3i d = occ.dims;
   const int64_t strides[3] = {1, int64_t(d.x), int64_t(d.x) * d.y};
-  // Pass along `axis`, reading `in`, writing `out`: one task per range of z-slices.
+  // Pass along `axis`, reading `in`, writing `out`: distanceLine over each line of that axis,
+  // one task per range of lines (a line is numbered by its position on the other two axes).
   auto pass = [&](int axis, const std::vector<uint8_t>& in, std::vector<uint8_t>& out) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, d.z), [&](const tbb::blocked_range<int>& r) {
-      for (int z = r.begin(); z != r.end(); ++z)
-        for (int y = 0; y < d.y; ++y)
-          for (int x = 0; x < d.x; ++x) {
-            const int64_t i = x + strides[1] * y + strides[2] * z;
-            const int pos = axis == 0 ? x : axis == 1 ? y : z;
-            out[size_t(i)] = distancePass(in.data(), i, strides[axis], pos, d[axis], cap);
-          }
+    const int u = axis == 0 ? 1 : 0, w = axis == 2 ? 1 : 2;  // the other two axes
+    const int64_t lines = int64_t(d[u]) * d[w];
+    tbb::parallel_for(tbb::blocked_range<int64_t>(0, lines, 256), [&](const tbb::blocked_range<int64_t>& r) {
+      std::vector<int> last(size_t(cap) + 1);
+      for (int64_t l = r.begin(); l != r.end(); ++l) {
+        const int64_t first = strides[u] * (l % d[u]) + strides[w] * (l / d[u]);
+        distanceLine(in.data(), out.data(), first, strides[axis], d[axis], cap, last.data(), 1);
+      }
     });
   };
   pass(0, a, b);

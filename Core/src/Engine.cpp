@@ -99,18 +99,26 @@ struct Engine::Impl {
 
   // Builder Auto ("never slower than naive"): skipping is lossless, so every candidate draws the
   // same image and only its speed differs. Measuring: every candidate renders a frame, in turn
-  // (round 1); those within kAutoPrune of round 1's fastest render another, in the reverse order
+  // (round 1); those within kAutoPrune of round 1's cheapest render again, in the reverse order
   // (round 2: A B C D, then D C B A, so a drift of the machine's load favours none and the last
-  // structure of round 1 needs no rebuild); a candidate's time is the minimum of its frames (other
-  // work only ever adds time). The fastest is kept, over Naive only when kAutoMargin faster.
+  // structure of round 1 needs no rebuild), short frames several times in a row (until
+  // kAutoMinMeasureSeconds, at most kAutoMaxRepeats frames: one sub-millisecond frame is at the
+  // mercy of a launch's jitter); a candidate's frame time is the minimum of its frames (other
+  // work only ever adds time). Its cost is that frame time plus its build time spread over
+  // kAutoFramesPerBuild frames (autoCost): a structure that draws a few percent faster at the
+  // measured view but takes milliseconds to rebuild on every opacity edit loses to one nearly as
+  // fast that rebuilds at once. The cheapest is kept, over Naive only when kAutoMargin cheaper.
   // The candidates are measured again when the occupancy moves by more than kAutoReexplore or
   // the image size changes, otherwise an occupancy change rebuilds the chosen one only.
   // Frame times depend on the view, so measurements are compared only when taken at one view:
   // once the camera has moved far (kAutoFarDegrees, or a zoom of kAutoFarZoom) from where the
   // choice was measured and then stays still, the kept structure is re-checked there against the
   // contenders (those within kAutoPrune of it when it was measured, at least the runner-up), two
-  // frames each; a moving
-  // camera (an orbit) never triggers a re-check, and one that moves during it cancels it.
+  // frames each; a moving camera (an orbit) never triggers a re-check, and one that moves during
+  // it cancels it. A frame that carries a TF or crop/clip change never builds a contender: it
+  // cancels a re-check under way and starts none, so an edit under Auto costs what the kept
+  // structure's edit costs (a user editing at a resting view would otherwise pay a contender's
+  // build on the frames that show the edits).
   struct ViewKey {
     double dir[3] = {0, 0, 0};  ///< the camera's backward axis in world space
     double zoom = 0;            ///< |proj[0][0]|
@@ -124,8 +132,10 @@ struct Engine::Impl {
     std::vector<int> frames;      ///< frames measured per candidate in the current measuring
     std::vector<int> queue;       ///< the candidates still to render in this measuring, in order
     bool standIn = false;         ///< this frame draws Grid while the kept one waits (refinement)
+    bool tfEdit = false;          ///< this frame carries a transfer-function (or crop/clip) change
     bool refined = false;         ///< the kept structure was rebuilt after a stand-in frame
-    int current = -1;             ///< the candidate built now
+    int current = -1;             ///< the candidate to draw with (built when it differs from `built`)
+    int built = -1;               ///< the candidate the backend holds, -1: none (or stale)
     int kept = -1;                ///< the kept structure (during a re-check: the one before it)
     bool exploring = false;       ///< measuring (all candidates, or a re-check)
     bool rechecking = false;      ///< this measuring is a re-check of the kept one at a new view
@@ -140,8 +150,18 @@ struct Engine::Impl {
     std::string choice;
   } autoState;
   static constexpr double kAutoReexplore = 0.1;
-  /// Round 2 (and a re-check) measures only candidates within this factor of the fastest.
+  /// Round 2 (and a re-check) measures only candidates within this factor of the cheapest.
   static constexpr double kAutoPrune = 1.5;
+  /// Round 2 renders a candidate until its frames there add up to this, at most kAutoMaxRepeats.
+  static constexpr double kAutoMinMeasureSeconds = 2e-3;
+  static constexpr int kAutoMaxRepeats = 3;
+  /// A candidate's build time counts as if spread over this many frames (autoCost): an opacity
+  /// edit about every second at 30 frames/s, as when a user drags a TF point. On the H100 (round
+  /// 7, docs/results/round7-h100/auto) the k-d tree drew the first, axis-aligned view of aneurism,
+  /// stag beetle and kingsnake 3-8% faster than DistanceGrid and the orbit 5-11% slower, with
+  /// builds of 0.9-2.2 ms against 0.03-0.33 ms: this weight keeps DistanceGrid there, and the
+  /// k-d tree where it is 17-58% faster (Menger, Richtmyer-Meshkov).
+  static constexpr double kAutoFramesPerBuild = 30;
   /// A structure is kept over Naive (or over the kept one in a re-check) only when this much faster.
   static constexpr double kAutoMargin = 1.05;
   /// A view this far from the measured one (degrees between view directions, or zoom ratio) is
@@ -217,11 +237,13 @@ struct Engine::Impl {
     a.exploring = true;
     a.rechecking = recheck;
     a.round = recheck ? 0 : 1;
-    if (a.current != a.queue.front()) buildDirty = true;
     a.current = a.queue.front();
   }
 
-  void startAutoExploration() {
+  /// Measures every candidate from the start. `afterEdit`: an opacity edit moved the occupancy,
+  /// and the frame that shows it is the first measured: Grid (no build beyond the
+  /// classification) draws it instead of Naive, so the edit costs what Grid's frame costs.
+  void startAutoExploration(bool afterEdit = false) {
     AutoState& a = autoState;
     a.candidates = autoCandidates();
     a.seconds.assign(a.candidates.size(), -1.0);
@@ -231,9 +253,11 @@ struct Engine::Impl {
     a.rechecks = a.switches = 0;
     std::vector<int> all(a.candidates.size());
     for (size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+    const int grid = gridCandidate();
+    if (afterEdit && grid > 0) std::rotate(all.begin(), all.begin() + grid, all.begin() + grid + 1);
     beginMeasuring(all, false);
     a.choice = "Auto: measuring " + std::to_string(a.candidates.size()) + " structures";
-    buildDirty = true;
+    a.built = -1;  // the candidates are new: build whatever is current
   }
 
   /// Ends a re-check without a decision: the kept structure draws the next frame.
@@ -242,8 +266,16 @@ struct Engine::Impl {
     if (!a.rechecking) return;
     a.exploring = a.rechecking = false;
     a.queue.clear();
-    if (a.current != a.kept) buildDirty = true;
     a.current = a.kept;
+  }
+
+  /// A candidate's cost per frame: its measured frame time plus its last build time spread over
+  /// kAutoFramesPerBuild frames; < 0 when it has no frame time yet.
+  double autoCost(size_t i) const {
+    const AutoState& a = autoState;
+    if (!(a.seconds[i] > 0)) return -1.0;
+    const double b = i < a.buildSeconds.size() && a.buildSeconds[i] > 0 ? a.buildSeconds[i] : 0.0;
+    return a.seconds[i] + b / kAutoFramesPerBuild;
   }
 
   /// Records a measured frame of the current candidate (the minimum of its frames so far).
@@ -260,6 +292,8 @@ struct Engine::Impl {
     AutoState& a = autoState;
     const ViewKey previous = a.lastView;
     a.lastView = view;
+    const bool tfEdit = a.tfEdit;
+    a.tfEdit = false;
     if (a.standIn) return;  // Grid stood in for the kept structure: not its frame time
     if (!a.exploring) {
       if (width != a.width || height != a.height) {
@@ -267,8 +301,10 @@ struct Engine::Impl {
         return;
       }
       // Settled: the kept structure's frame at a view far from the measured one, with the camera
-      // still since the previous frame, starts a re-check here (this frame is its first).
-      if (near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) || !near(view, previous, kAutoStillDegrees, kAutoStillZoom))
+      // still since the previous frame and no edit in this frame, starts a re-check here (this
+      // frame is its first).
+      if (tfEdit || near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) ||
+          !near(view, previous, kAutoStillDegrees, kAutoStillZoom))
         return;
       // The contenders: those within kAutoPrune of the kept one where it was measured, at least
       // the runner-up (the likeliest to overtake it at another view).
@@ -276,8 +312,8 @@ struct Engine::Impl {
       int runnerUp = -1;
       for (size_t i = 0; i < a.candidates.size(); ++i) {
         if (int(i) == a.kept || !(a.seconds[i] > 0)) continue;
-        if (a.seconds[i] < kAutoPrune * a.seconds[size_t(a.kept)]) q.push_back(int(i));
-        if (runnerUp < 0 || a.seconds[i] < a.seconds[size_t(runnerUp)]) runnerUp = int(i);
+        if (autoCost(i) < kAutoPrune * autoCost(size_t(a.kept))) q.push_back(int(i));
+        if (runnerUp < 0 || autoCost(i) < autoCost(size_t(runnerUp))) runnerUp = int(i);
       }
       if (q.empty() && runnerUp >= 0) q.push_back(runnerUp);
       if (q.empty()) {  // a single candidate: nothing to re-check
@@ -295,7 +331,6 @@ struct Engine::Impl {
       record(seconds());  // the frame just drawn: the kept one at this view
       a.queue.erase(a.queue.begin());
       a.current = a.queue.front();
-      buildDirty = true;
       return;
     }
     const bool first = !a.rechecking && a.frames == std::vector<int>(a.frames.size(), 0);
@@ -317,28 +352,34 @@ struct Engine::Impl {
     record(seconds());
     a.queue.erase(a.queue.begin());
     if (a.queue.empty() && a.round == 1) {
-      // Round 2: the candidates within kAutoPrune of round 1's fastest, in the reverse order.
-      double fastest = std::numeric_limits<double>::infinity();
-      for (double t : a.seconds) if (t > 0) fastest = std::min(fastest, t);
-      for (int i = int(a.candidates.size()) - 1; i >= 0; --i)
-        if (a.seconds[size_t(i)] > 0 && a.seconds[size_t(i)] <= kAutoPrune * fastest) a.queue.push_back(i);
+      // Round 2: the candidates within kAutoPrune of round 1's cheapest, in the reverse order,
+      // each for frames adding up to kAutoMinMeasureSeconds (round 1's time), at most kAutoMaxRepeats.
+      double cheapest = std::numeric_limits<double>::infinity();
+      for (size_t i = 0; i < a.candidates.size(); ++i)
+        if (autoCost(i) > 0) cheapest = std::min(cheapest, autoCost(i));
+      for (int i = int(a.candidates.size()) - 1; i >= 0; --i) {
+        const double c = autoCost(size_t(i));
+        if (!(c > 0) || c > kAutoPrune * cheapest) continue;
+        const double t = a.seconds[size_t(i)];
+        const int repeats = std::clamp(int(std::ceil(kAutoMinMeasureSeconds / t)), 1, kAutoMaxRepeats);
+        for (int k = 0; k < repeats; ++k) a.queue.push_back(i);
+      }
       a.round = 2;
     }
     if (!a.queue.empty()) {
-      if (a.queue.front() != a.current) buildDirty = true;
       a.current = a.queue.front();
       return;
     }
-    // The decision over the candidates measured in this measuring.
+    // The decision over the candidates measured in this measuring: the cheapest (autoCost).
     int best = -1;
     for (size_t i = 0; i < a.candidates.size(); ++i)
-      if (a.frames[i] > 0 && (best < 0 || a.seconds[i] < a.seconds[size_t(best)])) best = int(i);
+      if (a.frames[i] > 0 && (best < 0 || autoCost(i) < autoCost(size_t(best)))) best = int(i);
     // Never slower than Naive: a structure must beat Naive by kAutoMargin to be kept (on dense
     // noise, 256^3, one frame each once put Grid 4% ahead of Naive and the next frames 11% behind
     // it); in a re-check the kept structure wins likewise unless another beats it by the margin.
     for (size_t i = 0; i < a.candidates.size(); ++i) {
       const bool favoured = a.rechecking ? int(i) == a.kept : a.candidates[i].builder == BuilderKind::Naive;
-      if (favoured && a.frames[i] > 0 && int(i) != best && a.seconds[size_t(best)] * kAutoMargin > a.seconds[i])
+      if (favoured && a.frames[i] > 0 && int(i) != best && autoCost(size_t(best)) * kAutoMargin > autoCost(i))
         best = int(i);
     }
     if (a.rechecking && best != a.kept) ++a.switches;
@@ -346,7 +387,6 @@ struct Engine::Impl {
     a.round = 0;
     a.measuredAt = view;
     a.occupancy = backend->occupiedFraction();
-    if (best != a.current) buildDirty = true;
     a.current = a.kept = best;
     describeAutoChoice();
   }
@@ -359,9 +399,12 @@ struct Engine::Impl {
     std::string line = buf;
     if (a.rechecks) line += ", re-checked " + std::to_string(a.rechecks) + "x at new views";
     if (a.switches) line += ", switched " + std::to_string(a.switches) + "x";
-    line += "; measured (ms, best of the frames)";
+    std::snprintf(buf, sizeof buf, "; measured (ms, best frame + build/%g)", kAutoFramesPerBuild);
+    line += buf;
     for (size_t i = 0; i < a.seconds.size(); ++i) {
-      std::snprintf(buf, sizeof buf, "%s %s %.3g", i ? "," : "", builderName(a.candidates[i].builder), 1e3 * a.seconds[i]);
+      const double b = a.buildSeconds[i] > 0 ? a.buildSeconds[i] : 0.0;
+      std::snprintf(buf, sizeof buf, "%s %s %.3g+%.2g", i ? "," : "", builderName(a.candidates[i].builder),
+                    1e3 * a.seconds[i], 1e3 * b / kAutoFramesPerBuild);
       line += buf;
     }
     a.choice = line;
@@ -504,6 +547,11 @@ struct Engine::Impl {
       opacityDirty = true;
       buildDirty = true;
     }
+    if (opacityDirty || colorDirty || cropClipDirty) {
+      // A TF (or crop/clip) edit: no contender is built on the frame that shows it.
+      autoState.tfEdit = true;
+      cancelRecheck();
+    }
     if (opacityDirty || cropClipDirty) {
       auto t0 = Clock::now();
       bool changed = backend->classify(scaledTF(), cropClip);
@@ -512,10 +560,9 @@ struct Engine::Impl {
       if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
       opacityDirty = cropClipDirty = false;
       if (changed) buildDirty = edited = true;
-      if (changed) cancelRecheck();  // its frames were drawn over the old occupancy
       if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
           std::fabs(backend->occupiedFraction() - autoState.occupancy) > kAutoReexplore)
-        startAutoExploration();
+        startAutoExploration(true);
     }
     if (build.builder == BuilderKind::Auto && autoState.candidates.empty()) startAutoExploration();
     if (tableDirty || colorDirty) {
@@ -529,6 +576,9 @@ struct Engine::Impl {
       tableDirty = colorDirty = false;
     }
     if (refineNow && !buildDirty) buildDirty = true;
+    // Auto: the structure to draw with is built when the backend holds another (measuring moves
+    // `current`; a cancelled re-check whose contender was never built rebuilds nothing).
+    if (build.builder == BuilderKind::Auto && autoState.current != autoState.built) buildDirty = true;
     if (buildDirty) {
       const bool isAuto = build.builder == BuilderKind::Auto;
       int use = isAuto ? autoState.current : -1;
@@ -565,6 +615,7 @@ struct Engine::Impl {
       s.classifySeconds = stats.classifySeconds;
       s.occupancy = backend->occupiedFraction();
       if (isAuto) {
+        autoState.built = use;
         autoState.buildSeconds[size_t(use)] = s.seconds;
         s.choice = autoState.choice;
         if (autoState.standIn)

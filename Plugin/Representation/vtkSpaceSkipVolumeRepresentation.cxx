@@ -16,8 +16,11 @@
 #include "vtkPointData.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPVRenderView.h"
+#include "vtkPVView.h"
 #include "vtkPartitionedDataSet.h"
 #include "vtkScalarsToColors.h"
+#include "vtkSpaceSkipMPIExchange.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 
@@ -137,6 +140,29 @@ bool GatherLattice(vtkMultiProcessController* controller, const std::vector<vtkI
   }
   return true;
 }
+
+// The bounds of all ranks' data (collective; uninitialized when no rank has data).
+void GatherBounds(vtkMultiProcessController* controller, const double local[6], double global[6])
+{
+  double lo[6], out[6];
+  const bool have = vtkMath::AreBoundsInitialized(local);
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = have ? local[2 * a] : VTK_DOUBLE_MAX;
+    lo[3 + a] = have ? -local[2 * a + 1] : VTK_DOUBLE_MAX;
+  }
+  controller->AllReduce(lo, out, 6, vtkCommunicator::MIN_OP);
+  vtkMath::UninitializeBounds(global);
+  if (out[0] == VTK_DOUBLE_MAX)
+  {
+    return;
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    global[2 * a] = out[a];
+    global[2 * a + 1] = -out[3 + a];
+  }
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -238,6 +264,13 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   // The colour array's range over all ranks (collective: every rank runs RequestData).
   this->WholeRanges.clear();
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  this->UpdateExchange(controller);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    double whole[6];
+    GatherBounds(controller, this->DataBounds, whole);
+    this->SpaceSkipMapper->SetWholeBounds(whole);
+  }
   vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
     ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
@@ -253,6 +286,51 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   }
   this->WholeRanges = GatherWholeRanges(controller, arrays);
   return ok;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::UpdateExchange(vtkMultiProcessController* controller)
+{
+  const bool want = this->FloatCompositing && controller && controller->GetNumberOfProcesses() > 1;
+  if (want && !this->Exchange)
+  {
+    // Collective (a communicator of its own): every rank runs RequestData. One that gave up
+    // stays off until the property is turned off and on (the same on every rank).
+    this->Exchange = vtkSpaceSkipMPIExchange::New(
+      controller, [](const std::string& m) { vtkGenericWarningMacro(<< "SpaceSkip: " << m); });
+  }
+  else if (!want)
+  {
+    this->Exchange.reset();
+  }
+  this->SpaceSkipMapper->SetPieceExchange(this->Exchange);
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::SetFloatCompositing(int on)
+{
+  if (this->FloatCompositing != on)
+  {
+    this->FloatCompositing = on;
+    this->MarkModified(); // RequestData (on every rank) makes or drops the exchange
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::ProcessViewRequest(
+  vtkInformationRequestKey* request_type, vtkInformation* inInfo, vtkInformation* outInfo)
+{
+  if (!this->Superclass::ProcessViewRequest(request_type, inInfo, outInfo))
+  {
+    return 0;
+  }
+  if (request_type == vtkPVView::REQUEST_UPDATE() && this->SpaceSkipMapper->GetPieceExchange())
+  {
+    // The exchange waits for every rank's piece: IceT must draw every rank in every frame, even
+    // one whose piece is out of the tile.
+    outInfo->Set(vtkPVRenderView::RENDER_EMPTY_IMAGES(), 1);
+  }
+  return 1;
 }
 
 //------------------------------------------------------------------------------
@@ -321,6 +399,13 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
   this->SpaceSkipMapper->SetWholeExtent(wholeExtent);
 
   cache->GetBounds(this->DataBounds);
+  this->UpdateExchange(controller);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    double whole[6];
+    GatherBounds(controller, this->DataBounds, whole);
+    this->SpaceSkipMapper->SetWholeBounds(whole);
+  }
   if (vtkMath::AreBoundsInitialized(this->DataBounds))
   {
     this->OutlineSource->SetBounds(this->DataBounds);

@@ -19,9 +19,12 @@
 #include "vtkImageVolumeRepresentation.h"
 #include "vtkSpaceSkipRepresentationModule.h" // for export macro
 
+#include <memory> // for std::shared_ptr
 #include <string> // for std::string
 #include <vector> // for std::vector
 
+class vtkMultiProcessController;
+class vtkSpaceSkipMPIExchange;
 class vtkSpaceSkippingVolumeMapper;
 
 class VTKSPACESKIPREPRESENTATION_EXPORT vtkSpaceSkipVolumeRepresentation
@@ -59,6 +62,10 @@ public:
   /// BlendModeOverride): -1 follows Blend Mode.
   void SetExtraBlendMode(int mode);
   int GetExtraBlendMode();
+  /// Under MPI: composite the ranks' pieces in float on rank 0 (the serial image; on by
+  /// default) instead of ParaView's 8-bit compositing of the ranks' images (vtkSpaceSkipMPIExchange).
+  void SetFloatCompositing(int on);
+  vtkGetMacro(FloatCompositing, int);
   ///@}
 
   ///@{
@@ -91,6 +98,15 @@ protected:
   /// The base class hands the colour map's Magnitude/Component choice only to VTK's own
   /// mappers; this passes it to ours as well.
   void UpdateMapperParameters() override;
+
+  /// With float compositing under MPI: asks the view to draw every rank in every frame
+  /// (RENDER_EMPTY_IMAGES), as the exchange needs.
+  int ProcessViewRequest(vtkInformationRequestKey* request_type, vtkInformation* inInfo,
+    vtkInformation* outInfo) override;
+  int FloatCompositing = 1;
+  std::shared_ptr<vtkSpaceSkipMPIExchange> Exchange;
+  // Creates the exchange (collective: every rank's RequestData) and hands it to the mapper.
+  void UpdateExchange(vtkMultiProcessController* controller);
 
   ///@{
   /// In pieces (MPI): one ghost layer is requested and kept (the base class crops it away), the

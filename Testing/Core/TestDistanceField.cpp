@@ -3,6 +3,7 @@
 // samples as the plain grid DDA, same image as naive).
 #include "TestUtil.h"
 
+#include "spaceskip/Backend.h"
 #include "spaceskip/DistanceField.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <random>
+#include <string>
 
 using namespace spaceskip;
 
@@ -47,6 +49,60 @@ TEST(DistanceField, EqualsBruteForceChebyshevDistance) {
         for (size_t i = 0; i < ref.size(); ++i) bad += field[i] != ref[i];
         EXPECT_EQ(bad, 0) << dims.x << "x" << dims.y << "x" << dims.z << " p " << p << " cap " << cap;
         for (size_t i = 0; i < ref.size(); ++i) EXPECT_EQ(field[i] == 0, g.occ[i] != 0);
+      }
+}
+
+TEST(DistanceField, TheLinearLinePassEqualsThePerBrickPass) {
+  // distanceLine (two O(n) sweeps, what the builds run) against distancePass (the definition,
+  // per brick) on lines of every kind of input a pass sees: 0/cap (pass 1), earlier passes'
+  // values (any in [0, cap], here random, sparse or smooth), values above cap, strided lines.
+  std::mt19937 rng(7);
+  int64_t checked = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int cap = trial % 7 == 0 ? 1 + int(rng() % 3) : trial % 5 == 0 ? 255 : int(1 + rng() % 70);
+    const int n = int(rng() % (trial % 3 == 0 ? 300 : 40));
+    const int64_t stride = 1 + int64_t(rng() % 3);
+    std::vector<uint8_t> in(size_t(std::max<int64_t>(1, n * stride + 1)), 0), out(in.size(), 77);
+    const int kind = trial % 4;
+    for (int i = 0; i < n; ++i) {
+      uint8_t v = 0;
+      if (kind == 0) v = rng() % 50 == 0 ? 0 : uint8_t(cap);                        // pass 1
+      else if (kind == 1) v = uint8_t(rng() % (cap + 1));                           // any value
+      else if (kind == 2) v = uint8_t(std::min<int>(cap, int(std::abs(i - n / 2))));  // smooth
+      else v = uint8_t(rng() % 256);                                                // above cap too
+      in[size_t(i * stride)] = v;
+    }
+    std::vector<int> last(size_t(cap) + 1);
+    distanceLine(in.data(), out.data(), 0, stride, n, cap, last.data(), 1);
+    for (int i = 0; i < n; ++i) {
+      const uint8_t ref = distancePass(in.data(), i * stride, stride, i, n, cap);
+      ASSERT_EQ(int(out[size_t(i * stride)]), int(ref))
+          << "trial " << trial << " n " << n << " cap " << cap << " brick " << i;
+      ++checked;
+    }
+    for (size_t k = 0; k < out.size(); ++k)
+      if (k % size_t(stride) != 0 || k >= size_t(n) * size_t(stride)) ASSERT_EQ(out[k], 77) << "wrote off the line";
+  }
+  EXPECT_GT(checked, 100000);
+}
+
+TEST(DistanceField, TheCudaFieldEqualsTheCpuField) {
+  // The CUDA kernels (one thread per line, scratch in shared memory) against the oneTBB build,
+  // on shapes with lines of 1 to 300 bricks, sparse to full grids and every cap.
+  std::string why;
+  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  const vec3i shapes[] = {{17, 13, 11}, {1, 1, 300}, {300, 1, 1}, {3, 29, 2}, {64, 48, 40}};
+  unsigned seed = 100;
+  for (vec3i dims : shapes)
+    for (double p : {0.0, 0.001, 0.03, 0.4, 1.0})
+      for (int cap : {kMaxSkipDistance, 255, 5, 1}) {
+        const OccupancyGrid g = test::randomBrickGrid(dims, p, seed++);
+        const auto cpu = computeDistanceField(g, cap);
+        const auto gpu = computeDistanceFieldCuda(g, cap);
+        ASSERT_EQ(gpu.size(), cpu.size());
+        int64_t bad = 0;
+        for (size_t i = 0; i < cpu.size(); ++i) bad += gpu[i] != cpu[i];
+        EXPECT_EQ(bad, 0) << dims.x << "x" << dims.y << "x" << dims.z << " p " << p << " cap " << cap;
       }
 }
 

@@ -5,7 +5,13 @@ the client's own copy of the representation never renders and stays at "none"/0)
 matches the built-in session's baseline, and Blend Mode Slice follows the Slice Type plane moved
 from the client as ParaView's Volume does.
 
-Usage: pvpython test_clientserver.py PVSERVER
+With MPIEXEC the server runs as `mpiexec -n 2 pvserver`: the volume is split over 2 ranks and
+composited in float on rank 0 (Float Parallel Compositing), the same checks apply, and views
+that put one rank's piece out of the frame, hide and show the volume, or zoom in, each render
+within a time limit and match the 8-bit path (the property off) within 2/255; the exchange must
+never give up (its warning) in those views.
+
+Usage: pvpython test_clientserver.py PVSERVER [MPIEXEC]
 The server is started under `timeout` and killed at the end, whatever happened.
 """
 import os
@@ -30,9 +36,14 @@ def free_port():
     return port
 
 
-def start_server(pvserver, port):
+def start_server(pvserver, port, mpiexec=None):
+    mpi = [mpiexec, "--allow-run-as-root", "--oversubscribe", "-n", "2"] if mpiexec else []
+    # pvpython may have initialised MPI (as a singleton): its variables would confuse mpiexec.
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "PRTE_", "HYDRA_", "PMI_"))}
     server = subprocess.Popen(
-        ["timeout", "-s", "KILL", str(SERVER_SECONDS), pvserver, "--server-port=%d" % port],
+        ["timeout", "-s", "KILL", str(SERVER_SECONDS)] + mpi + [pvserver, "--server-port=%d" % port],
+        env=env,
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
     # Wait (bounded) for its first line, "Waiting for client..." (the lines after it may stay in
     # the pipe's buffer); Connect() below retries until the server accepts.
@@ -63,14 +74,17 @@ def stop_server(server):
         out, _ = server.communicate(timeout=30)
         if out:
             print("pvserver output:\n" + out)
+        return out or ""
     except subprocess.TimeoutExpired:
         print("pvserver did not exit")
+    return ""
 
 
 ok = ssptest.Checker()
 pvserver = sys.argv[1]
+mpiexec = sys.argv[2] if len(sys.argv) > 2 else None
 port = free_port()
-server = start_server(pvserver, port)
+server = start_server(pvserver, port, mpiexec)
 try:
     connection = Connect("localhost", port, timeout=60)
     ok.check(connection is not None, "connected to pvserver on localhost:%d" % port)
@@ -149,9 +163,52 @@ try:
         shots.append(ours)
     p = ssptest.psnr(shots[0], shots[1])
     ok.check(p < 30.0, "moving the plane moves the server's slice (PSNR %.2f dB)" % p)
+
+    if mpiexec:
+        # 2 server ranks: views where one rank's piece leaves the frame (its renderer would cull
+        # it), the volume hidden and shown, a zoom. Float compositing vs the 8-bit path.
+        disp.BlendMode = "Composite"
+        disp.Builder = "Grid"
+        # The 8-bit path's own differences off: FXAA smooths each rank's image apart, early ray
+        # termination stops a ray in the front piece only (README, Parallel).
+        view.UseFXAA = 0
+        disp.EarlyRayTermination = 0
+        n = servermanager.ActiveConnection.GetNumberOfDataPartitions()
+        ok.check(n == 2, "the server runs 2 ranks (%d)" % n)
+        cam = view.GetActiveCamera()
+
+        def to_corner(sign):
+            # Camera and focal point moved towards a corner of the 64^3 volume, zoomed in: the
+            # frame shows that corner and little else.
+            ssptest.set_camera(view)
+            off = [sign * 0.42 * d for d in ssptest.DIMS]
+            view.CameraFocalPoint = [a + b for a, b in zip(view.CameraFocalPoint, off)]
+            view.CameraPosition = [a + b for a, b in zip(view.CameraPosition, off)]
+            view.GetActiveCamera().Zoom(4.0)
+        views = [("whole", lambda: None),
+                 ("zoomed in on the low corner", lambda: to_corner(-1)),
+                 ("zoomed in on the high corner", lambda: to_corner(1)),
+                 ("zoomed and turned", lambda: (ssptest.set_camera(view), cam.Zoom(2.5),
+                                                cam.Azimuth(150.0))),
+                 ("hidden, then shown", lambda: (Hide(reader, view), Render(view), Show(reader, view)))]
+        for i, (what, move) in enumerate(views):
+            move()
+            t0 = time.time()
+            flt = ssptest.read_png(ssptest.render_to(view, "clientserver_mpi%d_float.png" % i))
+            seconds = time.time() - t0
+            disp.FloatCompositing = 0
+            eight = ssptest.read_png(ssptest.render_to(view, "clientserver_mpi%d_8bit.png" % i))
+            disp.FloatCompositing = 1
+            d = int(abs(flt.astype(int) - eight.astype(int)).max())
+            ok.check(seconds < 30.0 and d <= 2,
+                     "2 ranks, %s: rendered in %.2f s, float vs 8-bit path max %d/255 (<= 2)"
+                     % (what, seconds, d))
     Disconnect()
 except Exception as e:  # reported as a failed check; the server goes below
     ok.check(False, "client/server run raised %s: %s" % (type(e).__name__, e))
 finally:
-    stop_server(server)
+    output = stop_server(server)
+if mpiexec:
+    ok.check("float compositing of the MPI ranks' pieces is off" not in output,
+             "the server's ranks never gave up float compositing")
 ok.done()

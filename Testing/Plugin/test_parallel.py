@@ -1,6 +1,10 @@
 """`mpiexec -n 2` and `-n 3 pvbatch` render the serial pvbatch image: each rank renders its piece
 of the volume (with one ghost layer) on the whole volume's sample lattice, drawing only its own
-cells; ParaView (IceT) composites the pieces in visibility order. The scene is the bundled MNI152
+cells, into a float image; rank 0 blends the ranks' float images in the order the rays meet the
+pieces and draws the sum, the other ranks nothing (Float Parallel Compositing, the default:
+within 1/255 of the serial image). With SPACESKIP_FLOAT_COMPOSITING=0 (--8bit) ParaView (IceT)
+composites the ranks' 8-bit images in visibility order instead; the rest of this text is about
+that path. The scene is the bundled MNI152
 head with a translucent transfer function, seen obliquely, so the planes where the pieces meet
 (y for 2 ranks; y, then x in the upper half for 3) cut visible tissue.
 Each rank's piece is exact (Testing/Core/TestPieces.cpp composites pieces in float: within
@@ -18,7 +22,7 @@ partitions sharing their face points, written by this test): each rank draws its
 blocks on the lattice of all ranks' blocks (the representation gathers it) and the result is
 compared with the same serial image (measured 2026-11-24, 2-core machine: 58.87 / 58.13 dB, max
 2/255 / 3/255, 0.011 % / 0.240 % of the pixels off by more than 1/255; the same limits apply).
-Usage: pvpython test_parallel.py MPIEXEC PVBATCH [--partitioned] [builder [ranks...]]
+Usage: pvpython test_parallel.py MPIEXEC PVBATCH [--partitioned] [--8bit] [builder [ranks...]]
   builder "stock": ParaView's own Volume representation, reported only (no limit checked)."""
 import os
 import re
@@ -32,8 +36,10 @@ import ssptest
 xretry_marks = ("bad X server connection",
                 "require remote rendering which, however, is not available")
 
-args = [a for a in sys.argv[1:] if a != "--partitioned"]
+args = [a for a in sys.argv[1:] if a not in ("--partitioned", "--8bit")]
 partitioned = "--partitioned" in sys.argv
+if "--8bit" in sys.argv:
+    os.environ["SPACESKIP_FLOAT_COMPOSITING"] = "0"  # ParaView's 8-bit compositing (the fallback)
 mpiexec, pvbatch = args[0], args[1]
 builder = args[2] if len(args) > 2 else "Grid"
 ranks = [int(r) for r in args[3:]] or [2, 3]
@@ -42,6 +48,13 @@ off_by_two = {2: 0.0005, 3: 0.0075}
 # PSNR floor per number of ranks (measured 58.87 / 57.34 dB)
 min_psnr = {2: 58.5, 3: 57.0}
 check = builder != "stock"
+# Float compositing (the default; SPACESKIP_FLOAT_COMPOSITING=0 turns it off): the ranks' float
+# pieces are blended on rank 0, IceT adds empty images: the serial image within one rounding.
+# Measured 2026-11-24 on the 2-core machine (Grid and KdTreeCPU alike): 101.02 / 98.01 dB at 2 / 3
+# ranks, max 1/255 on 0.002 % / 0.003 % of the pixels. Checked: max 1/255 for any number of ranks,
+# PSNR >= 90 dB, at most 0.05 % of the pixels off at all. Partitioned input (each rank's blocks
+# sent one by one): 101.02 / 101.02 dB, max 1/255 on 0.002 % at 2 / 3 ranks, the same limits.
+float_compositing = os.environ.get("SPACESKIP_FLOAT_COMPOSITING", "1") != "0"
 scene = os.path.join(os.path.dirname(os.path.abspath(__file__)), "parallel_scene.py")
 ok = ssptest.Checker()
 
@@ -121,7 +134,8 @@ if a is not None:
              % (100 * ssptest.lit_fraction(a)))
 env_args = []
 for name in ("DISPLAY", "PYTHONPATH", "SPACESKIP_PIECE_BIAS", "SPACESKIP_PLUGIN", "SPACESKIP_DATA", "SPACESKIP_TEMP",
-             "SPACESKIP_BASELINES", "SPACESKIP_PIECE_BIAS", "SPACESKIP_PARALLEL_ERT"):
+             "SPACESKIP_BASELINES", "SPACESKIP_PIECE_BIAS", "SPACESKIP_PARALLEL_ERT",
+             "SPACESKIP_FLOAT_COMPOSITING"):
     if name in os.environ:
         env_args += ["-x", name]
 for n in ranks:
@@ -130,9 +144,11 @@ for n in ranks:
                     "-n", str(n)] + env_args + [pvbatch, scene, mpi, builder] + mpi_scene, 170)
     ok.check(rc == 0 and os.path.exists(mpi), "mpiexec -n %d pvbatch rendered (rc %d)" % (n, rc))
     m = re.search(r"ranks=(\d+) process_id_range=\(([-\d.]+), ([-\d.]+)\)", info)
+    # 4 partitions: with more ranks than that, the ranks above 3 hold none (and still draw).
+    holders = min(n, 4) if partitioned else n
     ok.check(m is not None and m.group(1) == str(n) and float(m.group(2)) == 0.0
-             and float(m.group(3)) == n - 1, "the volume was split over %d ranks (%s)"
-             % (n, m.group(0) if m else "no report"))
+             and float(m.group(3)) == holders - 1, "the volume was split over %d of %d ranks (%s)"
+             % (holders, n, m.group(0) if m else "no report"))
     if a is None or not os.path.exists(mpi):
         continue
     b = ssptest.read_png(mpi)
@@ -141,7 +157,14 @@ for n in ranks:
     print("SPACESKIP_PARALLEL_RESULT %s%s serial vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
           "%.3f%% of pixels differ by more than 1, %.3f%% by any" % (
               builder, " partitioned" if partitioned else "", n, p, diff.max(), 100.0 * (diff > 1).mean(), 100.0 * (diff > 0).mean()))
-    if check:
+    if check and float_compositing:
+        ok.check(diff.max() <= 1, "%d ranks == serial within 1/255 (max %d/255, PSNR %.2f dB)"
+                 % (n, diff.max(), p))
+        ok.check(p >= 90.0, "%d ranks: PSNR %.2f dB >= 90 dB" % (n, p))
+        frac = float((diff > 0).mean())
+        ok.check(frac <= 0.0005, "%d ranks: %.3f%% of the pixels off at all (at most 0.05%%: "
+                 "float sums in another order)" % (n, 100 * frac))
+    elif check:
         ok.check(diff.max() <= n, "%d ranks == serial within %d/255 (max %d/255, PSNR %.2f dB)"
                  % (n, n, diff.max(), p))
         floor = min_psnr.get(n, 56.0)

@@ -58,8 +58,8 @@ for i, name in enumerate(names):
              % (name, s["BuilderUsed"], p))
     if name == "Auto":
         # A measured frame per candidate (CPU: Naive, Grid, DistanceGrid, KdTreeCPU), a second one
-        # for the close ones, each the Naive image; then the fastest is kept and says why.
-        for k in range(12):
+        # to three more for the close ones, each the Naive image; then the cheapest is kept and says why.
+        for k in range(24):
             img = shot("prop_builder_Auto_%d.png" % k)
             p = min(p, ssptest.psnr(naive, img))
             if not ssptest.stats(disp)["BuilderChoice"].startswith("Auto: measuring"):

@@ -30,7 +30,9 @@
 #          without the CUDA override), DEADLINE (epoch seconds: phases that would
 #          start after it are skipped), MEMCHECK_TESTS, BENCH_BUILDERS, VTK_GPU (1: also time
 #          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks), REQUIRE_NVIDIA_GL (set: stop
-#          when only Mesa works), BENCH_N (every benchmark at this size instead: quick checks)
+#          when only Mesa works), BENCH_N (every benchmark at this size instead: quick checks),
+#          EDIT_CUT (the window benchmark's --edit-cut: 0.3 by default, changing N-body's occupied
+#          cells; 0.2 changes none, the edit of round 7 and before)
 #
 # OUTDIR receives at most 8 files (the device tool's limit): env.txt, tests.log, memcheck.log,
 # bench.log, bench.csv, cli-bench.log, cli-bench.csv, logs.tgz (everything).
@@ -188,7 +190,8 @@ window_bench() {  # SHAPE N [--vtk-gpu] [--egl]
   late && { log "skip bench $shape$n (deadline)"; return; }
   log "window bench $shape $n^3 $*"
   SPACESKIP_BACKEND=cuda timeout 420 "$bench" --shape "$shape" --dims "$n" --frames "$frames" \
-    --size 1024 --builders "${ITEMS:-$wb}" --csv "$out/bench.csv" --png "$work/frame" "$@" >> "$work/bench.log" 2>&1
+    --size 1024 --builders "${ITEMS:-$wb}" --csv "$out/bench.csv" --png "$work/frame" \
+    ${EDIT_CUT:+--edit-cut "$EDIT_CUT"} "$@" >> "$work/bench.log" 2>&1
   log "window bench rc=$?"
   cp "$work/bench.log" "$out/bench.log"
   [ -n "${ITEMS:-}" ] && return  # a variant of a case benched above: no second CLI run
@@ -302,7 +305,7 @@ if has core && ! late && [ -x "$coretests" ]; then
   log "Core tests rc=$rc"
   [ $rc -eq 0 ] || status=1
   { echo "==== spaceskip_core_tests rc=$rc"; grep -E "^\[  (PASSED|FAILED|SKIPPED) |tests ran|FAILED TEST" "$work/core-tests.log" | head -40; } > "$out/core.log"
-  filter=${CORE_SANITIZE_FILTER:-CudaBackend.*:BlendModes.CudaEqualsCpu*:Volumes/CudaImage.EqualsCpuForEveryBuilder/nbody_*}
+  filter=${CORE_SANITIZE_FILTER:-CudaBackend.*:BlendModes.CudaEqualsCpu*:Volumes/CudaImage.EqualsCpuForEveryBuilder/nbody_*:DistanceField.TheCudaFieldEqualsTheCpuField}
   for tool in memcheck racecheck; do
     late && break
     log "compute-sanitizer $tool on $filter"

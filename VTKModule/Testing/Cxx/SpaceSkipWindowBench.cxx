@@ -3,11 +3,16 @@
 // protocol (orthographic camera zoomed to the volume, rotating, no early ray termination, no
 // shading). Per builder: the wall time of renderWindow->Render() (+ glFinish) split into the
 // mapper's parts, the first frame's parts, and the time from an opacity edit that changes the
-// occupied cells to the end of the first new frame. Run by Testing/gpu/run-gpu-vtk.sh.
+// occupied cells to the end of the first new frame (with its engine update, kernel, builds and
+// builder), and of the frame after it (where Auto rebuilds the structure a stand-in drew the
+// edit's frame with). Run by Testing/gpu/run-gpu-vtk.sh.
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
 //       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:sync|:full|:float]]
 //       [--vtk-gpu]
+//       [--edits E (4)] [--edit-cut C (the edits move the ramp's zero between 10% and C of the
+//        range: 0.3 by default, which changes N-body's occupied cells; 0.2 does not, as its
+//        particles start at 25% of the range)]
 //       [--csv FILE] [--filter hw|exact (the mapper's FilterMode for every item without :hw or
 //        :exact; default exact)]
 //       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
@@ -366,6 +371,7 @@ int main(int argc, char* argv[])
   std::string shape = "nbody", csvPath, pngPrefix, builders =
     "Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4";
   int n = 256, frames = 16, size = 1024, edits = 4;
+  double editCut = 0.3;
   bool vtkGpu = false, egl = false, floatComposite = false, ert = false, hostComposite = false;
   bool shade = false, depthActor = false;
   int blend = vtkVolumeMapper::COMPOSITE_BLEND;
@@ -386,6 +392,8 @@ int main(int argc, char* argv[])
       builders = next();
     else if (a == "--edits")
       edits = std::max(0, std::atoi(next().c_str()));
+    else if (a == "--edit-cut")
+      editCut = std::atof(next().c_str());
     else if (a == "--vtk-gpu")
       vtkGpu = true;
     else if (a == "--egl")
@@ -561,7 +569,8 @@ int main(int argc, char* argv[])
     csv.open(csvPath, std::ios::app);
     csv << "dataset,dims,item,builder_used,backend,frames,frame_ms,fps,mapper_ms,update_ms,depth_ms,"
            "engine_ms,kernel_ms,composite_ms,other_ms,kernel_fps,first_frame_s,build_s,classify_s,"
-           "nodes,occupancy,edit_ms,edit_classify_ms,edit_build_ms,render_ms,finish_ms\n";
+           "nodes,occupancy,edit_ms,edit_classify_ms,edit_build_ms,edit_update_ms,edit_kernel_ms,"
+           "edit_builds,edit_builder,edit_next_ms,render_ms,finish_ms\n";
   }
   const std::string ds = shape + std::to_string(n);
 
@@ -581,14 +590,14 @@ int main(int argc, char* argv[])
   if (csv.is_open())
   {
     csv << ds << "," << n << ",empty,,," << frames << "," << empty * 1e3 << "," << 1 / empty
-        << ",,,,,,,,,,,,,,,," << emptyCall * 1e3 << "," << (empty - emptyCall) * 1e3 << "\n";
+        << std::string(22, ',') << emptyCall * 1e3 << "," << (empty - emptyCall) * 1e3 << "\n";
   }
 
   std::printf("%-22s %-13s %-5s %8s %7s %8s %8s %8s %8s %8s %8s %8s %8s %9s %8s %8s %8s %9s %7s "
-              "%8s %8s\n",
+              "%8s %8s %6s %9s %8s %8s %s\n",
     "item", "used", "bk", "frame_ms", "fps", "mapper", "update", "depth", "engine", "kernel",
     "compos", "other", "kern_fps", "first_s", "build_ms", "class_ms", "nodes", "occupancy",
-    "edit_ms", "render", "finish");
+    "edit_ms", "ed_upd", "ed_kern", "ed_bld", "ed_next", "render", "finish", "ed_used");
   vtkNew<vtkVolume> volume;
   volume->SetProperty(prop);
   ren->AddVolume(volume);
@@ -651,9 +660,9 @@ int main(int argc, char* argv[])
         mapper->GetLastCompositeSeconds());
       firstOfAll = false;
     }
-    // Builder Auto measures its candidates first (one or two frames each): the steady state
+    // Builder Auto measures its candidates first (one to four frames each): the steady state
     // starts after.
-    for (int i = 0; i < 24 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
+    for (int i = 0; i < 40 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
     {
       TimedRender(win);
     }
@@ -697,14 +706,27 @@ int main(int argc, char* argv[])
       SavePng(win, pngPrefix + "-" + ds + "-" + name + ".png");
     }
     // Opacity edits that move the threshold (changing the occupied cells) and back: edit ->
-    // end of the first new frame, with the classification and rebuild it needed.
-    double edit = 0, editClassify = 0, editBuild = 0;
+    // end of the first new frame, with the classification and rebuild it needed (the engine's
+    // update), its kernel, the builds and the builder it drew with; then the frame after it.
+    double edit = 0, editClassify = 0, editBuild = 0, editUpdate = 0, editKernel = 0, editNext = 0;
+    int editBuilds = 0;
+    std::string editBuilder;
     for (int e = 0; e < edits; ++e)
     {
-      SetRamp(ctf, pwf, lo, hi, e % 2 == 0 ? 0.2 : 0.1);
+      SetRamp(ctf, pwf, lo, hi, e % 2 == 0 ? editCut : 0.1);
+      const int builds = mapper->GetBuildCount();
       edit += TimedRender(win);
+      editBuilds += mapper->GetBuildCount() - builds;
       editClassify += mapper->GetLastClassifySeconds();
       editBuild += mapper->GetLastBuildSeconds();
+      editUpdate += mapper->GetLastUpdateSeconds();
+      editKernel += mapper->GetLastKernelSeconds();
+      const std::string used = mapper->GetBuilderUsed();
+      if (editBuilder.find(used) == std::string::npos)
+      {
+        editBuilder += (editBuilder.empty() ? "" : "+") + used;
+      }
+      editNext += TimedRender(win);
     }
     if (edits % 2 == 1)
     {
@@ -713,11 +735,13 @@ int main(int argc, char* argv[])
     }
     const double ke = edits > 0 ? 1e3 / edits : 0;
     std::printf("%-22s %-13s %-5s %8.3f %7.1f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.1f %9.3f "
-                "%8.3f %8.3f %8lld %9.5f %7.3f %8.3f %8.3f\n",
+                "%8.3f %8.3f %8lld %9.5f %7.3f %8.3f %8.3f %6.2f %9.3f %8.3f %8.3f %s\n",
       it.label.c_str(), mapper->GetBuilderUsed(), mapper->GetBackendUsed(), wall * k,
       frames / wall, m * k, up * k, dep * k, eng * k, ker * k, comp * k, (wall - m) * k,
       frames / ker, first, buildS * 1e3, classifyS * 1e3, static_cast<long long>(mapper->GetNodeCount()),
-      mapper->GetOccupancy(), edit * ke, call * k, (wall - call) * k);
+      mapper->GetOccupancy(), edit * ke, editUpdate * ke, editKernel * ke,
+      edits > 0 ? double(editBuilds) / edits : 0.0, editNext * ke, call * k, (wall - call) * k,
+      editBuilder.c_str());
     std::fflush(stdout);
     if (csv.is_open())
     {
@@ -727,7 +751,9 @@ int main(int argc, char* argv[])
           << "," << comp * k << "," << (wall - m) * k << "," << frames / ker << "," << first << ","
           << buildS << "," << classifyS << "," << mapper->GetNodeCount() << ","
           << mapper->GetOccupancy() << "," << edit * ke << "," << editClassify * ke << ","
-          << editBuild * ke << "," << call * k << "," << (wall - call) * k << "\n";
+          << editBuild * ke << "," << editUpdate * ke << "," << editKernel * ke << ","
+          << (edits > 0 ? double(editBuilds) / edits : 0.0) << "," << editBuilder << ","
+          << editNext * ke << "," << call * k << "," << (wall - call) * k << "\n";
     }
   }
 
@@ -759,7 +785,7 @@ int main(int argc, char* argv[])
     double edit = 0;
     for (int e = 0; e < edits; ++e)
     {
-      SetRamp(ctf, pwf, lo, hi, e % 2 == 0 ? 0.2 : 0.1);
+      SetRamp(ctf, pwf, lo, hi, e % 2 == 0 ? editCut : 0.1);
       edit += TimedRender(win);
     }
     std::printf("%-22s %-13s %-5s %8.3f %7.1f %62s %9.3f %44s %7.3f\n", "vtkGPUVolumeRayCast", "-",
@@ -768,7 +794,7 @@ int main(int argc, char* argv[])
     {
       csv << ds << "," << n << ",vtkGPUVolumeRayCastMapper,,gl," << frames << ","
           << wall * 1e3 / frames << "," << frames / wall << ",,,,,,,,," << first << ",,,,,"
-          << (edits ? edit * 1e3 / edits : 0.0) << ",,,,\n";
+          << (edits ? edit * 1e3 / edits : 0.0) << ",,,,,,,,,\n";
     }
     volume->SetMapper(mapper);
   }

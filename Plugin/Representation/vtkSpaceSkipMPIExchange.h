@@ -1,0 +1,74 @@
+// vtkSpaceSkipMPIExchange: float compositing of the ranks' pieces for vtkSpaceSkippingVolumeMapper
+// under MPI (its PieceExchange). Internal to the representation module.
+#ifndef vtkSpaceSkipMPIExchange_h
+#define vtkSpaceSkipMPIExchange_h
+
+#include "vtkSmartPointer.h"
+#include "vtkSpaceSkippingVolumeMapper.h"
+
+#include <chrono>
+#include <functional>
+#include <list>
+#include <memory>
+#include <string>
+#include <vector>
+
+class vtkMPIController;
+class vtkMultiProcessController;
+
+/**
+ * Every rank draws its piece exactly into a float image; rank 0 receives the others' images (the
+ * rectangle of pixels they drew, and their cells), its mapper blends all of them front to back in
+ * the order the rays meet the pieces and draws the sum; the other ranks draw nothing. IceT then composites one exact image with empty ones, which its 8-bit
+ * blend leaves unchanged: N ranks give the serial image (within one rounding).
+ *
+ * It never waits forever. The messages travel on a communicator of its own. Other ranks send
+ * without waiting (non-blocking sends). Rank 0 waits for every rank's "frame begun" message for
+ * at most `BeginSeconds` after its own Begin() (ParaView's IceT draws every rank in the same
+ * frame: the representation asks for RENDER_EMPTY_IMAGES, the mapper reports the whole image's
+ * bounds), then for the images of the ranks that began (they are drawing). At its end it sends
+ * each rank a verdict; a rank waits for the previous frame's verdict at most `BeginSeconds`.
+ * When a rank is missing, late or on another frame, the exchange gives up on every rank, with
+ * one message, and the ranks draw their own pieces again (ParaView's 8-bit compositing).
+ */
+class vtkSpaceSkipMPIExchange : public vtkSpaceSkippingVolumeMapper::PieceExchange
+{
+public:
+  using WarnFunction = std::function<void(const std::string&)>;
+
+  /// Collective over `controller`'s ranks (it duplicates the communicator); null when
+  /// `controller` is not an MPI controller of more than one rank.
+  static std::shared_ptr<vtkSpaceSkipMPIExchange> New(
+    vtkMultiProcessController* controller, WarnFunction warn);
+  ~vtkSpaceSkipMPIExchange() override;
+
+  using PieceImage = vtkSpaceSkippingVolumeMapper::PieceImage;
+  void Begin() override;
+  int Finish(int width, int height, std::vector<PieceImage>& mine,
+    std::vector<PieceImage>& others) override;
+
+  /// Whether it gave up (the ranks draw their own pieces).
+  bool GaveUp() const { return this->Failed; }
+  double BeginSeconds = 20.0;  // the longest wait for a rank to begin a frame
+  double ImageSeconds = 600.0; // the longest wait for a rank that began to send its image
+
+private:
+  vtkSpaceSkipMPIExchange() = default;
+  struct Pending;
+  void GiveUp(const std::string& why);
+  void Reap();
+  void Send(std::vector<int> ints, std::vector<float> floats, int dest, int tag);
+  int FinishRoot(int width, int height, std::vector<PieceImage>& others);
+
+  vtkSmartPointer<vtkMPIController> Controller;
+  int Rank = 0;
+  int Size = 1;
+  long long Frame = 0;
+  bool Failed = false;
+  bool VerdictPending = false; // a non-root rank: the verdict of frame Frame is due
+  std::chrono::steady_clock::time_point BeginTime;
+  std::list<Pending> Sends;
+  WarnFunction Warn;
+};
+
+#endif
