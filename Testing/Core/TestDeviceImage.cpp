@@ -1,0 +1,126 @@
+// The image left on the device for CUDA-GL interop (Engine::setImageOnDevice): render() returns
+// without waiting for the kernel, work queued on deviceImageStream() sees the finished frame (the
+// same bits as the host image), its kernel time is read when asked for, and DeviceImageCopy
+// writes a rectangle of it into a CUDA array as float4 or as RGBA8 rounded as the mapper's host
+// path rounds. Skipped without a CUDA device.
+#include "spaceskip/Backend.h"
+#include "spaceskip/DeviceImageCopy.h"
+#include "TestUtil.h"
+
+#include <gtest/gtest.h>
+
+#ifdef SPACESKIP_HAVE_CUDA
+#include <cuda_runtime_api.h>
+#endif
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace spaceskip;
+
+#ifdef SPACESKIP_HAVE_CUDA
+namespace {
+
+// The mapper's host rounding (vtkSpaceSkipCompositor::UploadHostImage).
+unsigned char round8(float s) {
+  const float v = std::min(std::max(s, 0.f), 1.f);
+  return static_cast<unsigned char>(v * 255.f + 0.5f);
+}
+
+struct Scene {
+  Volume v = generateVolume("nbody", vec3l{64, 64, 64}, 4);
+  TransferFunction tf;
+  Camera cam;
+  Scene() {
+    double lo, hi;
+    v.scalarRange(lo, hi);
+    tf = TransferFunction::preset("ramp", lo, hi);
+    cam = test::orbit(v, 30, 20);
+  }
+};
+
+}  // namespace
+
+TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
+  std::string why;
+  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  Scene s;
+  const int w = 120, h = 90;
+  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid}) {
+    SCOPED_TRACE(builderName(k));
+    Engine e(BackendKind::CUDA);
+    test::load(e, s.v, s.tf, test::builder(k));
+    Image host;
+    e.render(s.cam, w, h, host);
+    ASSERT_EQ(e.deviceImage(), nullptr);
+    ASSERT_EQ(host.rgba.size(), size_t(w) * size_t(h));
+    ASSERT_GT(test::coverage(host), 0.001);
+    ASSERT_TRUE(e.setImageOnDevice(true));
+    Image sized;
+    e.render(s.cam, w, h, sized);
+    EXPECT_EQ(sized.width, w);
+    EXPECT_TRUE(sized.rgba.empty());
+    const void* image = e.deviceImage();
+    void* stream = e.deviceImageStream();
+    ASSERT_NE(image, nullptr);
+    ASSERT_NE(stream, nullptr);
+    const char* sync = std::getenv("SPACESKIP_SYNC_FRAME");
+    if (!(sync && sync[0] == '1')) {
+      EXPECT_EQ(e.frameStats(false).deviceSeconds, -1.0) << "render() waited for the kernel";
+    }
+    // Queued behind the kernel on the engine's stream: the finished frame.
+    std::vector<vec4f> down(size_t(w) * size_t(h));
+    ASSERT_EQ(cudaMemcpyAsync(down.data(), image, down.size() * sizeof(vec4f), cudaMemcpyDeviceToHost,
+                              static_cast<cudaStream_t>(stream)),
+              cudaSuccess);
+    ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);
+    Image dev;
+    dev.width = w;
+    dev.height = h;
+    dev.rgba = down;
+    EXPECT_EQ(compareImages(host, dev).maxAbs, 0.f) << "the device image differs from the host image";
+    EXPECT_GT(e.frameStats().deviceSeconds, 0.0) << "the kernel time, read on demand";
+
+    // A rectangle into CUDA arrays (as into a mapped GL texture), 8-bit and float.
+    const int x0 = 17, y0 = 9, rw = 71, rh = 58;
+    DeviceImageCopy copy;
+    for (bool eightBit : {true, false}) {
+      SCOPED_TRACE(eightBit ? "RGBA8" : "float4");
+      const cudaChannelFormatDesc desc = eightBit ? cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned)
+                                                  : cudaCreateChannelDesc(32, 32, 32, 32, cudaChannelFormatKindFloat);
+      cudaArray_t array = nullptr;
+      ASSERT_EQ(cudaMallocArray(&array, &desc, size_t(w), size_t(h)), cudaSuccess);
+      EXPECT_EQ(copy.copy(image, w, h, array, x0, y0, rw, rh, eightBit, stream), 0);
+      ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);
+      const size_t texel = eightBit ? 4 : sizeof(vec4f);
+      std::vector<unsigned char> back(size_t(rw) * size_t(rh) * texel);
+      ASSERT_EQ(cudaMemcpy2DFromArray(back.data(), size_t(rw) * texel, array, size_t(x0) * texel, size_t(y0),
+                                      size_t(rw) * texel, size_t(rh), cudaMemcpyDeviceToHost),
+                cudaSuccess);
+      cudaFreeArray(array);
+      int bad = 0;
+      for (int y = 0; y < rh; ++y)
+        for (int x = 0; x < rw; ++x) {
+          const vec4f& c = host.rgba[size_t(y0 + y) * size_t(w) + size_t(x0 + x)];
+          const size_t o = (size_t(y) * size_t(rw) + size_t(x)) * texel;
+          if (eightBit) {
+            const unsigned char want[4] = {round8(c.x), round8(c.y), round8(c.z), round8(c.w)};
+            bad += !std::equal(want, want + 4, back.data() + o);
+          } else {
+            bad += std::memcmp(&c, back.data() + o, sizeof(vec4f)) != 0;
+          }
+        }
+      EXPECT_EQ(bad, 0) << "texels differing from the host image (rounded as the host path rounds)";
+    }
+    // A rectangle outside the image is refused, not written.
+    cudaArray_t array = nullptr;
+    const cudaChannelFormatDesc desc = cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned);
+    ASSERT_EQ(cudaMallocArray(&array, &desc, size_t(w), size_t(h)), cudaSuccess);
+    EXPECT_NE(copy.copy(image, w, h, array, w - 10, 0, 11, 5, true, stream), 0);
+    cudaFreeArray(array);
+  }
+}
+#endif
