@@ -305,7 +305,7 @@ if has core && ! late && [ -x "$coretests" ]; then
   log "Core tests rc=$rc"
   [ $rc -eq 0 ] || status=1
   { echo "==== spaceskip_core_tests rc=$rc"; grep -E "^\[  (PASSED|FAILED|SKIPPED) |tests ran|FAILED TEST" "$work/core-tests.log" | head -40; } > "$out/core.log"
-  filter=${CORE_SANITIZE_FILTER:-CudaBackend.*:BlendModes.CudaEqualsCpu*:Volumes/CudaImage.EqualsCpuForEveryBuilder/nbody_*:DistanceField.TheCudaFieldEqualsTheCpuField}
+  filter=${CORE_SANITIZE_FILTER:-CudaBackend.*:BlendModes.CudaEqualsCpu*:Volumes/CudaImage.EqualsCpuForEveryBuilder/nbody_*:DistanceField.TheCudaFieldEqualsTheCpuField:DeviceImage.*}
   for tool in memcheck racecheck; do
     late && break
     log "compute-sanitizer $tool on $filter"
