@@ -399,7 +399,7 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::Composite(vtkOpenGLRenderWindow
 {
   const auto t0 = std::chrono::steady_clock::now();
   spaceskip::Engine& engine = *this->Engine;
-  // The pixels the rays can colour: the box grown by a sample step and a voxel (a ray's last
+  // The pixels the rays can colour: the box grown by a sample step and two voxels (a ray's last
   // sample may lie up to a step past the box, clamped onto it).
   int rect[4];
   const double* spacing = input ? input->GetSpacing() : nullptr;
