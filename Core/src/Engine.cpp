@@ -287,8 +287,7 @@ struct Engine::Impl {
 
   /// After a frame of `seconds()` at width x height seen from `view`: records it and picks the
   /// next build. `seconds` is called only when a time is recorded (it may wait for the device).
-  template <class Seconds>
-  void autoFrameDone(const Seconds& seconds, int width, int height, const ViewKey& view) {
+  void autoFrameDone(const std::function<double()>& seconds, int width, int height, const ViewKey& view) {
     AutoState& a = autoState;
     const ViewKey previous = a.lastView;
     a.lastView = view;
