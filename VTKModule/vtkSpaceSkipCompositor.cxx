@@ -279,6 +279,8 @@ void vtkSpaceSkipCompositor::UploadHostImage(vtkOpenGLRenderWindow* renWin,
   {
     return; // this frame is drawn from the interop texture
   }
+  // vtkTextureObject keeps the first internal format it chose (EightBitComposite may change).
+  this->Texture->ResetFormatAndType();
   if (eightBit)
   {
     // The window holds 8 bits per channel: round the premultiplied image to 8 bits here (a
@@ -425,6 +427,8 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(vtkOpenGLRenderWindow* renWin,
     this->InteropTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
     this->InteropTexture->SetWrapS(vtkTextureObject::ClampToEdge);
     this->InteropTexture->SetWrapT(vtkTextureObject::ClampToEdge);
+    // vtkTextureObject keeps the first internal format it chose: RGBA8 <-> RGBA32F needs a reset.
+    this->InteropTexture->ResetFormatAndType();
     if (!this->InteropTexture->Allocate2D(static_cast<unsigned>(w), static_cast<unsigned>(h), 4,
           eightBit ? VTK_UNSIGNED_CHAR : VTK_FLOAT))
     {
