@@ -312,7 +312,7 @@ TEST(AutoBuilder, EditsAtAStillNewViewBuildNoContender) {
 TEST(AutoBuilder, NeverSlowerThanNaiveOnEveryShapeAt256) {
   // Issue 13's CPU rule: on every generated shape at 256^3 (the paper's stand-ins among them),
   // Auto's settled frames are at least 0.95x as fast as Naive's. Ratios of frame times taken
-  // alternately in this one process (medians of 5), never absolute times.
+  // alternately in this one process (medians of 7), never absolute times.
   // Other tests run beside this one (ctest -j): a measurement disturbed by them is taken again,
   // up to 3 times (Auto measures afresh each time); a structure Auto keeps that is really slower
   // fails every attempt.
@@ -326,21 +326,25 @@ TEST(AutoBuilder, NeverSlowerThanNaiveOnEveryShapeAt256) {
     test::load(autoE, v, tf, test::builder(BuilderKind::Auto));
     Image img;
     const int size = 128;
-    // No warm-up frame: a cold first Naive frame is one of the 5 and the median drops it.
+    // No warm-up frame: a cold first Naive frame is one of the 7 and the median drops it.
     for (int i = 0; i < 10 && autoE.exploring(); ++i) autoE.render(cam, size, size, img);
     EXPECT_FALSE(autoE.exploring()) << shape;
     autoE.render(cam, size, size, img);  // the kept structure's build
     std::vector<double> tn, ta;
-    for (int i = 0; i < 5; ++i) {
-      naive.render(cam, size, size, img);
-      tn.push_back(naive.frameStats().seconds);
-      autoE.render(cam, size, size, img);
-      ta.push_back(autoE.frameStats().seconds);
+    // Each engine first in every other pair, so that neither always runs right after the
+    // other (on the H100 host's 16 cores Auto-kept-Naive once measured 0.89-0.95x Naive itself
+    // with Auto always second): medians of 7.
+    for (int i = 0; i < 7; ++i) {
+      for (int k = 0; k < 2; ++k) {
+        Engine& e = (i + k) % 2 == 0 ? naive : autoE;
+        e.render(cam, size, size, img);
+        (&e == &naive ? tn : ta).push_back(e.frameStats().seconds);
+      }
     }
     std::sort(tn.begin(), tn.end());
     std::sort(ta.begin(), ta.end());
     choice = autoE.buildStats().choice;
-    return tn[2] / ta[2];
+    return tn[3] / ta[3];
   };
   for (const std::string& shape : generatorShapes()) {
     const Volume v = generateVolume(shape, vec3l{256, 256, 256});  // once, not per attempt
