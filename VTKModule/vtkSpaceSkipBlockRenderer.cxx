@@ -548,13 +548,7 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
       this->AddFollowBias(ren, vol, bias);
     }
   }
-  if (!this->Compositor)
-  {
-    this->Compositor.reset(new vtkSpaceSkipCompositor);
-  }
-  auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
-  if (!renWin ||
-    !this->Compositor->Draw(renWin, sum, width, height, parent->GetEightBitComposite() != 0))
+  if (!this->DrawSum(ren, parent->GetEightBitComposite() != 0))
   {
     problem = "could not compile the compositing shader: nothing drawn";
     return false;
@@ -874,18 +868,23 @@ void vtkSpaceSkipBlockRenderer::ExchangeCamera(
 }
 
 //------------------------------------------------------------------------------
-void vtkSpaceSkipBlockRenderer::DrawSum(vtkRenderer* ren)
+bool vtkSpaceSkipBlockRenderer::DrawSum(vtkRenderer* ren, bool eightBit)
 {
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
-  if (!this->SumImage || this->SumImage->rgba.empty() || !renWin)
+  if (!renWin)
   {
-    return;
+    return false;
+  }
+  if (!this->SumImage || this->SumImage->rgba.empty())
+  {
+    return true; // no block drew this frame
   }
   if (!this->Compositor)
   {
     this->Compositor.reset(new vtkSpaceSkipCompositor);
   }
-  this->Compositor->Draw(renWin, *this->SumImage, this->SumImage->width, this->SumImage->height, false);
+  return this->Compositor->Draw(
+    renWin, *this->SumImage, this->SumImage->width, this->SumImage->height, eightBit);
 }
 
 //------------------------------------------------------------------------------

@@ -77,13 +77,14 @@ public:
   /// MPI with a piece exchange: while `pieces` is set, Render() on the whole image's lattice
   /// leaves each block's image there (cropped, with its cells in the lattice's index space)
   /// instead of drawing the blocks; ExchangeCamera() gives the camera in that index space and
-  /// DrawSum() draws this process's blocks after all (the exchange is off).
+  /// DrawSum() draws this frame's blended blocks (Render() itself, or after all when the
+  /// exchange is off); false when it cannot draw.
   void SetExchangePieces(std::vector<vtkSpaceSkippingVolumeMapper::PieceImage>* pieces)
   {
     this->ExchangePieces = pieces;
   }
   void ExchangeCamera(vtkRenderer* ren, vtkVolume* vol, double eye[3], double dir[3], bool& parallel) const;
-  void DrawSum(vtkRenderer* ren);
+  bool DrawSum(vtkRenderer* ren, bool eightBit);
   ///@}
 
   /// Whether the last Render() drew blocks (the parent's statistics then add them up).

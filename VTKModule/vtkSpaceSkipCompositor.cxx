@@ -169,21 +169,8 @@ void vtkSpaceSkipCompositor::VisibleRect(const spaceskip::Camera& camera, vtkIma
   int ext[6];
   input->GetExtent(ext);
   // clip = proj * view * (x, y, z, 1): Core's matrices are column-major, m[c * 4 + r].
-  const double* P = camera.proj.m;
-  const double* V = camera.view.m;
-  double pv[16];
-  for (int r = 0; r < 4; ++r)
-  {
-    for (int c = 0; c < 4; ++c)
-    {
-      double sum = 0;
-      for (int k = 0; k < 4; ++k)
-      {
-        sum += P[k * 4 + r] * V[c * 4 + k];
-      }
-      pv[c * 4 + r] = sum;
-    }
-  }
+  const spaceskip::mat4 projView = spaceskip::multiply(camera.proj, camera.view);
+  const double* pv = projView.m;
   double lo[2] = { 1e300, 1e300 }, hi[2] = { -1e300, -1e300 };
   for (int corner = 0; corner < 8; ++corner)
   {

@@ -852,23 +852,16 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
   {
     return;
   }
-  spaceskip::Image& img = d.Exchanged;
-  if (draw == -1)
+  const bool eightBit = this->EightBitComposite != 0;
+  bool drawn = true;
+  if (draw == -1 && blocks)
   {
-    // The exchange is off: this process's own pieces, as without it.
-    if (blocks)
-    {
-      d.Blocks.DrawSum(ren);
-      return;
-    }
-    if (!image)
-    {
-      return;
-    }
-    img.width = width;
-    img.height = height;
-    img.rgba.assign(reinterpret_cast<const spaceskip::vec4f*>(image),
-      reinterpret_cast<const spaceskip::vec4f*>(image) + size_t(width) * size_t(height));
+    drawn = d.Blocks.DrawSum(ren, eightBit); // the exchange is off: this process's own blocks
+  }
+  else if (draw == -1)
+  {
+    // The exchange is off: this process's own frame (d.Image, kept by DeferDraw), as without it.
+    drawn = !image || d.Compositor.Draw(renWin, d.Image, width, height, eightBit);
   }
   else
   {
@@ -878,9 +871,10 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     {
       others.push_back(std::move(p));
     }
-    pc::Blend(others, eye, dir, parallel, width, height, img);
+    pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged);
+    drawn = d.Compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
   }
-  if (!d.Compositor.Draw(renWin, img, width, height, this->EightBitComposite != 0))
+  if (!drawn)
   {
     d.Fail("could not compile the compositing shader: nothing drawn");
   }

@@ -265,12 +265,6 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   this->WholeRanges.clear();
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   this->UpdateExchange(controller);
-  if (controller && controller->GetNumberOfProcesses() > 1)
-  {
-    double whole[6];
-    GatherBounds(controller, this->DataBounds, whole);
-    this->SpaceSkipMapper->SetWholeBounds(whole);
-  }
   vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
     ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
@@ -291,7 +285,15 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
 //------------------------------------------------------------------------------
 void vtkSpaceSkipVolumeRepresentation::UpdateExchange(vtkMultiProcessController* controller)
 {
-  const bool want = this->FloatCompositing && controller && controller->GetNumberOfProcesses() > 1;
+  const bool parallel = controller && controller->GetNumberOfProcesses() > 1;
+  if (parallel)
+  {
+    // The bounds of all ranks' data: the volume reports them while the exchange is on.
+    double whole[6];
+    GatherBounds(controller, this->DataBounds, whole);
+    this->SpaceSkipMapper->SetWholeBounds(whole);
+  }
+  const bool want = this->FloatCompositing && parallel;
   if (want && !this->Exchange)
   {
     // Collective (a communicator of its own): every rank runs RequestData. One that gave up
@@ -400,12 +402,6 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
 
   cache->GetBounds(this->DataBounds);
   this->UpdateExchange(controller);
-  if (controller && controller->GetNumberOfProcesses() > 1)
-  {
-    double whole[6];
-    GatherBounds(controller, this->DataBounds, whole);
-    this->SpaceSkipMapper->SetWholeBounds(whole);
-  }
   if (vtkMath::AreBoundsInitialized(this->DataBounds))
   {
     this->OutlineSource->SetBounds(this->DataBounds);

@@ -105,7 +105,8 @@ protected:
     vtkInformation* outInfo) override;
   int FloatCompositing = 1;
   std::shared_ptr<vtkSpaceSkipMPIExchange> Exchange;
-  // Creates the exchange (collective: every rank's RequestData) and hands it to the mapper.
+  // Creates the exchange and gathers the bounds of all ranks' data (DataBounds, set first) for
+  // the mapper (collective: every rank's RequestData).
   void UpdateExchange(vtkMultiProcessController* controller);
 
   ///@{
