@@ -282,6 +282,9 @@ BenchItem benchItem(const std::string& item) {
     if (part == "hw") it.filter = int(FilterMode::Hardware);
     else if (part == "exact") it.filter = int(FilterMode::Exact);
     else if (part == "cold") it.cold = true;
+    else if (part == "whole") it.parts = -1;
+    else if (part.size() > 5 && part.rfind("parts", 0) == 0 && part.find_first_not_of("0123456789", 5) == std::string::npos)
+      it.parts = int(parseIntArg(part.substr(5), "bench suffix 'parts'", 0, 64));
     else if (part.size() > 3 && part.rfind("res", 0) == 0 && part.find_first_not_of("0123456789", 3) == std::string::npos)
       it.resident = int(parseIntArg(part.substr(3), "bench suffix 'res'", 0, 1024));
     else it.spec += (it.spec.empty() ? "" : ":") + part;

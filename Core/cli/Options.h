@@ -74,6 +74,10 @@ struct BenchItem {
   int filter = -1;       ///< -1: --filter, else a FilterMode
   bool cold = false;
   int resident = -1;  ///< `resN`: LaunchParams::resident = N for this item (CUDA launch shape)
+  /// Sub-brick masks for this item: -2 as the environment says; -1 (`whole`): none
+  /// (SPACESKIP_SUB_MASKS=0); N (`partsN`): bricks with at most N of 64 parts set are walked part
+  /// by part (SPACESKIP_SUB_MASK_MAX=N).
+  int parts = -2;
 };
 BenchItem benchItem(const std::string& item);
 

@@ -59,7 +59,8 @@ const char* kUsage = R"(usage:
       or kdtree-gpu-fast:deep:mls32:bins0 (the sweep: the kdtree-cpu:deep:mls32 tree)
       --build-reps N: report the fastest of N rebuilds (default 1)
       bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only),
-      :resN (CUDA: persistent launch with N blocks per SM; res0 = plain)
+      :resN (CUDA: persistent launch with N blocks per SM; res0 = plain), :whole (no sub-brick
+      masks: occupied bricks marched whole), :partsN (bricks with <= N of 64 parts set walked by parts)
   spaceskip bench --paper [--scale F] [--datasets a,b] [--builders k1,k2] [--frames N] [--time-limit S]
                   [--csv FILE] [--json FILE] [options]
       the paper's whole benchmark: stand-ins for its 11 data sets (dims x F), every builder and
@@ -339,11 +340,42 @@ const char* leafName(LeafCriterion l) {
   return l == LeafCriterion::Shallow ? "shallow" : l == LeafCriterion::Empty ? "empty" : "deep";
 }
 
+/// The bench suffixes :whole / :partsN (BenchItem::parts) set the sub-brick mask switches the
+/// backends read at classification; an item whose setting differs from the last item's makes
+/// the engine classify again (an opacity edit and back), so items with and without masks are
+/// measured side by side in one process. -2 restores the environment's own settings.
+void applySubMaskSwitch(Engine& engine, const Volume& v, const Options& o, int parts) {
+  static int applied = -2;
+  static const std::string envMasks = std::getenv("SPACESKIP_SUB_MASKS") ? std::getenv("SPACESKIP_SUB_MASKS") : "";
+  static const std::string envMax = std::getenv("SPACESKIP_SUB_MASK_MAX") ? std::getenv("SPACESKIP_SUB_MASK_MAX") : "";
+  static const bool hadMasks = std::getenv("SPACESKIP_SUB_MASKS") != nullptr;
+  static const bool hadMax = std::getenv("SPACESKIP_SUB_MASK_MAX") != nullptr;
+  if (parts == applied) return;
+  applied = parts;
+  auto put = [](const char* name, bool set, const std::string& value) {
+    if (set) setenv(name, value.c_str(), 1);
+    else unsetenv(name);
+  };
+  if (parts == -2) {
+    put("SPACESKIP_SUB_MASKS", hadMasks, envMasks);
+    put("SPACESKIP_SUB_MASK_MAX", hadMax, envMax);
+  } else {
+    put("SPACESKIP_SUB_MASKS", parts == -1, "0");
+    put("SPACESKIP_SUB_MASK_MAX", parts >= 0, std::to_string(parts));
+  }
+  TransferFunction tf = makeTF(o, v), edited = tf;
+  for (vec4f& e : edited.table) e.w = e.w > 0.f ? 0.f : 1.f;  // every brick's state differs
+  engine.setTransferFunction(edited);
+  engine.update();
+  engine.setTransferFunction(tf);
+}
+
 BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemText, const Options& o, int w, int h,
                      int frames, int buildReps, const LaunchParams& launch) {
   BenchRow row;
   const BenchItem item = benchItem(itemText);
   const BuildParams bp = buildParams(o, item.spec);
+  applySubMaskSwitch(engine, v, o, item.parts);
   row.bp = bp;
   RenderParams rp = renderParams(o);
   if (item.filter >= 0) rp.filter = FilterMode(item.filter);
@@ -604,7 +636,7 @@ int cmdBenchPaper(const Options& o) {
     if (!csv) throw std::runtime_error("cannot write " + o.get("--csv", ""));
     csv << "dataset,paper_dims,dims,scale,variant,item,builder,backend,built_on,leaf,mls,bins,brick,build_s,build_cold_s,"
            "classify_s,fps,kernel_fps,frame_cpu_s,nodes,height,leaves,brick_occupancy,voxel_occupancy_pct,"
-           "paper_occupancy_pct,samples_per_frame,vs_naive_kernel,width,height_px,frames,status\n";
+           "paper_occupancy_pct,samples_per_frame,vs_naive_kernel,width,height_px,frames,status,parts_share\n";
   }
   std::ostringstream json;
   json << "{\n  \"protocol\": {\"width\": " << w << ", \"height\": " << h << ", \"frames\": " << frames
@@ -695,7 +727,7 @@ int cmdBenchPaper(const Options& o) {
             << r.bp.maxLeafSize << "," << r.bp.bins << "," << r.bp.brick << "," << s.seconds << "," << r.cold << ","
             << s.classifySeconds << "," << r.fps << "," << r.kernelFps << "," << r.frameCpu << "," << s.nodes << ","
             << s.height << "," << s.leaves << "," << s.occupancy << "," << voxelOcc << "," << ds.occupancyPct << ","
-            << r.samples << "," << vsNaive << "," << w << "," << h << "," << frames << ",ok\n";
+            << r.samples << "," << vsNaive << "," << w << "," << h << "," << frames << ",ok," << s.partsShare << "\n";
         csv.flush();
       }
       if (!firstJson) json << ",\n";

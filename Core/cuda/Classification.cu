@@ -28,21 +28,63 @@ __global__ void rangeKernel(const T* data, vec3l dims, vec3i bdims, int brick, f
 // block) and flags any difference from the previous occupancy.
 __global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims, int brick, vec3i cellDims,
                                OpacityRangeMaxView rmq, CropClip cc, const uint8_t* prev, uint8_t* occ,
-                               unsigned long long* occupied, int* changed) {
+                               unsigned long long* occupied, int* changed, int* grew) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
-  int o = 0, diff = 0;
+  int o = 0, diff = 0, more = 0;
   if (i < n) {
     o = brickOccupied(i, vmin[i], vmax[i], rmq, bdims, brick, cellDims, cc) ? 1 : 0;
     occ[i] = uint8_t(o);
     diff = prev ? (prev[i] != o) : 1;
+    more = prev ? (o && !prev[i]) : 1;
   }
   const int blockCount = __syncthreads_count(o);
   const int blockDiff = __syncthreads_or(diff);
+  const int blockMore = __syncthreads_or(more);
   if (threadIdx.x == 0) {
     if (blockCount) atomicAdd(occupied, (unsigned long long)blockCount);
     if (blockDiff) atomicOr(changed, 1);
+    if (blockMore) atomicOr(grew, 1);
   }
+}
+
+// Launch shape: one thread per brick, 256 per block; occupied bricks compute their sub-brick
+// mask (subBrickMask over their voxels), the others write 0; and every brick its state.
+// The set parts are summed per block (warp sums, then one atomic per block into one of
+// kPartCounters counters, which spreads the atomics).
+constexpr int kPartCounters = 64;
+template <class T>
+__global__ void subMaskKernel(const T* data, vec3l dims, vec3i cellDims, vec3i bdims, int brick,
+                              OpacityRangeMaxView rmq, int maxSet, const uint8_t* occ, uint64_t* masks,
+                              uint8_t* state, unsigned long long* setParts) {
+  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
+  unsigned set = 0;
+  if (i < n) {
+    const bool o = occ[i] != 0;
+    const uint64_t m = o ? subBrickMask(data, dims, cellDims, brick, i % bdims.x, (i / bdims.x) % bdims.y,
+                                        i / (int64_t(bdims.x) * bdims.y), rmq)
+                         : 0;
+    masks[i] = m;
+    state[i] = subBrickState(o, m, maxSet);
+    set = unsigned(popcount64(m));
+  }
+  __shared__ unsigned warpSums[kThreads / 32];
+  for (int d = 16; d > 0; d /= 2) set += __shfl_down_sync(0xffffffffu, set, d);
+  if ((threadIdx.x & 31) == 0) warpSums[threadIdx.x / 32] = set;
+  __syncthreads();
+  if (threadIdx.x == 0) {
+    unsigned long long total = 0;
+    for (int w = 0; w < int(blockDim.x + 31) / 32; ++w) total += warpSums[w];
+    if (total) atomicAdd(setParts + blockIdx.x % kPartCounters, total);
+  }
+}
+
+// Launch shape: one thread per brick, 256 per block. markedDistance; without states (no masks)
+// the marks are cleared.
+__global__ void markKernel(uint8_t* dist, const uint8_t* state, int64_t n) {
+  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < n) dist[i] = state ? markedDistance(dist[i], state[i]) : uint8_t(dist[i] & 0x7f);
 }
 
 }  // namespace
@@ -66,7 +108,7 @@ cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims
   const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
   classifyKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_vmin, d_vmax, bdims, brick, cellDims, rmq, cc,
                                                                   d_prev, d_occ, &d_flags->occupied,
-                                                                  &d_flags->changed);
+                                                                  &d_flags->changed, &d_flags->grew);
   return cudaPeekAtLastError();
 }
 
@@ -75,6 +117,10 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
   haveOcc = false;
   brick = std::max(1, b);
   cellDims = vol.cellDims();
+  d_voxels_ = v.d_voxels<unsigned char>();
+  type_ = vol.type;
+  dims_ = vol.dims;
+  components_ = vol.components;
   bdims = vec3i{(cellDims.x + brick - 1) / brick, (cellDims.y + brick - 1) / brick, (cellDims.z + brick - 1) / brick};
   const size_t nb = size_t(numBricks());
   d_vmin.reserve(nb);
@@ -87,6 +133,7 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
 
 void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaStream_t stream) {
   haveOcc = false;
+  d_voxels_ = nullptr;  // sparse residency: no voxels on the device, no sub-brick masks
   brick = r.brick;
   cellDims = vol.cellDims();
   bdims = r.dims;
@@ -114,16 +161,41 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   SS_CUDA_CHECK(cudaMemsetAsync(d_flags_.get(), 0, sizeof(ClassifyFlags), stream));
   SS_CUDA_CHECK(
       classifyBricks(d_vmin.get(), d_vmax.get(), bdims, brick, cellDims, rmq, cc, prev, next, d_flags_.get(), stream));
+  haveSub_ = d_voxels_ && components_ == 1 && usesSubMasks(brick) && subMasksEnabled();
+  if (haveSub_) {
+    const int64_t nb = numBricks();
+    d_sub_.reserve(size_t(nb));
+    d_state_.reserve(size_t(nb));
+    const int maxSet = subMaskMaxSet();
+    dispatchVoxelType(type_, [&](auto t) {
+      using T = decltype(t);
+      subMaskKernel<T><<<blocksFor(nb, kThreads), kThreads, 0, stream>>>(
+          static_cast<const T*>(d_voxels_), dims_, cellDims, bdims, brick, rmq, maxSet, next, d_sub_.get(),
+          d_state_.get(), d_flags_.get()->setParts);
+    });
+    SS_CUDA_CHECK_LAUNCH(subMaskKernel);
+  }
   auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
   SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
   cur = 1 - cur;
   const bool changed = !haveOcc || flags->changed != 0;
+  grew = !haveOcc || flags->grew != 0;
   if (changed) ++generation;
   haveOcc = true;
   occupied = int64_t(flags->occupied);
+  unsigned long long set = 0;
+  for (int c = 0; c < kPartCounters; ++c) set += flags->setParts[c];
+  setFraction = haveSub_ && occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
   hostOccValid_ = false;
   return changed;
+}
+
+void BrickClassification::markDistances(uint8_t* d_dist, cudaStream_t stream) const {
+  const int64_t n = numBricks();
+  if (n <= 0) return;
+  markKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_dist, brickStates(), n);
+  SS_CUDA_CHECK_LAUNCH(markKernel);
 }
 
 const OccupancyGrid& BrickClassification::occupancy(cudaStream_t stream) {

@@ -10,6 +10,8 @@ namespace spaceskip::cuda {
 struct ClassifyFlags {
   unsigned long long occupied;  ///< occupied bricks
   int changed;                  ///< 1 when some brick differs from the previous occupancy
+  int grew;                     ///< 1 when some brick is occupied that was not before (or no previous)
+  unsigned long long setParts[64];  ///< set sub-brick parts, summed over spread counters
 };
 
 /// d_vmin/d_vmax[i] = brickRange of brick i (x fastest) of the `bdims` bricks of `brick` cells
@@ -49,13 +51,33 @@ class BrickClassification {
   vec3i cellDims{0, 0, 0}, bdims{0, 0, 0};
   DeviceBuffer<float> d_vmin, d_vmax;
   DeviceBuffer<uint8_t> d_occ[2];  ///< d_occ[cur]: the current occupancy
+  /// The sub-brick masks of the current occupancy (Classification.h); null when there are none
+  /// (brick size, several components, sparse residency, SPACESKIP_SUB_MASKS=0).
+  const uint64_t* subMasks() const { return haveSub_ ? d_sub_.get() : nullptr; }
+  /// The brick states of the current occupancy (subBrickState), with the masks; else null.
+  const uint8_t* brickStates() const { return haveSub_ ? d_state_.get() : nullptr; }
+  /// Marks DistanceGrid's field `d_dist` (one byte per brick) with markedDistance for the
+  /// current states, or clears the marks when there are none (on `stream`, no synchronization).
+  void markDistances(uint8_t* d_dist, cudaStream_t stream) const;
   int cur = 0;
   bool haveOcc = false;  ///< classify() ran for this volume
   int64_t occupied = 0;
   uint64_t generation = 0;  ///< counts classify() calls that changed the occupancy
+  bool grew = true;         ///< the last classify() occupied a brick the previous one had empty
+  /// Set parts over all parts of the occupied bricks (sub-brick masks; 1 without masks): the
+  /// share of an occupied brick's volume a part-walking frame still marches.
+  double setFraction = 1.0;
 
  private:
   DeviceBuffer<float> d_levels_;  ///< OpacityRangeMax's levels
+  DeviceBuffer<uint64_t> d_sub_;
+  DeviceBuffer<uint8_t> d_state_;
+  bool haveSub_ = false;
+  // The in-core voxels the masks read (setVolume; none after setRanges).
+  const void* d_voxels_ = nullptr;
+  VoxelType type_ = VoxelType::UInt8;
+  vec3l dims_{0, 0, 0};
+  int components_ = 1;
   DeviceBuffer<ClassifyFlags> d_flags_;
   PinnedBuffer h_flags_;
   OccupancyGrid hostOcc_;

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 
 namespace spaceskip {
 
@@ -54,8 +55,16 @@ class CudaBackend final : public Backend {
 
   bool classify(const TransferFunction& tf, const CropClip& cc) override {
     tf_ = tf;
-    return cls_.classify(tf, cc, stream_);
+    const bool changed = cls_.classify(tf, cc, stream_);
+    // The field kept across an edit that changed no occupancy (or drawn stale after one that only
+    // emptied bricks) takes the new states' marks.
+    if (d_distField_) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+    return changed;
   }
+  // Sparse residency loads the bricks the current occupancy needs: a structure that visits
+  // more would sample bricks that are not resident.
+  double subMaskShare() const override { return cls_.subMasks() ? cls_.setFraction : 1.0; }
+  bool lastClassifyOnlyEmptied() const override { return !cls_.grew && !pool_.active(); }
 
   void setMemoryBudget(int64_t bytes, int poolBrick) override {
     budget_ = bytes > 0 ? bytes : 0;
@@ -79,8 +88,10 @@ class CudaBackend final : public Backend {
     hybridGridValid_ = false;
     d_distField_ = nullptr;
     s.builtOn = "cuda";
-    if (info.extra == BuilderExtra::DistanceField)
+    if (info.extra == BuilderExtra::DistanceField) {
       d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, kMaxSkipDistance, dist_, stream_);
+      cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+    }
     if (info.cuda) {
       cuda::BuildContext ctx{{d_occ_[cur_].get(), bdims_, brick_, cellDims_, occupied_}, stream_, tree_, workspaces_};
       info.cuda(ctx, p);
@@ -108,11 +119,24 @@ class CudaBackend final : public Backend {
     s.leaves = tree_.leaves;
   }
 
+  /// Grid and DistanceGrid frames walk the parts of sparse bricks (GridParts) only where the set
+  /// parts are at most this share of the occupied bricks' parts: on the H100 the part walk made
+  /// every stand-in of the paper 5-26% slower where the share was 0.3 and more, and N-body
+  /// 1024^3 / 2048^3 (shares about 0.13 / 0.06) 1.26x / 1.71x faster (docs/results/round9-h100).
+  static constexpr double kPartsShare = 0.2;
+
   void render(FrameView f, FilterMode filter, const float* depth, Image& out) override {
     f.traversal = traversal_;
+    // SPACESKIP_CUDA_PARTS_SHARE (read per frame): another threshold, a measurement and test switch.
+    const char* share = std::getenv("SPACESKIP_CUDA_PARTS_SHARE");
+    const double maxShare = share ? std::atof(share) : kPartsShare;
+    const bool parts = traversal_ == TraversalKind::Grid && cls_.subMasks() && cls_.setFraction <= maxShare;
     if (traversal_ == TraversalKind::Hybrid && hybridGridValid_)
       f.grid = GridView{d_hybrid_.get(), hybridDims_, hybridBrick_};
-    else
+    else if (parts) {
+      f.traversal = TraversalKind::GridParts;
+      f.grid = GridView{cls_.brickStates(), bdims_, brick_, d_distField_, nullptr, nullptr, cls_.subMasks()};
+    } else
       f.grid = GridView{d_occ_[cur_].get(), bdims_, brick_, d_distField_};
     f.tree = TreeView{tree_.nodes.get(), tree_.numNodes};
     // In these modes every skipping builder marches the value ranges (render/Integrator.h, usesValueRanges).
@@ -155,7 +179,7 @@ class CudaBackend final : public Backend {
 
  private:
   /// Free device memory at setVolume, less what the rest of the backend may need (value
-  /// ranges, occupancy, distance field and trees: 32 bytes per brick) and 1 GiB for images,
+  /// ranges, occupancy, distance field, sub-brick masks and trees: 40 bytes per brick) and 1 GiB for images,
   /// textures' conversions and the builders' workspaces.
   static int64_t defaultBudget(const Volume& v, int brick) {
     size_t freeBytes = 0, total = 0;
@@ -169,7 +193,7 @@ class CudaBackend final : public Backend {
     const int64_t limit = cuda::deviceMemoryLimit();  // the testing cap, when set
     int64_t avail = int64_t(freeBytes) + cuda::liveDeviceBytes().load();
     if (limit >= 0) avail = std::min(avail, limit);
-    return std::max<int64_t>(0, avail - bricks * 32 - (int64_t(1) << 30));
+    return std::max<int64_t>(0, avail - bricks * 40 - (int64_t(1) << 30));
   }
 
   void uploadTree(const Tree& t) {

@@ -20,10 +20,12 @@ namespace {
 // every ESS kernel 4-11% slower than no cap, so the default is 1 (no cap).
 constexpr int kMaxRenderThreads = 256;
 // Default launch of the hardware-filtered kernels: plain for volumes up to kLargeTextureBytes; a
-// persistent launch with kLargeTextureResident blocks of 128 threads per SM above. Measured on
-// the H100 (docs/results/cuda-h100-round3): naive:hw at 2048^3 (8 GiB) runs fastest with 6
-// blocks per SM (more warps in flight thrash the texture path), at 1024^3 (1 GiB) with all 16;
-// the skipping kernels do not care either way.
+// persistent launch with kLargeTextureResident blocks of 128 threads per SM above, for Naive
+// only. Measured on the H100 (docs/results/cuda-h100-round3): naive:hw at 2048^3 (8 GiB) runs
+// fastest with 6 blocks per SM (more warps in flight thrash the texture path), at 1024^3 (1 GiB)
+// with all 16. The skipping kernels (iterators since round 6) run faster plain: DistanceGrid at
+// N-body 2048^3 789 kernel fps plain vs 730 persistent, in one process
+// (docs/results/round9-h100/before).
 constexpr size_t kLargeTextureBytes = size_t(2) << 30;
 constexpr int kLargeTextureResident = 6;
 template <class Sampler>
@@ -82,6 +84,11 @@ RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
     case TraversalKind::Grid: return renderKernel<Sampler, int(TraversalKind::Grid), Plain>;
     case TraversalKind::Tree: return renderKernel<Sampler, int(TraversalKind::Tree), Plain>;
     case TraversalKind::Hybrid: return renderKernel<Sampler, int(TraversalKind::Hybrid), Plain>;
+    case TraversalKind::GridParts:
+      // Parts are walked in plain frames only (the speed that matters; other modes march whole
+      // bricks: the same samples that can be drawn, fewer kernels to compile).
+      if constexpr (Plain) return renderKernel<Sampler, int(TraversalKind::GridParts), Plain>;
+      else return renderKernel<Sampler, int(TraversalKind::Grid), Plain>;
   }
   return renderKernel<Sampler, int(TraversalKind::Naive), Plain>;
 }
@@ -244,9 +251,10 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
                           cudaStream_t stream) {
   // Persistent launch with N blocks per SM taking tiles from a counter (0: one block per tile, the
   // plain launch): LaunchParams::resident, else SPACESKIP_CUDA_RESIDENT (read per frame), else automatic.
-  int residentBlocks = std::is_same<Sampler, TextureSampler>::value && textureBytes > kLargeTextureBytes
-                           ? std::max(1, kLargeTextureResident * 128 / int(block.x * block.y))
-                           : 0;
+  int residentBlocks =
+      std::is_same<Sampler, TextureSampler>::value && textureBytes > kLargeTextureBytes && f.traversal == TraversalKind::Naive
+          ? std::max(1, kLargeTextureResident * 128 / int(block.x * block.y))
+          : 0;
   if (launch_.resident >= 0) residentBlocks = launch_.resident;
   else if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks = std::max(0, std::atoi(r));
   RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f);

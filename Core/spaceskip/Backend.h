@@ -23,6 +23,10 @@ class Backend {
   /// Re-classifies bricks against the TF opacity and what `cc` leaves drawn (bricks no drawn
   /// sample can reach are empty); returns true when the occupancy changed.
   virtual bool classify(const TransferFunction& tf, const CropClip& cc) = 0;
+  /// True when the last classify() changed the occupancy only by emptying bricks (every brick
+  /// occupied now was occupied before): a structure built before it still covers every
+  /// occupied brick, so drawing with it stays lossless (it only visits bricks that are empty now).
+  virtual bool lastClassifyOnlyEmptied() const { return false; }
   /// The opacity-corrected table the integrator samples.
   virtual void setTransferTable(const std::vector<vec4f>& corrected, float lo, float scale) = 0;
   /// Builds the hierarchy `p.builder` asks for; throws BackendError when this backend cannot.
@@ -55,6 +59,9 @@ class Backend {
   virtual const OccupancyGrid& occupancy() = 0;
   /// Fraction of occupied bricks after the last classify(), without a host copy of the grid.
   virtual double occupiedFraction() { return occupancy().occupancy(); }
+  /// Set sub-brick parts over all parts of the occupied bricks after the last classify(); 1
+  /// without masks.
+  virtual double subMaskShare() const { return 1.0; }
   virtual Tree tree() = 0;
 };
 

@@ -49,6 +49,12 @@ const BuilderInfo& builderInfo(BuilderKind b);
 inline bool buildsTree(const BuilderInfo& b) {
   return b.traversal == TraversalKind::Tree || b.traversal == TraversalKind::Hybrid;
 }
+/// Whether building `b` makes anything beyond the classification's occupancy grid (a tree, a
+/// distance field, a coarse grid): Naive and Grid make nothing.
+inline bool buildsBeyondClassification(BuilderKind b) {
+  const BuilderInfo& i = builderInfo(b);
+  return buildsTree(i) || i.extra != BuilderExtra::None;
+}
 /// Whether a backend without device builders can build `b` itself (else it takes b.fallback).
 inline bool runsOnCpu(const BuilderInfo& b) { return !buildsTree(b) || b.cpu != nullptr; }
 

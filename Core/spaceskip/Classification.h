@@ -112,4 +112,76 @@ SS_FUNC bool brickOccupied(int64_t i, float vmin, float vmax, const RangeMax& rm
 /// leave drawn (oneTBB).
 OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, const CropClip& cc = CropClip{});
 
+/// Sub-brick masks: each occupied brick split into kSubPerAxis^3 = 64 parts of brick/4 cells a
+/// side, one bit each (x fastest), set when some sample inside the part can have opacity > 0:
+/// the brick rule (brickRange's +1 halo, OpacityRangeMaxView::query) on the part's own voxels.
+/// The grid traversals (GridIter) walk an occupied brick's parts and march only the set ones,
+/// so a brick that a few particles touch costs the samples of those parts, not of the whole
+/// brick. Recomputed on every opacity edit, for the occupied bricks only (the others get 0);
+/// only where a brick has 4 parts of >= 2 cells a side (brick 8, 12, 16, ...), one component,
+/// the voxels in core.
+/// (kSubPerAxis and usesSubMasks: Types.h, which the render headers read.)
+
+/// The mask of brick (bx, by, bz) of `brick` cells in a volume of `dims` voxels (`cellDims`
+/// cells) at `data`; parts with no cell inside the volume get 0.
+template <class T, class RangeMax>
+SS_FUNC uint64_t subBrickMask(const T* data, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz,
+                              const RangeMax& rmq) {
+  const int s = brick / kSubPerAxis;
+  uint64_t mask = 0;
+  for (int k = 0; k < kSubPerAxis * kSubPerAxis * kSubPerAxis; ++k) {
+    const int64_t c0[3] = {bx * brick + (k & 3) * s, by * brick + ((k >> 2) & 3) * s, bz * brick + (k >> 4) * s};
+    if (c0[0] >= cellDims.x || c0[1] >= cellDims.y || c0[2] >= cellDims.z) continue;  // no cell of the volume
+    int64_t v1[3];
+    const int64_t n[3] = {dims.x, dims.y, dims.z};
+    for (int a = 0; a < 3; ++a) v1[a] = c0[a] + s < n[a] - 1 ? c0[a] + s : n[a] - 1;
+    float lo = INFINITY, hi = -INFINITY;
+    for (int64_t z = c0[2]; z <= v1[2]; ++z)
+      for (int64_t y = c0[1]; y <= v1[1]; ++y) foldRange<T, 1>(data + dims.x * (y + dims.y * z), c0[0], v1[0], lo, hi);
+    if (rmq.query(lo, hi) > 0.f) mask |= uint64_t(1) << k;
+  }
+  return mask;
+}
+
+/// Walking a brick's parts pays where few are set (particles); where many are, the walk costs
+/// more than the samples it saves (measured on the H100: docs/results/round9-h100). So each
+/// occupied brick gets a state byte: kBrickWhole (march it whole) or kBrickParts (walk the set
+/// parts of its mask), the latter when at most `maxSet` of the 64 parts are set. Bit 7 marks
+/// "parts" in the state and in DistanceGrid's field alike (distances are <= kMaxSkipDistance),
+/// so the traversal learns it from the byte it reads anyway and loads the mask only then.
+constexpr uint8_t kBrickEmpty = 0, kBrickWhole = 1, kBrickParts = kBrickPartsBit | 1;  // kBrickPartsBit: Types.h
+SS_FUNC int popcount64(uint64_t m) {
+#ifdef __CUDA_ARCH__
+  return __popcll(m);
+#else
+  return __builtin_popcountll(m);
+#endif
+}
+SS_FUNC uint8_t subBrickState(bool occupied, uint64_t mask, int maxSet) {
+  return !occupied ? kBrickEmpty : popcount64(mask) <= maxSet ? kBrickParts : kBrickWhole;
+}
+/// DistanceGrid's byte for a brick at distance `dist` (its field) in `state`: an occupied brick
+/// (distance 0) walks its parts when its state says so, or when it is empty now (a field built
+/// before an edit that emptied it: its mask is 0, so nothing of it is marched).
+SS_FUNC uint8_t markedDistance(uint8_t dist, uint8_t state) {
+  const uint8_t d = uint8_t(dist & 0x7f);
+  return d == 0 && (state == kBrickEmpty || (state & kBrickPartsBit)) ? uint8_t(kBrickPartsBit) : d;
+}
+
+/// The masks and states of `occ` (one per brick, x fastest) for the voxels of `v` and `tf`
+/// (oneTBB); empty when subMasksEnabled() or usesSubMasks(occ.brick) is false or `v` has
+/// several components.
+struct SubMasks {
+  std::vector<uint64_t> mask;
+  std::vector<uint8_t> state;
+  double share = 1.0;  ///< set parts over all parts of the occupied bricks
+};
+SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf);
+/// Whether the backends compute sub-brick masks: yes unless SPACESKIP_SUB_MASKS=0 (read at each
+/// classification; a measurement switch: without masks an occupied brick is marched whole).
+bool subMasksEnabled();
+/// The most set parts a brick may have to be walked part by part (subBrickState): 24 of 64,
+/// or SPACESKIP_SUB_MASK_MAX (0..64, read at each classification; a measurement switch).
+int subMaskMaxSet();
+
 }  // namespace spaceskip

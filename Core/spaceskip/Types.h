@@ -16,7 +16,9 @@ namespace spaceskip {
 
 /// How the render loop walks the skipping structure (the registry in Builders.h maps each
 /// builder to one).
-enum class TraversalKind : int { Naive = 0, Grid = 1, Tree = 2, Hybrid = 3 };
+/// GridParts is Grid (and DistanceGrid) walking the parts of the bricks marked for it
+/// (sub-brick masks, Classification.h): a backend draws a Grid frame with it where that pays.
+enum class TraversalKind : int { Naive = 0, Grid = 1, Tree = 2, Hybrid = 3, GridParts = 4 };
 
 enum class BuilderKind : int {
   Naive,          ///< no skipping (the paper's baseline)
@@ -147,6 +149,14 @@ constexpr int kMaxClipPlanes = 6;
 constexpr double kMinStepsPerVoxel = 16;
 constexpr double kMaxSamplesPerRay = double(1 << 20);
 
+/// Sub-brick masks (Classification.h, subBrickMask): parts per brick edge, and the bricks that
+/// have them (4 parts of >= 2 cells a side).
+constexpr int kSubPerAxis = 4;
+SS_FUNC bool usesSubMasks(int brick) { return brick >= 8 && brick % kSubPerAxis == 0; }
+/// In a brick's state byte and in DistanceGrid's field: walk this occupied brick part by part
+/// (Classification.h, subBrickState).
+constexpr uint8_t kBrickPartsBit = 0x80;
+
 struct BuildStats {
   BuilderKind builder = BuilderKind::Naive;
   std::string builtOn;       ///< "cpu" or "cuda"
@@ -156,6 +166,8 @@ struct BuildStats {
   int height = 0;
   int64_t leaves = 0;
   double occupancy = 0;      ///< fraction of occupied macro cells
+  /// Set sub-brick parts over all parts of the occupied bricks (Classification.h); 1: no masks.
+  double partsShare = 1;
   /// Builder Auto: what it chose and why, one line ("" for the other builders, "exploring ..."
   /// while it measures).
   std::string choice;
@@ -194,6 +206,9 @@ struct Counters {
   int rangeGrids = 0;
   int classifications = 0;
   int builds = 0;
+  /// Frames Builder Auto drew with the structure built before an edit that only emptied bricks
+  /// (Backend::lastClassifyOnlyEmptied), leaving its rebuild to the next frame.
+  int staleFrames = 0;
   int colorUpdates = 0;
   int frames = 0;
   /// Whole-table compares of Engine::setTransferFunction (the parts its caller said may differ).

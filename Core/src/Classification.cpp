@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 
 namespace spaceskip {
@@ -86,6 +87,48 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, cons
       },
       [](int64_t a, int64_t b) { return a + b; });
   return o;
+}
+
+}  // namespace spaceskip
+
+namespace spaceskip {
+
+bool subMasksEnabled() {
+  const char* e = std::getenv("SPACESKIP_SUB_MASKS");
+  return !(e && e[0] == '0');
+}
+
+int subMaskMaxSet() {
+  const char* e = std::getenv("SPACESKIP_SUB_MASK_MAX");
+  const int v = e ? std::atoi(e) : 24;
+  return std::clamp(v, 0, 64);
+}
+
+SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf) {
+  SubMasks out;
+  if (!subMasksEnabled() || !usesSubMasks(occ.brick) || v.components != 1 || !v.data || occ.occ.empty()) return out;
+  out.mask.resize(size_t(occ.size()));
+  out.state.resize(size_t(occ.size()));
+  OpacityRangeMax rmq(tf);
+  const int maxSet = subMaskMaxSet();
+  const int64_t bx = occ.dims.x, by = occ.dims.y;
+  dispatchVoxelType(v.type, [&](auto t) {
+    using T = decltype(t);
+    const T* data = static_cast<const T*>(v.data);
+    tbb::parallel_for(tbb::blocked_range<int64_t>(0, occ.size(), 4096), [&](const tbb::blocked_range<int64_t>& r) {
+      for (int64_t i = r.begin(); i != r.end(); ++i) {
+        const bool o = occ.occ[size_t(i)] != 0;
+        const uint64_t m =
+            o ? subBrickMask(data, v.dims, occ.cellDims, occ.brick, i % bx, (i / bx) % by, i / (bx * by), rmq.view()) : 0;
+        out.mask[size_t(i)] = m;
+        out.state[size_t(i)] = subBrickState(o, m, maxSet);
+      }
+    });
+  });
+  int64_t set = 0;
+  for (const uint64_t m : out.mask) set += popcount64(m);
+  out.share = occ.occupied > 0 ? double(set) / (64.0 * double(occ.occupied)) : 1.0;
+  return out;
 }
 
 }  // namespace spaceskip

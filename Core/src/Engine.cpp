@@ -539,6 +539,7 @@ struct Engine::Impl {
       cropClip = cc;
       cropClipDirty = true;
     }
+    const bool newRanges = rangesDirty;
     if (rangesDirty) {
       backend->setVolume(volume, build.brick);
       ++counters.rangeGrids;
@@ -575,6 +576,25 @@ struct Engine::Impl {
       tableDirty = colorDirty = false;
     }
     if (refineNow && !buildDirty) buildDirty = true;
+    // Progressive refinement without any build: an edit that only emptied bricks leaves the
+    // structure Auto holds covering every occupied brick, so the edit's frame draws with it
+    // (lossless: it only visits some bricks that are empty now, whose sub-brick masks are 0)
+    // and the next frame rebuilds it.
+    if (buildDirty && edited && !newRanges && build.builder == BuilderKind::Auto && build.autoQuickBuildSeconds >= 0 &&
+        !autoState.exploring && autoState.built >= 0 && autoState.built == autoState.current &&
+        buildsBeyondClassification(autoState.candidates[size_t(autoState.current)].builder) &&
+        backend->lastClassifyOnlyEmptied()) {
+      AutoState& a = autoState;
+      a.standIn = true;
+      a.refined = false;
+      buildDirty = false;
+      stats.seconds = 0;
+      stats.occupancy = backend->occupiedFraction();
+      stats.partsShare = backend->subMaskShare();
+      stats.choice = a.choice + "; this frame: the " + builderName(a.candidates[size_t(a.current)].builder) +
+                     " built before the edit (it only emptied bricks), rebuilt next frame";
+      ++counters.staleFrames;
+    }
     // Auto: the structure to draw with is built when the backend holds another (measuring moves
     // `current`; a cancelled re-check whose contender was never built rebuilds nothing).
     if (build.builder == BuilderKind::Auto && autoState.current != autoState.built) buildDirty = true;
@@ -613,6 +633,7 @@ struct Engine::Impl {
       s.builder = p.builder;
       s.classifySeconds = stats.classifySeconds;
       s.occupancy = backend->occupiedFraction();
+      s.partsShare = backend->subMaskShare();
       if (isAuto) {
         autoState.built = use;
         autoState.buildSeconds[size_t(use)] = s.seconds;

@@ -3,6 +3,7 @@
 // equals Naive's image; measured again only when the occupancy moves or the size changes (Grid
 // first after an edit), and re-checked against its contenders at a new view where the camera rests.
 #include "TestUtil.h"
+#include "spaceskip/Builders.h"
 
 #include <gtest/gtest.h>
 
@@ -182,9 +183,16 @@ TEST(AutoBuilder, AfterAnEditGridStandsInForOneFrameThenTheKeptStructureIsRebuil
     }
   }
   ASSERT_NE(occupancyWith(tf2), occ1) << "test premise: an edit that changes the occupied cells";
-  const Image naive = test::renderWith(s.v, tf2, test::builder(BuilderKind::Naive), 30, 20, false, 64);
-  const int builds = e.counters().builds;
+  // Settled at tf2, the edit lowers the threshold back to 30: it occupies bricks (an edit that
+  // only empties some draws with the structure built before it: the next test).
   e.setTransferFunction(tf2);
+  e.render(s.cam, 64, 64, img);
+  s.settle(64, 64);
+  e.render(s.cam, 64, 64, img);
+  ASSERT_EQ(keptName(), kept) << "test premise: the same choice at tf2";
+  const Image naive = test::renderWith(s.v, ramp(30), test::builder(BuilderKind::Naive), 30, 20, false, 64);
+  const int builds = e.counters().builds;
+  e.setTransferFunction(ramp(30));
   e.render(s.cam, 64, 64, img);
   ASSERT_FALSE(e.exploring()) << "test premise: a small occupancy change";
   EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f);
@@ -207,10 +215,69 @@ TEST(AutoBuilder, AfterAnEditGridStandsInForOneFrameThenTheKeptStructureIsRebuil
   s.settle(64, 64);
   e.render(s.cam, 64, 64, img);
   const std::string kept2 = keptName();
-  e.setTransferFunction(ramp(30));
+  const int stale = e.counters().staleFrames;
+  e.setTransferFunction(tf2);
   e.render(s.cam, 64, 64, img);
   ASSERT_FALSE(e.exploring()) << "test premise: a small occupancy change";
   EXPECT_EQ(builderName(e.buildStats().builder), kept2);
+  EXPECT_EQ(e.counters().staleFrames, stale) << "refinement off: nothing drawn with a stale structure";
+}
+
+TEST(AutoBuilder, AnEditThatOnlyEmptiesBricksDrawsWithTheStructureBuiltBeforeIt) {
+  // Raising the opacity threshold only empties bricks: the structure Auto holds still covers
+  // every occupied brick, so the edit's frame builds nothing and draws with it (Naive's image),
+  // and the next frame rebuilds it. Lowering the threshold again occupies bricks: rebuilt at once.
+  // The scene: a ball whose value falls off from its centre, far from everything else in a
+  // large empty volume, where the grid's DDA walks many empty bricks and a distance field or a
+  // tree leaps over them (so Auto keeps a structure that is built, whatever the machine).
+  const int n = 160;
+  Volume v;
+  v.allocate(vec3l{n, n, n}, VoxelType::UInt8);
+  uint8_t* d = v.mutableData();
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const double r = std::sqrt(double((x - 40) * (x - 40) + (y - 50) * (y - 50) + (z - 60) * (z - 60))) / 14.0;
+        d[x + n * (y + n * z)] = uint8_t(r < 1 ? 255 * (1 - r) : 0);
+      }
+  auto ramp = [](float zeroUpTo) {
+    return TransferFunction::fromPoints({{0, 1, 1, 1, 0.f}, {zeroUpTo, 1, 1, 1, 0.f}, {255, 1, 0, 0, 0.8f}}, 0, 255, 256);
+  };
+  const Camera cam = test::orbit(v, 30, 20);
+  Engine e{BackendKind::CPU};
+  test::load(e, v, ramp(30), test::builder(BuilderKind::Auto));
+  Image img;
+  auto settle = [&] {
+    while (e.exploring()) e.render(cam, 96, 96, img);
+    e.render(cam, 96, 96, img);
+  };
+  settle();
+  const BuilderKind kept = e.buildStats().builder;
+  ASSERT_TRUE(buildsBeyondClassification(kept)) << "test premise: Auto keeps a built structure here: "
+                                                << e.buildStats().choice;
+  const int builds = e.counters().builds, stale = e.counters().staleFrames;
+  const double occ = e.buildStats().occupancy;
+  e.setTransferFunction(ramp(90));
+  e.render(cam, 96, 96, img);
+  ASSERT_FALSE(e.exploring()) << "test premise: a small occupancy change";
+  ASSERT_LT(e.buildStats().occupancy, occ) << "test premise: the edit empties bricks";
+  auto naive = [&](float cut) { return test::renderWith(v, ramp(cut), test::builder(BuilderKind::Naive), 30, 20, false, 96); };
+  EXPECT_LE(compareImages(naive(90), img).maxAbs, 1.f / 255.f);
+  EXPECT_EQ(e.counters().builds, builds) << "no build on the edit's frame";
+  EXPECT_EQ(e.counters().staleFrames, stale + 1);
+  EXPECT_EQ(e.buildStats().builder, kept);
+  EXPECT_NE(e.buildStats().choice.find("built before the edit"), std::string::npos) << e.buildStats().choice;
+  e.render(cam, 96, 96, img);
+  EXPECT_EQ(e.counters().builds, builds + 1) << "the frame after rebuilds it";
+  EXPECT_EQ(e.buildStats().builder, kept);
+  EXPECT_EQ(e.buildStats().choice.find("built before the edit"), std::string::npos);
+  EXPECT_LE(compareImages(naive(90), img).maxAbs, 1.f / 255.f);
+  // Back to 30: bricks become occupied, which the structure built at 90 misses: rebuilt at once
+  // (or Grid stands in), never drawn stale.
+  e.setTransferFunction(ramp(30));
+  e.render(cam, 96, 96, img);
+  EXPECT_EQ(e.counters().staleFrames, stale + 1);
+  EXPECT_LE(compareImages(naive(30), img).maxAbs, 1.f / 255.f);
 }
 
 TEST(AutoBuilder, AStillCameraAtAFarViewReChecksTheChoiceAnOrbitDoesNot) {

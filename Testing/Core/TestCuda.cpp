@@ -269,6 +269,57 @@ TEST(CudaBackend, ClassificationEqualsCpu) {
   }
 }
 
+TEST(CudaBackend, PartWalkEqualsWholeBricksAndTheCpu) {
+  // Sub-brick masks on the device: frames that walk the parts of sparse bricks (GridParts,
+  // forced with SPACESKIP_CUDA_PARTS_SHARE=1) and frames that march whole bricks (0) give the
+  // CPU's image (which walks the parts), for Grid and DistanceGrid, exact and hardware filter,
+  // several voxel types; the part walk takes fewer samples.
+  REQUIRE_CUDA();
+  struct Case {
+    const char* shape;
+    VoxelType type;
+  };
+  for (const Case& c : {Case{"nbody", VoxelType::UInt8}, Case{"vessels", VoxelType::UInt16}, Case{"noise", VoxelType::Float32}}) {
+    Volume base = generateVolume(c.shape, vec3l{80, 72, 64}, 5);
+    Volume v = base.type == c.type ? base : convert(base, c.type);
+    const TransferFunction tf = tfFor(v, "ramp");
+    for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid}) {
+      const Built cpu = run(v, tf, params(k), BackendKind::CPU, 30, 20);
+      ASSERT_GT(test::coverage(cpu.img), 0.001) << "test premise: the scene is not empty";
+      int64_t samples[2] = {0, 0};
+      Image hw[2];
+      for (int forced = 0; forced < 2; ++forced) {
+        setenv("SPACESKIP_CUDA_PARTS_SHARE", forced ? "1" : "0", 1);
+        const Built g = run(v, tf, params(k), BackendKind::CUDA, 30, 20);
+        ASSERT_EQ(g.kind, BackendKind::CUDA);
+        EXPECT_LE(compareImages(cpu.img, g.img).maxAbs, 2.f / 255.f)
+            << c.shape << " " << builderName(k) << (forced ? " parts" : " whole");
+        hw[forced] = run(v, tf, params(k), BackendKind::CUDA, 30, 20, false, FilterMode::Hardware).img;
+        Engine e(BackendKind::CUDA);
+        e.setLogger([](const std::string&) {});
+        e.setVolume(v);
+        e.setTransferFunction(tf);
+        e.setBuildParams(params(k));
+        RenderParams rp;
+        rp.countSamples = true;
+        e.setRenderParams(rp);
+        double b[6];
+        v.worldBounds(b);
+        Image img;
+        e.render(orbitCamera(b, 30, 20, 1.0, false, 1.0), 96, 96, img);
+        samples[forced] = e.frameStats().samples;
+      }
+      unsetenv("SPACESKIP_CUDA_PARTS_SHARE");
+      // The hardware filter differs from exact sampling, not between the two walks.
+      EXPECT_LE(compareImages(hw[0], hw[1]).maxAbs, 1.f / 255.f) << c.shape << " " << builderName(k) << " hardware";
+      // Fewer samples where bricks are sparse inside (particles); never more.
+      if (std::string(c.shape) == "nbody") EXPECT_LT(samples[1], samples[0]);
+      EXPECT_LE(samples[1], samples[0]) << c.shape << " " << builderName(k) << ": parts " << samples[1] << ", whole "
+                                        << samples[0];
+    }
+  }
+}
+
 TEST(CudaBackend, OpacityEditRebuildsOnlyWhenOccupancyChanges) {
   REQUIRE_CUDA();
   Volume v = generateVolume("nbody", vec3l{48, 48, 48}, 2);

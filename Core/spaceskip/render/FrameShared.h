@@ -26,6 +26,11 @@ struct GridView {
   /// far; so every visited brick is handed over on its own, before the next one is decided.
   const float* vmin = nullptr;
   const float* vmax = nullptr;
+  /// Optional (Grid, DistanceGrid): per brick its sub-brick mask (Classification.h,
+  /// subBrickMask), read for occupied bricks whose byte (`occ`: the brick states, or `dist`)
+  /// has kBrickPartsBit: the DDA then walks the brick's 4^3 parts and yields the set ones. Not
+  /// read with value ranges.
+  const uint64_t* sub = nullptr;
 };
 
 struct TreeView {

@@ -461,6 +461,11 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
         it.init(f.grid, rl, inv, a, b);
         return m.walk(it);
       }
+      case TraversalKind::GridParts: {
+        GridPartsIter it;
+        it.init(f.grid, rl, inv, a, b);
+        return m.walk(it);
+      }
       case TraversalKind::Tree: {
         TreeIter it;
         it.init(f.tree, rl, inv, a, b);

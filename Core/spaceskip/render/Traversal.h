@@ -20,13 +20,66 @@ enum class Step : int { Skip, Interval, Done };
 /// around it: the ray leaps to where it exits that cube (proximity clouds), then the DDA
 /// restarts there. With value ranges (GridView::vmin) a brick is occupied when
 /// `m.active(vmin, vmax)` says so, decided when the previous interval's samples are taken.
-struct GridIter {
+/// With sub-brick masks (GridView::sub) an occupied brick whose byte says so (bit 7,
+/// kBrickPartsBit) is walked by a second DDA over its 4^3 parts, which yields the runs of set
+/// parts only (no memory reads beyond the mask).
+template <bool Parts>
+struct GridIterT {
   const GridView* g;
   vec3f org, dir, inv;
   float t, tmax, B;
   int cell[3], step[3];
   float tNext[3], tDelta[3];
   bool done;
+  // The brick being walked part by part: its mask (0: none), the part, where the ray leaves
+  // the part along each axis, the cursor and where the ray leaves the brick.
+  uint64_t mask = 0;
+  int sc[3];
+  float sNext[3];
+  float ts, tsEnd;
+
+  /// The next run of set parts of the brick being walked: [a, b). false: the brick is done.
+  SS_FUNC bool partRun(float& a, float& b) {
+    const float S = B * (1.f / float(kSubPerAxis));
+    bool have = false;
+    while (ts < tsEnd) {
+      const int axis = sNext[0] < sNext[1] ? (sNext[0] < sNext[2] ? 0 : 2) : (sNext[1] < sNext[2] ? 1 : 2);
+      const bool set = (mask >> (sc[0] + kSubPerAxis * (sc[1] + kSubPerAxis * sc[2]))) & 1u;
+      const float te = ss_max(ts, ss_min(sNext[axis], tsEnd));
+      if (set && !have) {
+        a = ts;
+        have = true;
+      } else if (!set && have) {
+        break;  // the run ends where this part begins
+      }
+      ts = te;
+      sc[axis] += step[axis];
+      sNext[axis] += float(step[axis]) * S * inv[axis];
+      if (sc[axis] < 0 || sc[axis] >= kSubPerAxis) ts = tsEnd;  // left the brick
+    }
+    if (have) {
+      b = ts;
+      return true;
+    }
+    mask = 0;
+    return false;
+  }
+
+  /// Starts walking the parts of brick `c` (mask `m`) from t0 to t1.
+  SS_FUNC void enterParts(const int c[3], uint64_t m, float t0, float t1) {
+    const float S = B * (1.f / float(kSubPerAxis));
+    mask = m;
+    ts = t0;
+    tsEnd = t1;
+    const vec3f p = org + dir * t0;
+    for (int a = 0; a < 3; ++a) {
+      const float base = float(c[a]) * B;
+      int k = int(floorf((p[a] - base) / S));
+      k = ss_maxi(0, ss_mini(k, kSubPerAxis - 1));
+      sc[a] = k;
+      sNext[a] = step[a] == 0 ? INFINITY : (base + float(step[a] > 0 ? k + 1 : k) * S - org[a]) * inv[a];
+    }
+  }
 
   /// Where the ray leaves cell c along axis a (the cell's far face in the step direction).
   SS_FUNC float exitOf(int a, int c) const {
@@ -41,6 +94,7 @@ struct GridIter {
     t = tmin;
     tmax = tEnd;
     B = float(grid.brick);
+    mask = 0;
     done = !(tmin < tEnd);
     if (done) return;
     const vec3f p = org + dir * tmin;
@@ -57,14 +111,22 @@ struct GridIter {
 
   template <class Marcher>
   SS_FUNC Step next(const Marcher& m, float& a, float& b) {
+    if (Parts && mask && partRun(a, b)) return Step::Interval;
     if (done || !(t < tmax)) {
       done = true;
       return Step::Done;
     }
     const int64_t idx = cell[0] + int64_t(g->dims.x) * (cell[1] + int64_t(g->dims.y) * cell[2]);
-    const int dist = g->vmin ? (m.active(g->vmin[idx], g->vmax[idx]) ? 0 : 1)
-                     : g->dist ? int(g->dist[idx])
-                               : (g->occ[idx] != 0 ? 0 : 1);
+    int dist;
+    bool walkParts = false;
+    if (g->vmin) {
+      dist = m.active(g->vmin[idx], g->vmax[idx]) ? 0 : 1;
+    } else {
+      // DistanceGrid's field or the brick states: bit 7 says "walk the parts" (subBrickState).
+      const int raw = g->dist ? g->dist[idx] : g->occ[idx];
+      walkParts = Parts && (raw & kBrickPartsBit) != 0 && g->sub != nullptr;
+      dist = g->dist ? (raw & 0x7f) : (raw != 0 ? 0 : 1);
+    }
     if (dist >= 2) {
       // Leave the empty cube [cell - (dist-1), cell + (dist-1)] through its nearest exit face.
       const int rad = dist - 1;
@@ -105,12 +167,20 @@ struct GridIter {
     a = t;
     b = tExit;
     t = tExit;
+    const uint64_t parts = Parts && dist == 0 && walkParts ? g->sub[idx] : ~uint64_t(0);
+    if (Parts && parts != ~uint64_t(0)) enterParts(cell, parts, a, tExit);
     cell[axis] += step[axis];
     tNext[axis] += tDelta[axis];
     if (cell[axis] < 0 || cell[axis] >= g->dims[axis]) done = true;
-    return dist == 0 ? Step::Interval : Step::Skip;
+    if (dist != 0) return Step::Skip;
+    if (!Parts || parts == ~uint64_t(0)) return Step::Interval;
+    return mask && partRun(a, b) ? Step::Interval : Step::Skip;
   }
 };
+/// The DDA over whole bricks (bricks marked for their parts are marched whole).
+using GridIter = GridIterT<false>;
+/// The DDA walking the parts of the bricks marked for it (TraversalKind::GridParts).
+using GridPartsIter = GridIterT<true>;
 
 /// Ordered front-to-back traversal of the flat tree: the nearer child (by entry distance)
 /// first, the farther one pushed on a fixed stack of kMaxTreeHeight entries. Each step handles

@@ -25,7 +25,10 @@
 // stream, as before the asynchronous interop), :full SPACESKIP_COMPOSITE_FULL=1 (copy and blend
 // the whole window, not the volume's rectangle), :float the mapper's EightBitComposite off (a
 // float texture). Columns render_ms and finish_ms split the frame into the time in Render() and
-// the wait in glFinish() after it.
+// the wait in glFinish() after it. stream_ms / stream_fps: the same orbit rendered back to back
+// with one glFinish() at the end (throughput; frame_ms is the latency of one waited-for frame).
+// edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
+// --edit-cut (they empty bricks) and those that lower it back (they occupy bricks).
 // --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
 // headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
 // config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
@@ -364,6 +367,22 @@ void Orbit(vtkRenderer* ren, const double b[6], double az, double el)
   cam->SetParallelScale(r);
   cam->SetClippingRange(3 * r - 1.01 * r, 3 * r + 1.01 * r);
 }
+
+// The same orbit as the timed frames, back to back with one glFinish() at the end: frames in
+// flight overlap (the host queues frame f+1 while the GPU still draws frame f), as when a user
+// drags the camera. Seconds for all `frames`: the throughput, where TimedRender gives latency.
+double StreamedRender(vtkRenderWindow* win, vtkRenderer* ren, const double b[6], int frames)
+{
+  glFinish();
+  const auto t0 = Clock::now();
+  for (int f = 0; f < frames; ++f)
+  {
+    Orbit(ren, b, 360.0 * f / frames, 15);
+    win->Render();
+  }
+  glFinish();
+  return Since(t0);
+}
 } // namespace
 
 int main(int argc, char* argv[])
@@ -570,7 +589,8 @@ int main(int argc, char* argv[])
     csv << "dataset,dims,item,builder_used,backend,frames,frame_ms,fps,mapper_ms,update_ms,depth_ms,"
            "engine_ms,kernel_ms,composite_ms,other_ms,kernel_fps,first_frame_s,build_s,classify_s,"
            "nodes,occupancy,edit_ms,edit_classify_ms,edit_build_ms,edit_update_ms,edit_kernel_ms,"
-           "edit_builds,edit_builder,edit_next_ms,render_ms,finish_ms\n";
+           "edit_builds,edit_builder,edit_next_ms,render_ms,finish_ms,stream_ms,stream_fps,"
+           "edit_cut_ms,edit_back_ms\n";
   }
   const std::string ds = shape + std::to_string(n);
 
@@ -585,19 +605,23 @@ int main(int argc, char* argv[])
   }
   empty /= frames;
   emptyCall /= frames;
-  std::printf("empty window: %.3f ms/frame (in Render() %.3f ms, glFinish() %.3f ms)\n",
-    empty * 1e3, emptyCall * 1e3, (empty - emptyCall) * 1e3);
+  const double emptyStream = StreamedRender(win, ren, b, frames) / frames;
+  std::printf("empty window: %.3f ms/frame (in Render() %.3f ms, glFinish() %.3f ms); streamed "
+              "%.3f ms/frame (%.1f fps)\n",
+    empty * 1e3, emptyCall * 1e3, (empty - emptyCall) * 1e3, emptyStream * 1e3, 1 / emptyStream);
   if (csv.is_open())
   {
     csv << ds << "," << n << ",empty,,," << frames << "," << empty * 1e3 << "," << 1 / empty
-        << std::string(22, ',') << emptyCall * 1e3 << "," << (empty - emptyCall) * 1e3 << "\n";
+        << std::string(22, ',') << emptyCall * 1e3 << "," << (empty - emptyCall) * 1e3 << ","
+        << emptyStream * 1e3 << "," << 1 / emptyStream << ",,\n";
   }
 
   std::printf("%-22s %-13s %-5s %8s %7s %8s %8s %8s %8s %8s %8s %8s %8s %9s %8s %8s %8s %9s %7s "
-              "%8s %8s %6s %9s %8s %8s %s\n",
+              "%8s %8s %6s %9s %8s %8s %8s %7s %7s %7s %s\n",
     "item", "used", "bk", "frame_ms", "fps", "mapper", "update", "depth", "engine", "kernel",
     "compos", "other", "kern_fps", "first_s", "build_ms", "class_ms", "nodes", "occupancy",
-    "edit_ms", "ed_upd", "ed_kern", "ed_bld", "ed_next", "render", "finish", "ed_used");
+    "edit_ms", "ed_upd", "ed_kern", "ed_bld", "ed_next", "render", "finish", "stream",
+    "s_fps", "ed_cut", "ed_back", "ed_used");
   vtkNew<vtkVolume> volume;
   volume->SetProperty(prop);
   ren->AddVolume(volume);
@@ -683,6 +707,7 @@ int main(int argc, char* argv[])
       comp += mapper->GetLastCompositeSeconds();
     }
     const double k = 1e3 / frames;
+    const double stream = StreamedRender(win, ren, b, frames);
     const std::string path = mapper->GetCompositePathUsed();
     std::string check;
     if (path == "gpu")
@@ -709,13 +734,16 @@ int main(int argc, char* argv[])
     // end of the first new frame, with the classification and rebuild it needed (the engine's
     // update), its kernel, the builds and the builder it drew with; then the frame after it.
     double edit = 0, editClassify = 0, editBuild = 0, editUpdate = 0, editKernel = 0, editNext = 0;
+    double editCutS = 0, editBack = 0; // the edits to --edit-cut (bricks emptied) and back to 0.1
     int editBuilds = 0;
     std::string editBuilder;
     for (int e = 0; e < edits; ++e)
     {
       SetRamp(ctf, pwf, lo, hi, e % 2 == 0 ? editCut : 0.1);
       const int builds = mapper->GetBuildCount();
-      edit += TimedRender(win);
+      const double te = TimedRender(win);
+      edit += te;
+      (e % 2 == 0 ? editCutS : editBack) += te;
       editBuilds += mapper->GetBuildCount() - builds;
       editClassify += mapper->GetLastClassifySeconds();
       editBuild += mapper->GetLastBuildSeconds();
@@ -734,14 +762,17 @@ int main(int argc, char* argv[])
       TimedRender(win);
     }
     const double ke = edits > 0 ? 1e3 / edits : 0;
+    const int cuts = (edits + 1) / 2, backs = edits / 2;
     std::printf("%-22s %-13s %-5s %8.3f %7.1f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.1f %9.3f "
-                "%8.3f %8.3f %8lld %9.5f %7.3f %8.3f %8.3f %6.2f %9.3f %8.3f %8.3f %s\n",
+                "%8.3f %8.3f %8lld %9.5f %7.3f %8.3f %8.3f %6.2f %9.3f %8.3f %8.3f %8.3f %7.1f %7.3f "
+                "%7.3f %s\n",
       it.label.c_str(), mapper->GetBuilderUsed(), mapper->GetBackendUsed(), wall * k,
       frames / wall, m * k, up * k, dep * k, eng * k, ker * k, comp * k, (wall - m) * k,
       frames / ker, first, buildS * 1e3, classifyS * 1e3, static_cast<long long>(mapper->GetNodeCount()),
       mapper->GetOccupancy(), edit * ke, editUpdate * ke, editKernel * ke,
       edits > 0 ? double(editBuilds) / edits : 0.0, editNext * ke, call * k, (wall - call) * k,
-      editBuilder.c_str());
+      stream * k, frames / stream, cuts ? editCutS * 1e3 / cuts : 0.0,
+      backs ? editBack * 1e3 / backs : 0.0, editBuilder.c_str());
     std::fflush(stdout);
     if (csv.is_open())
     {
@@ -753,7 +784,9 @@ int main(int argc, char* argv[])
           << mapper->GetOccupancy() << "," << edit * ke << "," << editClassify * ke << ","
           << editBuild * ke << "," << editUpdate * ke << "," << editKernel * ke << ","
           << (edits > 0 ? double(editBuilds) / edits : 0.0) << "," << editBuilder << ","
-          << editNext * ke << "," << call * k << "," << (wall - call) * k << "\n";
+          << editNext * ke << "," << call * k << "," << (wall - call) * k << "," << stream * k
+          << "," << frames / stream << "," << (cuts ? editCutS * 1e3 / cuts : 0.0) << ","
+          << (backs ? editBack * 1e3 / backs : 0.0) << "\n";
     }
   }
 
@@ -778,6 +811,7 @@ int main(int argc, char* argv[])
       Orbit(ren, b, 360.0 * f / frames, 15);
       wall += TimedRender(win);
     }
+    const double gpuStream = StreamedRender(win, ren, b, frames);
     if (!pngPrefix.empty())
     {
       SavePng(win, pngPrefix + "-" + ds + "-vtkGPUVolumeRayCastMapper.png");
@@ -788,13 +822,16 @@ int main(int argc, char* argv[])
       SetRamp(ctf, pwf, lo, hi, e % 2 == 0 ? editCut : 0.1);
       edit += TimedRender(win);
     }
-    std::printf("%-22s %-13s %-5s %8.3f %7.1f %62s %9.3f %44s %7.3f\n", "vtkGPUVolumeRayCast", "-",
-      "gl", wall * 1e3 / frames, frames / wall, "", first, "", edits ? edit * 1e3 / edits : 0.0);
+    std::printf("%-22s %-13s %-5s %8.3f %7.1f %62s %9.3f %44s %7.3f (streamed %.3f ms/frame, "
+                "%.1f fps)\n",
+      "vtkGPUVolumeRayCast", "-", "gl", wall * 1e3 / frames, frames / wall, "", first, "",
+      edits ? edit * 1e3 / edits : 0.0, gpuStream * 1e3 / frames, frames / gpuStream);
     if (csv.is_open())
     {
       csv << ds << "," << n << ",vtkGPUVolumeRayCastMapper,,gl," << frames << ","
           << wall * 1e3 / frames << "," << frames / wall << ",,,,,,,,," << first << ",,,,,"
-          << (edits ? edit * 1e3 / edits : 0.0) << ",,,,,,,,,\n";
+          << (edits ? edit * 1e3 / edits : 0.0) << ",,,,,,,,," << gpuStream * 1e3 / frames << ","
+          << frames / gpuStream << ",,\n";
     }
     volume->SetMapper(mapper);
   }
