@@ -26,9 +26,13 @@ __global__ void rangeKernel(const T* data, vec3l dims, vec3i bdims, int brick, f
 // Launch shape: one thread per brick, 256 per block. Occupancy against the TF and the cropping
 // and clipping planes (brickOccupied, as on the CPU); counts occupied bricks (one atomic per
 // block) and flags any difference from the previous occupancy.
+// With `state` (sub-brick masks): every brick's state (kBrickWhole or kBrickEmpty; the mask
+// kernel marks the sparse ones) and the occupied bricks' indices appended to `list` (one
+// atomic a warp; any order).
 __global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims, int brick, vec3i cellDims,
                                OpacityRangeMaxView rmq, CropClip cc, const uint8_t* prev, uint8_t* occ,
-                               unsigned long long* occupied, int* changed, int* grew) {
+                               unsigned long long* occupied, int* changed, int* grew, uint8_t* state,
+                               uint32_t* list, unsigned* listCount) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
   int o = 0, diff = 0, more = 0;
@@ -37,6 +41,17 @@ __global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims
     occ[i] = uint8_t(o);
     diff = prev ? (prev[i] != o) : 1;
     more = prev ? (o && !prev[i]) : 1;
+    if (state) state[i] = o ? kBrickWhole : kBrickEmpty;
+  }
+  if (list) {
+    const unsigned lane = threadIdx.x & 31, ballot = __ballot_sync(0xffffffffu, o != 0);
+    if (ballot) {
+      const int leader = __ffs(int(ballot)) - 1;
+      unsigned base = 0;
+      if (int(lane) == leader) base = atomicAdd(listCount, unsigned(__popc(int(ballot))));
+      base = __shfl_sync(0xffffffffu, base, leader);
+      if (o) list[base + unsigned(__popc(int(ballot & ((1u << lane) - 1u))))] = uint32_t(i);
+    }
   }
   const int blockCount = __syncthreads_count(o);
   const int blockDiff = __syncthreads_or(diff);
@@ -48,36 +63,35 @@ __global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims
   }
 }
 
-// Launch shape: one thread per brick, 256 per block; occupied bricks compute their sub-brick
-// mask (subBrickMask over their voxels), the others write 0; and every brick its state.
-// The set parts are summed per block (warp sums, then one atomic per block into one of
-// kPartCounters counters, which spreads the atomics).
+// Launch shape: a fixed grid (kMaskBlocksPerSM blocks of 256 threads per SM) whose warps take
+// the occupied bricks of `list` in turn: one warp per brick, two of its 64 parts a lane
+// (subPartSet), the mask by ballot; lane 0 writes the mask, marks the brick kBrickParts when
+// sparse (subBrickState) and sums the set parts into one of kPartCounters counters. On the H100
+// at N-body 2048^3 (183 k occupied bricks): 0.59 ms (one thread a brick: 8.4 ms; the warp
+// copying the brick into shared memory first: 1.04 ms).
 constexpr int kPartCounters = 64;
+constexpr int kMaskBlocksPerSM = 8;
 template <class T>
 __global__ void subMaskKernel(const T* data, vec3l dims, vec3i cellDims, vec3i bdims, int brick,
-                              OpacityRangeMaxView rmq, int maxSet, const uint8_t* occ, uint64_t* masks,
-                              uint8_t* state, unsigned long long* setParts) {
-  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
-  unsigned set = 0;
-  if (i < n) {
-    const bool o = occ[i] != 0;
-    const uint64_t m = o ? subBrickMask(data, dims, cellDims, brick, i % bdims.x, (i / bdims.x) % bdims.y,
-                                        i / (int64_t(bdims.x) * bdims.y), rmq)
-                         : 0;
-    masks[i] = m;
-    state[i] = subBrickState(o, m, maxSet);
-    set = unsigned(popcount64(m));
+                              OpacityRangeMaxView rmq, int maxSet, const uint32_t* list, const unsigned* listCount,
+                              uint64_t* masks, uint8_t* state, unsigned long long* setParts) {
+  const unsigned lane = threadIdx.x & 31;
+  const unsigned warp = (blockIdx.x * blockDim.x + threadIdx.x) >> 5, warps = (gridDim.x * blockDim.x) >> 5;
+  const unsigned count = *listCount;
+  unsigned long long set = 0;
+  for (unsigned w = warp; w < count; w += warps) {
+    const int64_t i = list[w];
+    const int64_t bx = i % bdims.x, by = (i / bdims.x) % bdims.y, bz = i / (int64_t(bdims.x) * bdims.y);
+    const bool a = subPartSet(data, dims, cellDims, brick, bx, by, bz, int(lane), rmq);
+    const bool b = subPartSet(data, dims, cellDims, brick, bx, by, bz, int(lane) + 32, rmq);
+    const uint64_t m = uint64_t(__ballot_sync(0xffffffffu, a)) | (uint64_t(__ballot_sync(0xffffffffu, b)) << 32);
+    if (lane == 0) {
+      masks[i] = m;
+      state[i] = subBrickState(true, m, maxSet);
+      set += unsigned(popcount64(m));
+    }
   }
-  __shared__ unsigned warpSums[kThreads / 32];
-  for (int d = 16; d > 0; d /= 2) set += __shfl_down_sync(0xffffffffu, set, d);
-  if ((threadIdx.x & 31) == 0) warpSums[threadIdx.x / 32] = set;
-  __syncthreads();
-  if (threadIdx.x == 0) {
-    unsigned long long total = 0;
-    for (int w = 0; w < int(blockDim.x + 31) / 32; ++w) total += warpSums[w];
-    if (total) atomicAdd(setParts + blockIdx.x % kPartCounters, total);
-  }
+  if (lane == 0 && set) atomicAdd(setParts + warp % kPartCounters, set);
 }
 
 // Launch shape: one thread per brick, 256 per block. markedDistance; without states (no masks)
@@ -104,11 +118,12 @@ cudaError_t brickRanges(const void* d_voxels, VoxelType type, int components, ve
 
 cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims, int brick, vec3i cellDims,
                            const OpacityRangeMaxView& rmq, const CropClip& cc, const uint8_t* d_prev, uint8_t* d_occ,
-                           ClassifyFlags* d_flags, cudaStream_t stream) {
+                           ClassifyFlags* d_flags, cudaStream_t stream, uint8_t* d_state, uint32_t* d_list) {
   const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
   classifyKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_vmin, d_vmax, bdims, brick, cellDims, rmq, cc,
                                                                   d_prev, d_occ, &d_flags->occupied,
-                                                                  &d_flags->changed, &d_flags->grew);
+                                                                  &d_flags->changed, &d_flags->grew, d_state, d_list,
+                                                                  &d_flags->listCount);
   return cudaPeekAtLastError();
 }
 
@@ -159,22 +174,15 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   uint8_t* next = d_occ[1 - cur].get();
   d_flags_.reserve(1);
   SS_CUDA_CHECK(cudaMemsetAsync(d_flags_.get(), 0, sizeof(ClassifyFlags), stream));
-  SS_CUDA_CHECK(
-      classifyBricks(d_vmin.get(), d_vmax.get(), bdims, brick, cellDims, rmq, cc, prev, next, d_flags_.get(), stream));
   haveSub_ = d_voxels_ && components_ == 1 && usesSubMasks(brick) && subMasksEnabled();
+  const int64_t nb = numBricks();
   if (haveSub_) {
-    const int64_t nb = numBricks();
     d_sub_.reserve(size_t(nb));
     d_state_.reserve(size_t(nb));
-    const int maxSet = subMaskMaxSet();
-    dispatchVoxelType(type_, [&](auto t) {
-      using T = decltype(t);
-      subMaskKernel<T><<<blocksFor(nb, kThreads), kThreads, 0, stream>>>(
-          static_cast<const T*>(d_voxels_), dims_, cellDims, bdims, brick, rmq, maxSet, next, d_sub_.get(),
-          d_state_.get(), d_flags_.get()->setParts);
-    });
-    SS_CUDA_CHECK_LAUNCH(subMaskKernel);
+    d_list_.reserve(size_t(nb));
   }
+  SS_CUDA_CHECK(classifyBricks(d_vmin.get(), d_vmax.get(), bdims, brick, cellDims, rmq, cc, prev, next, d_flags_.get(),
+                               stream, haveSub_ ? d_state_.get() : nullptr, haveSub_ ? d_list_.get() : nullptr));
   auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
   SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
@@ -184,11 +192,40 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   if (changed) ++generation;
   haveOcc = true;
   occupied = int64_t(flags->occupied);
-  unsigned long long set = 0;
-  for (int c = 0; c < kPartCounters; ++c) set += flags->setParts[c];
-  setFraction = haveSub_ && occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
+  // The masks follow on a later frame (refreshMasks): the edit's own frame marches whole bricks.
+  masksReady_ = false;
+  rmq_ = rmq;
   hostOccValid_ = false;
   return changed;
+}
+
+void BrickClassification::refreshMasks(cudaStream_t stream) {
+  if (!masksPending()) return;
+  if (numSMs_ == 0) {
+    int dev = 0;
+    if (cudaGetDevice(&dev) != cudaSuccess ||
+        cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
+      (void)cudaGetLastError();
+      numSMs_ = 1;
+    }
+  }
+  const int maxSet = subMaskMaxSet();
+  // setParts is zeroed by classify()'s memset; the list and its count are classify()'s.
+  dispatchVoxelType(type_, [&](auto t) {
+    using T = decltype(t);
+    subMaskKernel<T><<<numSMs_ * kMaskBlocksPerSM, kThreads, 0, stream>>>(
+        static_cast<const T*>(d_voxels_), dims_, cellDims, bdims, brick, rmq_, maxSet, d_list_.get(),
+        &d_flags_.get()->listCount, d_sub_.get(), d_state_.get(), d_flags_.get()->setParts);
+  });
+  SS_CUDA_CHECK_LAUNCH(subMaskKernel);
+  auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
+  SS_CUDA_CHECK(cudaMemcpyAsync(flags->setParts, d_flags_.get()->setParts, sizeof(flags->setParts),
+                                cudaMemcpyDeviceToHost, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  unsigned long long set = 0;
+  for (int c = 0; c < kPartCounters; ++c) set += flags->setParts[c];
+  setFraction = occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
+  masksReady_ = true;
 }
 
 void BrickClassification::markDistances(uint8_t* d_dist, cudaStream_t stream) const {

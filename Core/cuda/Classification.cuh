@@ -12,6 +12,7 @@ struct ClassifyFlags {
   int changed;                  ///< 1 when some brick differs from the previous occupancy
   int grew;                     ///< 1 when some brick is occupied that was not before (or no previous)
   unsigned long long setParts[64];  ///< set sub-brick parts, summed over spread counters
+  unsigned listCount;               ///< occupied bricks appended to the list (sub-brick masks)
 };
 
 /// d_vmin/d_vmax[i] = brickRange of brick i (x fastest) of the `bdims` bricks of `brick` cells
@@ -23,10 +24,12 @@ cudaError_t brickRanges(const void* d_voxels, VoxelType type, int components, ve
 /// d_occ[i] = 1 when brick i of the `bdims` bricks of `brick` cells (of `cellDims`) is occupied
 /// by brickOccupied: its range can have opacity > 0 (rmq.levels on the device) and `cc` leaves
 /// some of it drawn; counts into d_flags and flags any difference from d_prev (nullptr:
-/// everything changed).
+/// everything changed). With d_state and d_list: the bricks' states (whole or empty) and the
+/// occupied bricks' indices (d_flags->listCount of them).
 cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims, int brick, vec3i cellDims,
                            const OpacityRangeMaxView& rmq, const CropClip& cc, const uint8_t* d_prev, uint8_t* d_occ,
-                           ClassifyFlags* d_flags, cudaStream_t stream);
+                           ClassifyFlags* d_flags, cudaStream_t stream, uint8_t* d_state = nullptr,
+                           uint32_t* d_list = nullptr);
 
 /// The brick grid of the current volume: value ranges (once per volume) and a double-buffered
 /// occupancy (once per opacity edit), with a host copy of the occupancy made on demand.
@@ -53,9 +56,16 @@ class BrickClassification {
   DeviceBuffer<uint8_t> d_occ[2];  ///< d_occ[cur]: the current occupancy
   /// The sub-brick masks of the current occupancy (Classification.h); null when there are none
   /// (brick size, several components, sparse residency, SPACESKIP_SUB_MASKS=0).
-  const uint64_t* subMasks() const { return haveSub_ ? d_sub_.get() : nullptr; }
+  /// Computed by refreshMasks(), not by classify(): the classification of an opacity edit
+  /// stays as cheap as before, and the edit's frame marches whole bricks.
+  const uint64_t* subMasks() const { return haveSub_ && masksReady_ ? d_sub_.get() : nullptr; }
   /// The brick states of the current occupancy (subBrickState), with the masks; else null.
-  const uint8_t* brickStates() const { return haveSub_ ? d_state_.get() : nullptr; }
+  const uint8_t* brickStates() const { return haveSub_ && masksReady_ ? d_state_.get() : nullptr; }
+  /// Whether this classification has masks to compute (refreshMasks).
+  bool masksPending() const { return haveSub_ && !masksReady_; }
+  /// Computes the masks and states of the last classification (one warp per occupied brick)
+  /// and their set share; waits for them.
+  void refreshMasks(cudaStream_t stream);
   /// Marks DistanceGrid's field `d_dist` (one byte per brick) with markedDistance for the
   /// current states, or clears the marks when there are none (on `stream`, no synchronization).
   void markDistances(uint8_t* d_dist, cudaStream_t stream) const;
@@ -64,14 +74,18 @@ class BrickClassification {
   int64_t occupied = 0;
   uint64_t generation = 0;  ///< counts classify() calls that changed the occupancy
   bool grew = true;         ///< the last classify() occupied a brick the previous one had empty
-  /// Set parts over all parts of the occupied bricks (sub-brick masks; 1 without masks): the
-  /// share of an occupied brick's volume a part-walking frame still marches.
+  /// Set parts over all parts of the occupied bricks (after refreshMasks): the share of an
+  /// occupied brick's volume a part-walking frame still marches.
   double setFraction = 1.0;
 
  private:
   DeviceBuffer<float> d_levels_;  ///< OpacityRangeMax's levels
   DeviceBuffer<uint64_t> d_sub_;
   DeviceBuffer<uint8_t> d_state_;
+  DeviceBuffer<uint32_t> d_list_;  ///< the occupied bricks' indices (mask kernel's work list)
+  bool masksReady_ = false;
+  OpacityRangeMaxView rmq_{};  ///< the last classification's table (d_levels_ on the device)
+  int numSMs_ = 0;
   bool haveSub_ = false;
   // The in-core voxels the masks read (setVolume; none after setRanges).
   const void* d_voxels_ = nullptr;

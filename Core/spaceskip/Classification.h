@@ -122,24 +122,48 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, cons
 /// the voxels in core.
 /// (kSubPerAxis and usesSubMasks: Types.h, which the render headers read.)
 
-/// The mask of brick (bx, by, bz) of `brick` cells in a volume of `dims` voxels (`cellDims`
-/// cells) at `data`; parts with no cell inside the volume get 0.
+/// Part k (x fastest, 0..63) of brick (bx, by, bz) of `brick` cells in a volume of `dims`
+/// voxels (`cellDims` cells): can a sample inside it have opacity > 0? `voxel(x, y, z)` gives
+/// a voxel's value as float (global indices: from the volume, or from a copy of the brick's
+/// voxels in shared memory). NaN voxels are skipped, as in brickRange. A part with no cell
+/// inside the volume: false.
+template <class Voxel, class RangeMax>
+SS_FUNC bool subPartSetWith(const Voxel& voxel, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz,
+                            int k, const RangeMax& rmq) {
+  const int s = brick / kSubPerAxis;
+  const int64_t c0[3] = {bx * brick + (k & 3) * s, by * brick + ((k >> 2) & 3) * s, bz * brick + (k >> 4) * s};
+  if (c0[0] >= cellDims.x || c0[1] >= cellDims.y || c0[2] >= cellDims.z) return false;  // no cell of the volume
+  const int64_t n[3] = {dims.x, dims.y, dims.z};
+  int64_t v1[3];
+  for (int a = 0; a < 3; ++a) v1[a] = c0[a] + s < n[a] - 1 ? c0[a] + s : n[a] - 1;
+  float lo = INFINITY, hi = -INFINITY;
+  for (int64_t z = c0[2]; z <= v1[2]; ++z)
+    for (int64_t y = c0[1]; y <= v1[1]; ++y)
+      for (int64_t x = c0[0]; x <= v1[0]; ++x) {
+        const float v = voxel(x, y, z);
+        if (v != v) continue;  // NaN
+        lo = v < lo ? v : lo;
+        hi = v > hi ? v : hi;
+      }
+  return rmq.query(lo, hi) > 0.f;
+}
+
+/// subPartSetWith on the voxels of a volume in memory.
+template <class T, class RangeMax>
+SS_FUNC bool subPartSet(const T* data, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz, int k,
+                        const RangeMax& rmq) {
+  auto voxel = [&](int64_t x, int64_t y, int64_t z) { return float(data[x + dims.x * (y + dims.y * z)]); };
+  return subPartSetWith(voxel, dims, cellDims, brick, bx, by, bz, k, rmq);
+}
+
+/// The mask of brick (bx, by, bz): subPartSet of its 64 parts. One CUDA warp computes it two
+/// parts a lane; the oneTBB twin one brick at a time.
 template <class T, class RangeMax>
 SS_FUNC uint64_t subBrickMask(const T* data, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz,
                               const RangeMax& rmq) {
-  const int s = brick / kSubPerAxis;
   uint64_t mask = 0;
-  for (int k = 0; k < kSubPerAxis * kSubPerAxis * kSubPerAxis; ++k) {
-    const int64_t c0[3] = {bx * brick + (k & 3) * s, by * brick + ((k >> 2) & 3) * s, bz * brick + (k >> 4) * s};
-    if (c0[0] >= cellDims.x || c0[1] >= cellDims.y || c0[2] >= cellDims.z) continue;  // no cell of the volume
-    int64_t v1[3];
-    const int64_t n[3] = {dims.x, dims.y, dims.z};
-    for (int a = 0; a < 3; ++a) v1[a] = c0[a] + s < n[a] - 1 ? c0[a] + s : n[a] - 1;
-    float lo = INFINITY, hi = -INFINITY;
-    for (int64_t z = c0[2]; z <= v1[2]; ++z)
-      for (int64_t y = c0[1]; y <= v1[1]; ++y) foldRange<T, 1>(data + dims.x * (y + dims.y * z), c0[0], v1[0], lo, hi);
-    if (rmq.query(lo, hi) > 0.f) mask |= uint64_t(1) << k;
-  }
+  for (int k = 0; k < kSubPerAxis * kSubPerAxis * kSubPerAxis; ++k)
+    if (subPartSet(data, dims, cellDims, brick, bx, by, bz, k, rmq)) mask |= uint64_t(1) << k;
   return mask;
 }
 

@@ -967,6 +967,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     for (unsigned c : counts) d.frame.samples += c;
   }
   d.frame.backend = d.backend->name();
+  d.stats.partsShare = d.backend->subMaskShare();  // the CUDA backend computes masks after an edit's frame
   d.frame.residency = d.backend->residency();
   if (d.frame.residency.sparse && d.render.filter == FilterMode::Hardware)
     d.warn("sparse residency samples exactly (hardware filtering needs the whole volume in one texture)");
