@@ -439,6 +439,9 @@ BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemTex
   // Hybrid always builds the shallow tree (paper 3.3).
   row.leaf = s.builder == BuilderKind::Hybrid ? "shallow" : leafName(bp.leaf);
   row.s = s;
+  // The share of set sub-brick parts as the frames saw it (the CUDA backend computes the masks
+  // on the frame after a classification, so the build's statistics may predate them).
+  row.s.partsShare = engine.buildStats().partsShare;
   return row;
 }
 

@@ -258,7 +258,8 @@ TEST(SubMasks, FewerSamplesAndTheSameImage) {
   // the same bit for bit and equals Naive's; sparse data takes far fewer samples.
   Volume v = generateVolume("nbody", vec3l{96, 96, 96}, 3);
   auto tf = TransferFunction::preset("ramp", 0, 255);
-  for (const double* cam : {std::array<double, 2>{10, 10}.data(), std::array<double, 2>{73, -35}.data()}) {
+  const std::array<std::array<double, 2>, 2> cams = {{{10, 10}, {73, -35}}};
+  for (const std::array<double, 2>& cam : cams) {
     const Camera c = test::orbit(v, cam[0], cam[1], cam[0] > 50);
     int64_t naiveSamples = 0;
     const Image naive = test::renderCounting(v, tf, BuilderKind::Naive, c, 96, naiveSamples);
