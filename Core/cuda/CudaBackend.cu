@@ -62,9 +62,9 @@ class CudaBackend final : public Backend {
     if (d_distField_) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
     return changed;
   }
+  double subMaskShare() const override { return cls_.subMasks() ? cls_.setFraction : 1.0; }
   // Sparse residency loads the bricks the current occupancy needs: a structure that visits
   // more would sample bricks that are not resident.
-  double subMaskShare() const override { return cls_.subMasks() ? cls_.setFraction : 1.0; }
   bool lastClassifyOnlyEmptied() const override { return !cls_.grew && !pool_.active(); }
 
   void setMemoryBudget(int64_t bytes, int poolBrick) override {
@@ -122,8 +122,8 @@ class CudaBackend final : public Backend {
 
   /// Grid and DistanceGrid frames walk the parts of sparse bricks (GridParts) only where the set
   /// parts are at most this share of the occupied bricks' parts: on the H100 the part walk made
-  /// every stand-in of the paper 5-26% slower where the share was 0.3 and more, and N-body
-  /// 1024^3 / 2048^3 (shares about 0.13 / 0.06) 1.26x / 1.71x faster (docs/results/round9-h100).
+  /// the paper's stand-ins 5-26% slower where the share was 0.28 and more, and N-body
+  /// 1024^3 / 2048^3 (shares 0.11 / 0.06) 1.12x / 1.59x faster (docs/results/round9-h100).
   static constexpr double kPartsShare = 0.2;
 
   void render(FrameView f, FilterMode filter, const float* depth, Image& out) override {

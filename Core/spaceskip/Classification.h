@@ -115,18 +115,18 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, cons
 /// Sub-brick masks: each occupied brick split into kSubPerAxis^3 = 64 parts of brick/4 cells a
 /// side, one bit each (x fastest), set when some sample inside the part can have opacity > 0:
 /// the brick rule (brickRange's +1 halo, OpacityRangeMaxView::query) on the part's own voxels.
-/// The grid traversals (GridIter) walk an occupied brick's parts and march only the set ones,
-/// so a brick that a few particles touch costs the samples of those parts, not of the whole
-/// brick. Recomputed on every opacity edit, for the occupied bricks only (the others get 0);
+/// The grid traversal GridPartsIter walks an occupied brick's parts and marches only the set
+/// ones, so a brick that a few particles touch costs the samples of those parts, not of the
+/// whole brick. Recomputed after every opacity edit (the CUDA backend on the frame after the
+/// edit's), for the occupied bricks only;
 /// only where a brick has 4 parts of >= 2 cells a side (brick 8, 12, 16, ...), one component,
 /// the voxels in core.
 /// (kSubPerAxis and usesSubMasks: Types.h, which the render headers read.)
 
 /// Part k (x fastest, 0..63) of brick (bx, by, bz) of `brick` cells in a volume of `dims`
 /// voxels (`cellDims` cells): can a sample inside it have opacity > 0? `voxel(x, y, z)` gives
-/// a voxel's value as float (global indices: from the volume, or from a copy of the brick's
-/// voxels in shared memory). NaN voxels are skipped, as in brickRange. A part with no cell
-/// inside the volume: false.
+/// a voxel's value as float (global indices). NaN voxels are skipped, as in brickRange. A part
+/// with no cell inside the volume: false.
 template <class Voxel, class RangeMax>
 SS_FUNC bool subPartSetWith(const Voxel& voxel, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz,
                             int k, const RangeMax& rmq) {

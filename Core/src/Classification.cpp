@@ -89,10 +89,6 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, cons
   return o;
 }
 
-}  // namespace spaceskip
-
-namespace spaceskip {
-
 bool subMasksEnabled() {
   const char* e = std::getenv("SPACESKIP_SUB_MASKS");
   return !(e && e[0] == '0');

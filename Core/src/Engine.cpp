@@ -590,7 +590,6 @@ struct Engine::Impl {
       buildDirty = false;
       stats.seconds = 0;
       stats.occupancy = backend->occupiedFraction();
-      stats.partsShare = backend->subMaskShare();
       stats.choice = a.choice + "; this frame: the " + builderName(a.candidates[size_t(a.current)].builder) +
                      " built before the edit (it only emptied bricks), rebuilt next frame";
       ++counters.staleFrames;
@@ -633,7 +632,6 @@ struct Engine::Impl {
       s.builder = p.builder;
       s.classifySeconds = stats.classifySeconds;
       s.occupancy = backend->occupiedFraction();
-      s.partsShare = backend->subMaskShare();
       if (isAuto) {
         autoState.built = use;
         autoState.buildSeconds[size_t(use)] = s.seconds;
@@ -967,7 +965,8 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     for (unsigned c : counts) d.frame.samples += c;
   }
   d.frame.backend = d.backend->name();
-  d.stats.partsShare = d.backend->subMaskShare();  // the CUDA backend computes masks after an edit's frame
+  // Every frame: the CUDA backend computes the masks on the frame after a classification's.
+  d.stats.partsShare = d.backend->subMaskShare();
   d.frame.residency = d.backend->residency();
   if (d.frame.residency.sparse && d.render.filter == FilterMode::Hardware)
     d.warn("sparse residency samples exactly (hardware filtering needs the whole volume in one texture)");
