@@ -58,8 +58,10 @@ class CudaBackend final : public Backend {
     const bool changed = cls_.classify(tf, cc, stream_);
     classifiedSinceRender_ = true;
     // The field kept across an edit that changed no occupancy (or drawn stale after one that only
-    // emptied bricks) takes the new states' marks.
-    if (d_distField_) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+    // emptied bricks) takes the new states' marks, in render(): an edit that occupies bricks
+    // rebuilds the field (which marks it) first, and marking the old one too would only add a
+    // kernel to the edit's path.
+    distMarksStale_ = d_distField_ != nullptr;
     return changed;
   }
   double subMaskShare() const override { return cls_.subMasks() ? cls_.setFraction : 1.0; }
@@ -91,7 +93,10 @@ class CudaBackend final : public Backend {
     s.builtOn = "cuda";
     if (info.extra == BuilderExtra::DistanceField) {
       d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, kMaxSkipDistance, dist_, stream_);
-      cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+      // A field computed from the current occupancy carries no marks until the masks mark some
+      // bricks sparse: right after an edit (no masks yet) the mark kernel would change nothing.
+      if (cls_.brickStates()) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+      distMarksStale_ = false;
     }
     if (info.cuda) {
       cuda::BuildContext ctx{{d_occ_[cur_].get(), bdims_, brick_, cellDims_, occupied_}, stream_, tree_, workspaces_};
@@ -133,7 +138,11 @@ class CudaBackend final : public Backend {
       classifiedSinceRender_ = false;
     } else if (cls_.masksPending()) {
       cls_.refreshMasks(stream_);
-      if (d_distField_) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+      distMarksStale_ = d_distField_ != nullptr;
+    }
+    if (distMarksStale_) {
+      cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+      distMarksStale_ = false;
     }
     f.traversal = traversal_;
     // SPACESKIP_CUDA_PARTS_SHARE (read per frame): another threshold, a measurement and test switch.
@@ -244,6 +253,7 @@ class CudaBackend final : public Backend {
   cuda::DistanceWorkspace dist_;
   const uint8_t* d_distField_ = nullptr;  ///< DistanceGrid's field (in dist_) for the current occupancy
   bool classifiedSinceRender_ = false;     ///< classify() ran since the last render()
+  bool distMarksStale_ = false;            ///< d_distField_'s marks predate the brick states
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "spaceskip/DistanceField.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <string>
 
 namespace spaceskip::cuda {
@@ -40,24 +41,72 @@ __global__ void lineKernel(const uint8_t* in, vec3i dims, int axis, int cap, uin
                int(blockDim.x));
 }
 
-// The same with the block's lines staged in shared memory: every thread first copies its line
-// (independent loads the memory system overlaps), sweeps it there (the sweep's steps depend on
-// one another: shared-memory latency instead of global), then writes it back. Line k of the
-// block at staged[i * kLineThreads + k] (consecutive threads, consecutive bytes).
-__global__ void stagedLineKernel(const uint8_t* in, vec3i dims, int axis, int cap, uint8_t* out) {
+// The block's 32 lines staged in shared memory, `segs` threads a line (distanceSegment): the
+// block first copies its lines in (for axis 0 the 32 lines are one run of bytes, read in order;
+// for the other axes 32 consecutive lines are 32 consecutive bytes at each position), the
+// threads sweep their segments there (each sweep's steps depend on one another: a line cut in
+// `segs` segments shortens that chain from 2n to 2(n/segs + cap) steps, and gives the SM `segs`
+// times as many warps to hide it behind), then the block writes the lines back the same way.
+// Line k of the block at staged[i * kLineThreads + k]. Seed: `in` is the occupancy (0 / not 0)
+// and the pass reads it as 0 (occupied) / cap (empty), which saves a pass over the grid.
+template <bool Seed>
+__global__ void stagedLineKernel(const uint8_t* in, vec3i dims, int axis, int cap, int segs, uint8_t* out) {
   extern __shared__ int shared[];
+  __shared__ int64_t starts[kLineThreads];
   const int n = dims[axis];
-  int* last = shared;
-  uint8_t* stagedIn = reinterpret_cast<uint8_t*>(shared + (cap + 1) * kLineThreads);
+  const int threads = int(blockDim.x);
+  int16_t* last = reinterpret_cast<int16_t*>(shared);
+  uint8_t* stagedIn = reinterpret_cast<uint8_t*>(last + (cap + 1) * threads);
   uint8_t* stagedOut = stagedIn + size_t(n) * kLineThreads;
   const int u = axis == 0 ? 1 : 0, w = axis == 2 ? 1 : 2;
   const int64_t lines = int64_t(dims[u]) * dims[w];
-  const int64_t l = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (l >= lines) return;
-  const int64_t first = lineStart(dims, axis, l), stride = axisStride(dims, axis);
-  for (int i = 0; i < n; ++i) stagedIn[i * kLineThreads + threadIdx.x] = in[first + stride * i];
-  distanceLine(stagedIn, stagedOut, threadIdx.x, kLineThreads, n, cap, last + threadIdx.x, kLineThreads);
-  for (int i = 0; i < n; ++i) out[first + stride * i] = stagedOut[i * kLineThreads + threadIdx.x];
+  const int64_t l0 = int64_t(blockIdx.x) * kLineThreads;
+  const int nl = lines - l0 < kLineThreads ? int(lines - l0) : kLineThreads;
+  if (threadIdx.x < kLineThreads) starts[threadIdx.x] = int(threadIdx.x) < nl ? lineStart(dims, axis, l0 + threadIdx.x) : 0;
+  __syncthreads();
+  const int64_t stride = axisStride(dims, axis);
+  const int total = n * kLineThreads;
+  for (int o = int(threadIdx.x); o < total; o += threads) {
+    const int k = axis == 0 ? o / n : o % kLineThreads, i = axis == 0 ? o % n : o / kLineThreads;
+    if (k >= nl) continue;
+    const uint8_t v = in[starts[k] + stride * i];
+    stagedIn[i * kLineThreads + k] = Seed ? (v ? uint8_t(0) : uint8_t(cap)) : v;
+  }
+  __syncthreads();
+  const int k = int(threadIdx.x) % kLineThreads, s = int(threadIdx.x) / kLineThreads;
+  const int segLen = (n + segs - 1) / segs;
+  const int a = s * segLen, b = a + segLen < n ? a + segLen : n;
+  if (k < nl && a < b) distanceSegment(stagedIn, stagedOut, k, kLineThreads, n, a, b, cap, last + threadIdx.x, threads);
+  __syncthreads();
+  for (int o = int(threadIdx.x); o < total; o += threads) {
+    const int kk = axis == 0 ? o / n : o % kLineThreads, i = axis == 0 ? o % n : o / kLineThreads;
+    if (kk < nl) out[starts[kk] + stride * i] = stagedOut[i * kLineThreads + kk];
+  }
+}
+
+/// Dynamic shared memory of stagedLineKernel: the scratch (cap + 1 int16 a thread) and the
+/// block's lines, in and out.
+size_t stagedBytes(int n, int cap, int segs) {
+  return size_t(cap + 1) * kLineThreads * size_t(segs) * sizeof(int16_t) + 2 * size_t(n) * kLineThreads;
+}
+constexpr size_t kStagedMaxBytes = 96 * 1024;  // opted in (the default is 48 KiB)
+
+/// Threads a line for lines of n bricks: up to 8, segments of at least 32 bricks, within
+/// kStagedMaxBytes; SPACESKIP_DG_SEGMENTS (a measurement switch) caps it. 0: the unstaged
+/// kernel, for lines shorter than 128 bricks or too long for shared memory. On the H100 the
+/// staged kernel was slower than the unstaged one with one segment a line (N-body 2048^3: 0.73-1.17
+/// vs 0.62 ms a build) and on lines of 64-104 bricks (two segments: 0.07-0.10 vs 0.05-0.08 ms),
+/// faster with 4-8 segments on lines of 128-256 bricks (2048^3: 0.45 ms; 128 bricks: 0.09 vs
+/// 0.12 ms) (docs/results/round10-h100).
+int segmentsFor(int n, int cap) {
+  static const int cap_env = [] {
+    const char* e = std::getenv("SPACESKIP_DG_SEGMENTS");
+    return e ? std::max(1, std::atoi(e)) : 8;
+  }();
+  if (n < 128) return 0;
+  for (int segs = std::min(cap_env, 8); segs >= 2; segs /= 2)
+    if (n >= 32 * segs && stagedBytes(n, cap, segs) <= kStagedMaxBytes) return segs;
+  return 0;
 }
 
 }  // namespace
@@ -68,28 +117,46 @@ const uint8_t* computeDistanceField(const uint8_t* occ, vec3i dims, int cap, Dis
   const int64_t n = int64_t(dims.x) * dims.y * dims.z;
   ws.a.reserve(size_t(n));
   ws.b.reserve(size_t(n));
-  seedKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(occ, n, uint8_t(cap), ws.a.get());
-  SS_CUDA_CHECK_LAUNCH(seedKernel);
-  // (cap + 1) * 32 ints: at most 32 KiB, under the default 48 KiB of dynamic shared memory; the
-  // staged kernel adds two bytes per brick of the block's 32 lines while that stays under it.
+  static const bool optedIn = [] {
+    return cudaFuncSetAttribute(stagedLineKernel<true>, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                int(kStagedMaxBytes)) == cudaSuccess &&
+           cudaFuncSetAttribute(stagedLineKernel<false>, cudaFuncAttributeMaxDynamicSharedMemorySize,
+                                int(kStagedMaxBytes)) == cudaSuccess;
+  }();
+  if (!optedIn) (void)cudaGetLastError();
+  // The unstaged kernel's scratch: (cap + 1) * 32 ints, at most 32 KiB.
   const size_t shared = size_t(cap + 1) * kLineThreads * sizeof(int);
-  uint8_t* bufs[2] = {ws.a.get(), ws.b.get()};
+  // Passes: occupancy -> a (seeded), a -> b, b -> a.
+  const uint8_t* src[3] = {occ, ws.a.get(), ws.b.get()};
+  uint8_t* dst[3] = {ws.a.get(), ws.b.get(), ws.a.get()};
   for (int axis = 0; axis < 3; ++axis) {
     const int u = axis == 0 ? 1 : 0, w = axis == 2 ? 1 : 2;
     const int64_t lines = int64_t(dims[u]) * dims[w];
-    const size_t staged = shared + 2 * size_t(dims[axis]) * kLineThreads;
-    if (lines > 0 && staged <= 48 * 1024) {
-      stagedLineKernel<<<blocksFor(lines, kLineThreads), kLineThreads, staged, stream>>>(bufs[axis % 2], dims, axis,
-                                                                                       cap, bufs[1 - axis % 2]);
+    if (lines <= 0) continue;
+    int segs = segmentsFor(dims[axis], cap);
+    if (!optedIn && stagedBytes(dims[axis], cap, segs) > 48 * 1024) segs = 0;
+    if (segs > 0) {
+      const size_t bytes = stagedBytes(dims[axis], cap, segs);
+      const int blocks = int((lines + kLineThreads - 1) / kLineThreads);
+      if (axis == 0)
+        stagedLineKernel<true><<<blocks, kLineThreads * segs, bytes, stream>>>(src[0], dims, 0, cap, segs, dst[0]);
+      else
+        stagedLineKernel<false><<<blocks, kLineThreads * segs, bytes, stream>>>(src[axis], dims, axis, cap, segs,
+                                                                               dst[axis]);
       SS_CUDA_CHECK_LAUNCH(stagedLineKernel);
-    } else if (lines > 0) {
-      lineKernel<<<blocksFor(lines, kLineThreads), kLineThreads, shared, stream>>>(bufs[axis % 2], dims, axis, cap,
-                                                                                 bufs[1 - axis % 2]);
+    } else {
+      const uint8_t* from = src[axis];
+      if (axis == 0) {  // seed into b (free until pass 2), then the pass reads it
+        seedKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(occ, n, uint8_t(cap), ws.b.get());
+        SS_CUDA_CHECK_LAUNCH(seedKernel);
+        from = ws.b.get();
+      }
+      lineKernel<<<blocksFor(lines, kLineThreads), kLineThreads, shared, stream>>>(from, dims, axis, cap, dst[axis]);
       SS_CUDA_CHECK_LAUNCH(lineKernel);
     }
   }
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-  return ws.b.get();  // passes a->b, b->a, a->b
+  return ws.a.get();
 }
 
 std::vector<uint8_t> fieldOnDevice(const OccupancyGrid& occ, int cap) {

@@ -1,5 +1,5 @@
-// DistanceGrid's distance field on the device: the three passes of DistanceField.h, one thread
-// per line per pass (the same distanceLine as the oneTBB build, so both fields agree).
+// DistanceGrid's distance field on the device: the three passes of DistanceField.h, up to 8 threads
+// a line per pass (distanceSegment) (the same distanceLine as the oneTBB build, so both fields agree).
 #pragma once
 #include "CudaCommon.cuh"
 #include "spaceskip/Classification.h"
@@ -10,11 +10,11 @@
 namespace spaceskip::cuda {
 
 struct DistanceWorkspace {
-  DeviceBuffer<uint8_t> a, b;  ///< ping-pong; the result is in `b`
+  DeviceBuffer<uint8_t> a, b;  ///< ping-pong; the result is in `a`
 };
 
-/// Fills ws.b with the capped Chebyshev distance field of the occupancy `occ` (dims bricks);
-/// returns ws.b's pointer. Synchronizes `stream`.
+/// Fills ws.a with the capped Chebyshev distance field of the occupancy `occ` (dims bricks);
+/// returns ws.a's pointer. Synchronizes `stream`.
 const uint8_t* computeDistanceField(const uint8_t* occ, vec3i dims, int cap, DistanceWorkspace& ws,
                                     cudaStream_t stream);
 /// The same from a host grid to a host field, on the default stream (for the tests).

@@ -41,15 +41,18 @@ SS_FUNC uint8_t distancePass(const uint8_t* in, int64_t i, int64_t stride, int p
 
 /// One sweep of distanceLine: along `n` bricks from `first` in steps of `step` (+-stride),
 /// L = min(cap, min over the bricks j already passed, this one included, of max(|i - j|, in[j]))
-/// at each brick i, in O(1) a brick; `combine`: out = min(out, L), else out = L.
+/// at each brick i, in O(1) a brick; written from the brick `skip` on (the ones before are only
+/// passed); `combine`: out = min(out, L), else out = L.
 /// The recurrence: from one brick to the next every passed term either stays or grows by one,
 /// so L grows by one unless a passed brick j with in[j] <= L lies within L of the next brick;
 /// `p` is the last passed brick with in[j] <= L, `last[v * lastStep]` the last with in[j] == v
-/// (v <= cap) and feeds p when L grows.
-SS_FUNC void distanceSweep(const uint8_t* in, uint8_t* out, int64_t first, int64_t step, int n, int cap, int* last,
-                           int lastStep, bool combine) {
-  const int none = -(1 << 30);
-  for (int v = 0; v <= cap; ++v) last[v * lastStep] = none;
+/// (v <= cap) and feeds p when L grows. `Idx` holds positions on the sweep (int16_t where the
+/// sweep is shorter than 32k bricks: half the scratch).
+template <class Idx>
+SS_FUNC void distanceSweep(const uint8_t* in, uint8_t* out, int64_t first, int64_t step, int n, int skip, int cap,
+                           Idx* last, int lastStep, bool combine) {
+  const int none = sizeof(Idx) == 2 ? -32768 : -(1 << 30);
+  for (int v = 0; v <= cap; ++v) last[v * lastStep] = Idx(none);
   int L = cap + 1, p = none;  // nothing passed yet: "infinitely" far
   for (int i = 0; i < n; ++i) {
     const int64_t at = first + step * i;
@@ -59,12 +62,15 @@ SS_FUNC void distanceSweep(const uint8_t* in, uint8_t* out, int64_t first, int64
       L = v;
       p = i;
     } else {
-      if (c > L) p = p > last[c * lastStep] ? p : last[c * lastStep];  // c < v <= cap
+      const int lc = last[c * lastStep];
+      if (c > L) p = p > lc ? p : lc;  // c < v <= cap
       L = c;
     }
-    last[v * lastStep] = i;
-    const uint8_t d = uint8_t(L);
-    out[at] = combine && out[at] < d ? out[at] : d;
+    last[v * lastStep] = Idx(i);
+    if (i >= skip) {
+      const uint8_t d = uint8_t(L);
+      out[at] = combine && out[at] < d ? out[at] : d;
+    }
   }
 }
 
@@ -73,8 +79,21 @@ SS_FUNC void distanceSweep(const uint8_t* in, uint8_t* out, int64_t first, int64
 /// scratch of cap + 1 ints, `lastStep` apart.
 SS_FUNC void distanceLine(const uint8_t* in, uint8_t* out, int64_t first, int64_t stride, int n, int cap, int* last,
                           int lastStep) {
-  distanceSweep(in, out, first, stride, n, cap, last, lastStep, false);
-  distanceSweep(in, out, first + stride * (n - 1), -stride, n, cap, last, lastStep, true);
+  distanceSweep(in, out, first, stride, n, 0, cap, last, lastStep, false);
+  distanceSweep(in, out, first + stride * (n - 1), -stride, n, 0, cap, last, lastStep, true);
+}
+
+/// distanceLine's values on the bricks [a, b) of the line only (0 <= a < b <= n), so that
+/// several threads can share one line: each sweep starts `cap` bricks before its first written
+/// brick, because a brick farther than cap cannot bring a value below the cap. The segments of
+/// a line computed apart equal distanceLine of the whole line.
+template <class Idx>
+SS_FUNC void distanceSegment(const uint8_t* in, uint8_t* out, int64_t first, int64_t stride, int n, int a, int b,
+                             int cap, Idx* last, int lastStep) {
+  const int s0 = a - cap > 0 ? a - cap : 0;           // forward: from s0, written from a
+  const int e0 = b + cap < n ? b + cap - 1 : n - 1;   // backward: from e0, written from b - 1
+  distanceSweep(in, out, first + stride * s0, stride, b - s0, a - s0, cap, last, lastStep, false);
+  distanceSweep(in, out, first + stride * e0, -stride, e0 - a + 1, e0 - b + 1, cap, last, lastStep, true);
 }
 
 /// The distance field of `occ` (0 for occupied bricks, >= 1 for empty ones), oneTBB.

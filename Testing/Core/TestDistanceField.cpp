@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <random>
+#include <vector>
 #include <string>
 
 using namespace spaceskip;
@@ -86,12 +87,44 @@ TEST(DistanceField, TheLinearLinePassEqualsThePerBrickPass) {
   EXPECT_GT(checked, 100000);
 }
 
+TEST(DistanceField, SegmentsOfALineComputedApartEqualTheWholeLine) {
+  // distanceSegment (what the CUDA passes run, up to 8 threads a line) against distanceLine: a
+  // line cut into 1 to 9 segments of any length, each computed alone with its own int16 scratch,
+  // on lines shorter and longer than the cap and every kind of input a pass sees.
+  std::mt19937 rng(11);
+  int64_t checked = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int cap = trial % 6 == 0 ? 1 + int(rng() % 3) : trial % 5 == 0 ? 255 : int(1 + rng() % 70);
+    const int n = 1 + int(rng() % (trial % 2 == 0 ? 320 : 50));
+    const int64_t stride = 1 + int64_t(rng() % 3);
+    std::vector<uint8_t> in(size_t(n * stride), 0), whole(in.size(), 77), parts(in.size(), 77);
+    for (int i = 0; i < n; ++i) {
+      const int kind = trial % 3;
+      in[size_t(i * stride)] = kind == 0 ? (rng() % 40 == 0 ? 0 : uint8_t(cap))
+                               : kind == 1 ? uint8_t(rng() % (cap + 1))
+                                           : uint8_t(rng() % 256);
+    }
+    std::vector<int> last(size_t(cap) + 1);
+    distanceLine(in.data(), whole.data(), 0, stride, n, cap, last.data(), 1);
+    const int segs = 1 + int(rng() % 9), segLen = (n + segs - 1) / segs;
+    std::vector<int16_t> last16(size_t(cap) + 1);
+    for (int a = 0; a < n; a += segLen)
+      distanceSegment(in.data(), parts.data(), 0, stride, n, a, std::min(n, a + segLen), cap, last16.data(), 1);
+    for (int i = 0; i < n; ++i, ++checked)
+      ASSERT_EQ(int(parts[size_t(i * stride)]), int(whole[size_t(i * stride)]))
+          << "trial " << trial << " n " << n << " cap " << cap << " segments " << segs << " brick " << i;
+    EXPECT_EQ(parts, whole) << "wrote off the line";
+  }
+  EXPECT_GT(checked, 100000);
+}
+
 TEST(DistanceField, TheCudaFieldEqualsTheCpuField) {
-  // The CUDA kernels (one thread per line, scratch in shared memory) against the oneTBB build,
-  // on shapes with lines of 1 to 300 bricks, sparse to full grids and every cap.
+  // The CUDA kernels (up to 8 threads a line, lines staged in shared memory) against the oneTBB
+  // build, on shapes with lines of 1 to 300 bricks (a last block of fewer than 32 lines), sparse
+  // to full grids and every cap.
   std::string why;
   if (!cudaAvailable(&why)) GTEST_SKIP() << why;
-  const vec3i shapes[] = {{17, 13, 11}, {1, 1, 300}, {300, 1, 1}, {3, 29, 2}, {64, 48, 40}};
+  const vec3i shapes[] = {{17, 13, 11}, {1, 1, 300}, {300, 1, 1}, {3, 29, 2}, {64, 48, 40}, {260, 37, 35}, {33, 257, 5}};
   unsigned seed = 100;
   for (vec3i dims : shapes)
     for (double p : {0.0, 0.001, 0.03, 0.4, 1.0})
