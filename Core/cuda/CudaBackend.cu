@@ -92,7 +92,11 @@ class CudaBackend final : public Backend {
     d_distField_ = nullptr;
     s.builtOn = "cuda";
     if (info.extra == BuilderExtra::DistanceField) {
-      d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, kMaxSkipDistance, dist_, stream_);
+      // SPACESKIP_DG_CAP (read per build, 1..127: bit 7 of the field marks sparse bricks): another
+      // cap, a measurement switch (the segments' overlaps against the leaps' length).
+      int cap = kMaxSkipDistance;
+      if (const char* e = std::getenv("SPACESKIP_DG_CAP")) cap = std::clamp(std::atoi(e), 1, 127);
+      d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, cap, dist_, stream_);
       // A field computed from the current occupancy carries no marks until the masks mark some
       // bricks sparse: right after an edit (no masks yet) the mark kernel would change nothing.
       if (cls_.brickStates()) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
