@@ -61,7 +61,7 @@ class CudaBackend final : public Backend {
     // emptied bricks) takes the new states' marks, in render(): an edit that occupies bricks
     // rebuilds the field (which marks it) first, and marking the old one too would only add a
     // kernel to the edit's path.
-    distMarksStale_ = d_distField_ != nullptr;
+    distMarksStale_ = true;
     return changed;
   }
   double subMaskShare() const override { return cls_.subMasks() ? cls_.setFraction : 1.0; }
@@ -142,12 +142,11 @@ class CudaBackend final : public Backend {
       classifiedSinceRender_ = false;
     } else if (cls_.masksPending()) {
       cls_.refreshMasks(stream_);
-      distMarksStale_ = d_distField_ != nullptr;
+      distMarksStale_ = true;
     }
-    if (distMarksStale_) {
-      cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
-      distMarksStale_ = false;
-    }
+    // Only a field that is drawn with takes marks (a build after the edit may have dropped it).
+    if (distMarksStale_ && d_distField_) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
+    distMarksStale_ = false;
     f.traversal = traversal_;
     // SPACESKIP_CUDA_PARTS_SHARE (read per frame): another threshold, a measurement and test switch.
     const char* share = std::getenv("SPACESKIP_CUDA_PARTS_SHARE");
@@ -257,7 +256,7 @@ class CudaBackend final : public Backend {
   cuda::DistanceWorkspace dist_;
   const uint8_t* d_distField_ = nullptr;  ///< DistanceGrid's field (in dist_) for the current occupancy
   bool classifiedSinceRender_ = false;     ///< classify() ran since the last render()
-  bool distMarksStale_ = false;            ///< d_distField_'s marks predate the brick states
+  bool distMarksStale_ = false;            ///< d_distField_'s marks (if any) predate the brick states
 };
 
 }  // namespace

@@ -359,6 +359,44 @@ TEST(CudaBackend, OpacityEditRebuildsOnlyWhenOccupancyChanges) {
   EXPECT_TRUE(e.tree().nodes.empty());
 }
 
+TEST(CudaBackend, OpacityEditThenAnotherBuilderDrawsWithoutTheOldField) {
+  // An opacity edit leaves DistanceGrid's field to be re-marked by the next frame; a change of
+  // builder in the same update drops the field, and that frame must neither mark nor read it:
+  // the image equals Naive's and the backend stays CUDA (no device fault, no fallback).
+  REQUIRE_CUDA();
+  Volume v = generateVolume("nbody", vec3l{64, 56, 48}, 3);
+  const TransferFunction ramp = tfFor(v, "ramp");
+  TransferFunction fainter = ramp;
+  for (auto& c : fainter.table) c.w = c.w < 0.3f ? 0.f : c.w;
+  double b[6];
+  v.worldBounds(b);
+  const Camera cam = orbitCamera(b, 30, 20, 1.0, false, 1.0);
+  Image ref;
+  {
+    Engine naive(BackendKind::CUDA);
+    naive.setLogger([](const std::string&) {});
+    naive.setVolume(v);
+    naive.setTransferFunction(fainter);
+    naive.setBuildParams(params(BuilderKind::Naive));
+    naive.render(cam, 64, 64, ref);
+  }
+  for (BuilderKind next : {BuilderKind::Grid, BuilderKind::LBVH, BuilderKind::Naive}) {
+    Engine e(BackendKind::CUDA);
+    e.setLogger([](const std::string&) {});
+    e.setVolume(v);
+    e.setTransferFunction(ramp);
+    e.setBuildParams(params(BuilderKind::DistanceGrid));
+    Image img;
+    for (int frame = 0; frame < 2; ++frame) e.render(cam, 64, 64, img);  // frame 2 has the masks
+    e.setTransferFunction(fainter);
+    e.setBuildParams(params(next));
+    e.render(cam, 64, 64, img);
+    ASSERT_EQ(e.backendKind(), BackendKind::CUDA) << builderName(next);
+    ASSERT_GT(test::coverage(ref), 0.001) << "test premise: the scene is not empty";
+    EXPECT_LE(compareImages(ref, img).maxAbs, 1.f / 255) << builderName(next);
+  }
+}
+
 struct ImageCase {
   const char* shape;
   int n;
