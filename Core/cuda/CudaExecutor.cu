@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <type_traits>
 
 namespace spaceskip::cuda {
@@ -138,9 +139,18 @@ CudaExecutor::CudaExecutor() {
 }
 
 void CudaExecutor::setTransferTable(const std::vector<vec4f>& t, float lo, float scale, cudaStream_t stream) {
+  // An opacity edit's path: a pageable copy would make the host wait for the whole stream (the
+  // classification and the build queued before it); the pinned copy waits for nothing but the
+  // previous table's copy (long done).
+  const size_t bytes = t.size() * sizeof(vec4f);
+  if (tableCopyPending_) SS_CUDA_CHECK(cudaEventSynchronize(tableCopied_));
+  tableCopyPending_ = false;
   d_table_.reserve(t.size());
-  SS_CUDA_CHECK(cudaMemcpyAsync(d_table_.get(), t.data(), t.size() * sizeof(vec4f), cudaMemcpyHostToDevice, stream));
-  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  h_table_.reserve(bytes);
+  std::memcpy(h_table_.get(), t.data(), bytes);
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_table_.get(), h_table_.get(), bytes, cudaMemcpyHostToDevice, stream));
+  SS_CUDA_CHECK(cudaEventRecord(tableCopied_, stream));
+  tableCopyPending_ = true;
   table_ = TransferFunctionView{d_table_.get(), int(t.size()), lo, scale};
 }
 

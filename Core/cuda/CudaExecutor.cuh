@@ -18,7 +18,8 @@ class CudaExecutor {
   CudaExecutor();
 
   void setLaunchParams(const LaunchParams& p) { launch_ = p; }
-  /// The (opacity-corrected) table the integrator samples; synchronizes `stream`.
+  /// The (opacity-corrected) table the integrator samples, copied on `stream` through a pinned
+  /// staging buffer (no host wait; the frames after it on `stream` read it).
   void setTransferTable(const std::vector<vec4f>& table, float lo, float scale, cudaStream_t stream);
   /// Renders `f` (grid and tree pointing at device memory; the table and depth filled here) from
   /// `vol` into `out`, or only sizes `out` and leaves the image in deviceImage() (setImageOnDevice).
@@ -45,6 +46,9 @@ class CudaExecutor {
   LaunchParams env_;  ///< SPACESKIP_CUDA_BLOCK / _CARVEOUT as read at construction
   int numSMs_ = 1;
   DeviceBuffer<vec4f> d_table_;
+  PinnedBuffer h_table_;  ///< the table on its way to d_table_
+  Event tableCopied_;     ///< h_table_ may be written again once this has passed
+  bool tableCopyPending_ = false;
   TransferFunctionView table_{nullptr, 0, 0.f, 1.f};
   DeviceBuffer<float> d_depth_;
   DeviceBuffer<float> d_alphaIn_;

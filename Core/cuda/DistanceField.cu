@@ -41,6 +41,25 @@ __global__ void lineKernel(const uint8_t* in, vec3i dims, int axis, int cap, uin
                int(blockDim.x));
 }
 
+// Sixteen bricks, one 16-byte load or store.
+union Bytes16 {
+  uint4 v;
+  uint8_t c[16];
+};
+
+// The block's lines move in 16-byte pieces when they are whole aligned pieces of the grid: a
+// full block of 32 lines that are one run of bytes (axis 0: consecutive rows, n a multiple of
+// 16) or 32 adjacent bytes at each position (the other axes: the lines' first bricks adjacent,
+// the stride a multiple of 16), `in` and `out` aligned alike. Two loads a position instead of
+// 32 single-byte ones (and no division a byte).
+__device__ bool vectorStaging(const uint8_t* in, const uint8_t* out, const int64_t* starts, int nl, int n, int axis,
+                              int64_t stride) {
+  const int64_t step = axis == 0 ? n : 1;
+  const auto aligned = [&](const uint8_t* p) { return (reinterpret_cast<uintptr_t>(p + starts[0]) & 15) == 0; };
+  return nl == kLineThreads && starts[kLineThreads - 1] - starts[0] == (kLineThreads - 1) * step &&
+         (axis == 0 ? n % 16 == 0 : stride % 16 == 0) && aligned(in) && aligned(out);
+}
+
 // The block's 32 lines staged in shared memory, `segs` threads a line (distanceSegment): the
 // block first copies its lines in (for axis 0 the 32 lines are one run of bytes, read in order;
 // for the other axes 32 consecutive lines are 32 consecutive bytes at each position), the
@@ -51,7 +70,7 @@ __global__ void lineKernel(const uint8_t* in, vec3i dims, int axis, int cap, uin
 // and the pass reads it as 0 (occupied) / cap (empty), which saves a pass over the grid.
 template <bool Seed>
 __global__ void stagedLineKernel(const uint8_t* in, vec3i dims, int axis, int cap, int segs, uint8_t* out) {
-  extern __shared__ int shared[];
+  extern __shared__ __align__(16) int shared[];
   __shared__ int64_t starts[kLineThreads];
   const int n = dims[axis];
   const int threads = int(blockDim.x);
@@ -66,11 +85,37 @@ __global__ void stagedLineKernel(const uint8_t* in, vec3i dims, int axis, int ca
   __syncthreads();
   const int64_t stride = axisStride(dims, axis);
   const int total = n * kLineThreads;
-  for (int o = int(threadIdx.x); o < total; o += threads) {
-    const int k = axis == 0 ? o / n : o % kLineThreads, i = axis == 0 ? o % n : o / kLineThreads;
-    if (k >= nl) continue;
-    const uint8_t v = in[starts[k] + stride * i];
-    stagedIn[i * kLineThreads + k] = Seed ? (v ? uint8_t(0) : uint8_t(cap)) : v;
+  const bool vec = vectorStaging(in, out, starts, nl, n, axis, stride);
+  const uint8_t capByte = uint8_t(cap);
+  if (vec && axis == 0) {
+    // 32 rows of n bricks, one run: piece p is line p % 32's bricks 16 (p / 32) .. + 15.
+    for (int p = int(threadIdx.x); p < total / 16; p += threads) {
+      const int k = p % kLineThreads, i0 = 16 * (p / kLineThreads);
+      Bytes16 b;
+      b.v = *reinterpret_cast<const uint4*>(in + starts[0] + int64_t(k) * n + i0);
+#pragma unroll
+      for (int j = 0; j < 16; ++j)
+        stagedIn[(i0 + j) * kLineThreads + k] = Seed ? (b.c[j] ? uint8_t(0) : capByte) : b.c[j];
+    }
+  } else if (vec) {
+    // At each position the 32 lines are 32 adjacent bytes: the staged row itself.
+    for (int p = int(threadIdx.x); p < total / 16; p += threads) {
+      const int i = p >> 1, h = 16 * (p & 1);
+      Bytes16 b;
+      b.v = *reinterpret_cast<const uint4*>(in + starts[0] + stride * i + h);
+      if (Seed) {
+#pragma unroll
+        for (int j = 0; j < 16; ++j) b.c[j] = b.c[j] ? uint8_t(0) : capByte;
+      }
+      *reinterpret_cast<uint4*>(stagedIn + i * kLineThreads + h) = b.v;
+    }
+  } else {
+    for (int o = int(threadIdx.x); o < total; o += threads) {
+      const int k = axis == 0 ? o / n : o % kLineThreads, i = axis == 0 ? o % n : o / kLineThreads;
+      if (k >= nl) continue;
+      const uint8_t v = in[starts[k] + stride * i];
+      stagedIn[i * kLineThreads + k] = Seed ? (v ? uint8_t(0) : capByte) : v;
+    }
   }
   __syncthreads();
   const int k = int(threadIdx.x) % kLineThreads, s = int(threadIdx.x) / kLineThreads;
@@ -78,9 +123,25 @@ __global__ void stagedLineKernel(const uint8_t* in, vec3i dims, int axis, int ca
   const int a = s * segLen, b = a + segLen < n ? a + segLen : n;
   if (k < nl && a < b) distanceSegment(stagedIn, stagedOut, k, kLineThreads, n, a, b, cap, last + threadIdx.x, threads);
   __syncthreads();
-  for (int o = int(threadIdx.x); o < total; o += threads) {
-    const int kk = axis == 0 ? o / n : o % kLineThreads, i = axis == 0 ? o % n : o / kLineThreads;
-    if (kk < nl) out[starts[kk] + stride * i] = stagedOut[i * kLineThreads + kk];
+  if (vec && axis == 0) {
+    for (int p = int(threadIdx.x); p < total / 16; p += threads) {
+      const int kk = p % kLineThreads, i0 = 16 * (p / kLineThreads);
+      Bytes16 b;
+#pragma unroll
+      for (int j = 0; j < 16; ++j) b.c[j] = stagedOut[(i0 + j) * kLineThreads + kk];
+      *reinterpret_cast<uint4*>(out + starts[0] + int64_t(kk) * n + i0) = b.v;
+    }
+  } else if (vec) {
+    for (int p = int(threadIdx.x); p < total / 16; p += threads) {
+      const int i = p >> 1, h = 16 * (p & 1);
+      *reinterpret_cast<uint4*>(out + starts[0] + stride * i + h) =
+          *reinterpret_cast<const uint4*>(stagedOut + i * kLineThreads + h);
+    }
+  } else {
+    for (int o = int(threadIdx.x); o < total; o += threads) {
+      const int kk = axis == 0 ? o / n : o % kLineThreads, i = axis == 0 ? o % n : o / kLineThreads;
+      if (kk < nl) out[starts[kk] + stride * i] = stagedOut[i * kLineThreads + kk];
+    }
   }
 }
 

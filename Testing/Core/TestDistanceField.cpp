@@ -121,10 +121,12 @@ TEST(DistanceField, SegmentsOfALineComputedApartEqualTheWholeLine) {
 TEST(DistanceField, TheCudaFieldEqualsTheCpuField) {
   // The CUDA kernels (up to 8 threads a line, lines staged in shared memory) against the oneTBB
   // build, on shapes with lines of 1 to 300 bricks (a last block of fewer than 32 lines), sparse
-  // to full grids and every cap.
+  // to full grids and every cap. The last two stage their lines in 16-byte pieces (dims that are
+  // multiples of 16), the last one mixing such blocks with blocks whose lines straddle two rows.
   std::string why;
   if (!cudaAvailable(&why)) GTEST_SKIP() << why;
-  const vec3i shapes[] = {{17, 13, 11}, {1, 1, 300}, {300, 1, 1}, {3, 29, 2}, {64, 48, 40}, {260, 37, 35}, {33, 257, 5}};
+  const vec3i shapes[] = {{17, 13, 11}, {1, 1, 300}, {300, 1, 1}, {3, 29, 2}, {64, 48, 40},
+                           {260, 37, 35}, {33, 257, 5}, {256, 144, 160}, {144, 256, 160}};
   unsigned seed = 100;
   for (vec3i dims : shapes)
     for (double p : {0.0, 0.001, 0.03, 0.4, 1.0})
