@@ -15,28 +15,7 @@ set -uo pipefail
 out=${1:?usage: refill-dg.sh OUTDIR [phases]}
 shift
 phases=${*:-tests memcheck nbody segs refill paper ncu}
-has() { [[ " $phases " == *" $1 "* ]]; }
-late() { [ -n "${DEADLINE:-}" ] && [ "$(date +%s)" -ge "$DEADLINE" ]; }
-mkdir -p "$out"
-out=$(cd "$out" && pwd)
-src=$(cd "$(dirname "$0")/../.." && pwd)
-cd "$src"
-mkdir -p build-new build-old
-[ -x build-new/spaceskip ] || tar xJf build-bench/both.tar.xz -C build-new || exit 1
-[ -x build-old/spaceskip ] || { [ -f build-bench/old.tar.xz ] && tar xJf build-bench/old.tar.xz -C build-old; }
-export LD_LIBRARY_PATH=$src/build-bench/lib:$src/.deps/tbb/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-{
-  date -u +%Y-%m-%dT%H:%M:%SZ
-  nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv
-  git rev-parse HEAD 2>/dev/null || echo "tree of the carried working copy"
-} > "$out/env.txt" 2>&1
-log() { echo "$(date -u +%H:%M:%S) $*" | tee -a "$out/env.txt"; }
-
-if has tests && ! late; then
-  timeout 300 ./build-new/spaceskip_core_tests --gtest_brief=1 > "$out/core.log" 2>&1
-  log "core tests rc=$?"
-  tail -4 "$out/core.log"
-fi
+source "$(dirname "$0")/ab-common.sh"
 if has memcheck && ! late; then
   cs=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
   timeout 200 "$cs" --tool memcheck --error-exitcode 3 ./build-new/spaceskip_core_tests \
