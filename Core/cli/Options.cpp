@@ -26,7 +26,7 @@ const std::set<std::string>& valueOptions() {
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
       "--shade", "--cuda-block", "--cuda-carveout", "--scale", "--datasets", "--time-limit", "--memory-budget",
-      "--pool-brick", "--edit-tf"};
+      "--pool-brick", "--edit-tf", "--edits", "--edit-cut"};
   return s;
 }
 const std::set<std::string>& flagOptions() {

@@ -61,6 +61,11 @@ const char* kUsage = R"(usage:
       bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only),
       :resN (CUDA: persistent launch with N blocks per SM; res0 = plain), :whole (no sub-brick
       masks: occupied bricks marched whole), :partsN (bricks with <= N of 64 parts set walked by parts)
+      --edits N [--edit-cut C]: after an item's frames, N opacity edits at a still view, alternately
+      zeroing the TF's opacity below C of the range (default 0.3: bricks empty) and restoring it
+      (bricks occupied again), each timed to its first frame finished on the device (the image
+      left there, as the mapper's window path does), with a frame after each; the line
+      "edits:" gives each kind's mean: classification (of it the wait for the device), build, frame
   spaceskip bench --paper [--scale F] [--datasets a,b] [--builders k1,k2] [--frames N] [--time-limit S]
                   [--csv FILE] [--json FILE] [options]
       the paper's whole benchmark: stand-ins for its 11 data sets (dims x F), every builder and
@@ -334,7 +339,71 @@ struct BenchRow {
   double cold = 0, fps = 0, kernelFps = 0, frameCpu = 0, samples = 0, gsps = 0, voxelGBs = 0;
   const char* filter = "exact";
   const char* leaf = "deep";
+  /// --edits: the mean edit of each kind (0: the edits that empty bricks, 1: that occupy them).
+  struct Edit {
+    int count = 0;
+    double ms = 0, classifyMs = 0, waitMs = 0, buildMs = 0, frameMs = 0, kernelMs = 0, builds = 0;
+    double nextMs = 0, nextKernelMs = 0;  ///< the frame after the edit's (same view)
+  } edits[2];
 };
+
+/// --edits N: opacity edits at a still view, each timed from setTransferFunction() to its
+/// frame finished on the device (the image left in device memory, as the mapper's interop path
+/// does; on the CPU backend the frame is the host's), with one untimed frame after each. The
+/// edits alternate between zeroing the opacity below `cut` of the table (bricks empty) and the
+/// TF as it was (bricks occupied again).
+void measureEdits(Engine& engine, const TransferFunction& tf, const Camera& cam, int w, int h, int edits, double cut,
+                  BenchRow& row) {
+  TransferFunction cutTF = tf;
+  const size_t below = size_t(std::clamp(cut, 0.0, 1.0) * double(cutTF.table.size()));
+  for (size_t i = 0; i < below && i < cutTF.table.size(); ++i) cutTF.table[i].w = 0.f;
+  const bool onDevice = engine.setImageOnDevice(true);
+  Image img;
+  engine.render(cam, w, h, img);
+  (void)engine.frameStats(true);
+  for (int e = 0; e < edits; ++e) {
+    const int kind = e % 2;  // 0: to the cut TF (empties bricks), 1: back (occupies them)
+    const int builds = engine.counters().builds;
+    const auto t0 = Clock::now();
+    engine.setTransferFunction(kind == 0 ? cutTF : tf);
+    engine.render(cam, w, h, img);
+    const FrameStats& fs = engine.frameStats(true);
+    const double ms = 1e3 * since(t0);
+    BenchRow::Edit& k = row.edits[kind];
+    const BuildStats& s = engine.buildStats();
+    ++k.count;
+    k.ms += ms;
+    k.classifyMs += 1e3 * s.classifySeconds;
+    k.waitMs += 1e3 * s.classifyWaitSeconds;
+    const int built = engine.counters().builds - builds;
+    k.builds += built;
+    if (built) k.buildMs += 1e3 * s.seconds;
+    k.frameMs += 1e3 * fs.seconds;
+    k.kernelMs += fs.deviceSeconds > 0 ? 1e3 * fs.deviceSeconds : 0;
+    const auto t1 = Clock::now();
+    engine.render(cam, w, h, img);  // the frame after the edit (masks, refinement)
+    const FrameStats& next = engine.frameStats(true);
+    k.nextMs += 1e3 * since(t1);
+    k.nextKernelMs += next.deviceSeconds > 0 ? 1e3 * next.deviceSeconds : 0;
+  }
+  if (onDevice) engine.setImageOnDevice(false);
+  for (BenchRow::Edit& k : row.edits)
+    if (k.count) {
+      const double n = k.count;
+      k.ms /= n, k.classifyMs /= n, k.waitMs /= n, k.buildMs /= n, k.frameMs /= n, k.kernelMs /= n, k.builds /= n;
+      k.nextMs /= n, k.nextKernelMs /= n;
+    }
+  auto text = [](const BenchRow::Edit& k) {
+    char b[320];
+    std::snprintf(b, sizeof b,
+                  "%.3f ms (classify %.3f, of it waiting %.3f; build %.3f x%.2f; frame %.3f, kernel %.3f; next frame "
+                  "%.3f, kernel %.3f)",
+                  k.ms, k.classifyMs, k.waitMs, k.buildMs, k.builds, k.frameMs, k.kernelMs, k.nextMs, k.nextKernelMs);
+    return std::string(b);
+  };
+  std::printf("  edits: %s: occupying %s; emptying %s\n", row.label.c_str(), text(row.edits[1]).c_str(),
+              text(row.edits[0]).c_str());
+}
 
 const char* leafName(LeafCriterion l) {
   return l == LeafCriterion::Shallow ? "shallow" : l == LeafCriterion::Empty ? "empty" : "deep";
@@ -439,9 +508,16 @@ BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemTex
   // Hybrid always builds the shallow tree (paper 3.3).
   row.leaf = s.builder == BuilderKind::Hybrid ? "shallow" : leafName(bp.leaf);
   row.s = s;
-  // The share of set sub-brick parts as the frames saw it (the CUDA backend computes the masks
-  // on the frame after a classification, so the build's statistics may predate them).
+  // The share of set sub-brick parts as the frames saw it (without part ranges the CUDA backend
+  // computes the masks on the frame after a classification, so the build's statistics may
+  // predate them).
   row.s.partsShare = engine.buildStats().partsShare;
+  const int edits = int(o.getInt("--edits", 0, 0, 100000));
+  if (edits > 0) {
+    engine.setRenderParams(rp);
+    measureEdits(engine, makeTF(o, v), orbitCamera(b6, 0, 15, 1, false, double(w) / h), w, h, edits,
+                 o.getDouble("--edit-cut", 0.3, 0.0, 1.0), row);
+  }
   return row;
 }
 
@@ -639,7 +715,9 @@ int cmdBenchPaper(const Options& o) {
     if (!csv) throw std::runtime_error("cannot write " + o.get("--csv", ""));
     csv << "dataset,paper_dims,dims,scale,variant,item,builder,backend,built_on,leaf,mls,bins,brick,build_s,build_cold_s,"
            "classify_s,fps,kernel_fps,frame_cpu_s,nodes,height,leaves,brick_occupancy,voxel_occupancy_pct,"
-           "paper_occupancy_pct,samples_per_frame,vs_naive_kernel,width,height_px,frames,status,parts_share\n";
+           "paper_occupancy_pct,samples_per_frame,vs_naive_kernel,width,height_px,frames,status,parts_share,"
+           "edit_empty_ms,edit_occupy_ms,edit_occupy_classify_ms,edit_occupy_wait_ms,edit_occupy_build_ms,"
+           "edit_occupy_frame_ms,edit_occupy_kernel_ms\n";
   }
   std::ostringstream json;
   json << "{\n  \"protocol\": {\"width\": " << w << ", \"height\": " << h << ", \"frames\": " << frames
@@ -660,7 +738,7 @@ int cmdBenchPaper(const Options& o) {
       for (const PaperVariant& pv : vars) {
         if (csv.is_open())
           csv << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale << "," << pv.key << "," << pv.item
-              << ",,,,,,,,,,,,,,,,,,," << ds.occupancyPct << ",,,,,," << why << "\n";
+              << ",,,,,,,,,,,,,,,,,,," << ds.occupancyPct << ",,,,,," << why << ",,,,,,,,\n";
         progress.step(++done, std::string(ds.name) + " " + pv.key + ": " + why);
       }
     };
@@ -713,7 +791,7 @@ int cmdBenchPaper(const Options& o) {
       if (status != "ok") {
         if (csv.is_open())
           csv << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale << "," << pv.key << ","
-              << pv.item << ",,,,,,,,,,,,,,,,,,," << ds.occupancyPct << ",,,,,," << status << "\n";
+              << pv.item << ",,,,,,,,,,,,,,,,,,," << ds.occupancyPct << ",,,,,," << status << ",,,,,,,,\n";
         progress.step(done, std::string(ds.name) + " " + pv.key + ": " + status);
         continue;
       }
@@ -730,7 +808,15 @@ int cmdBenchPaper(const Options& o) {
             << r.bp.maxLeafSize << "," << r.bp.bins << "," << r.bp.brick << "," << s.seconds << "," << r.cold << ","
             << s.classifySeconds << "," << r.fps << "," << r.kernelFps << "," << r.frameCpu << "," << s.nodes << ","
             << s.height << "," << s.leaves << "," << s.occupancy << "," << voxelOcc << "," << ds.occupancyPct << ","
-            << r.samples << "," << vsNaive << "," << w << "," << h << "," << frames << ",ok," << s.partsShare << "\n";
+            << r.samples << "," << vsNaive << "," << w << "," << h << "," << frames << ",ok," << s.partsShare;
+        const BenchRow::Edit& em = r.edits[0];
+        const BenchRow::Edit& oc = r.edits[1];
+        if (oc.count)
+          csv << "," << em.ms << "," << oc.ms << "," << oc.classifyMs << "," << oc.waitMs << "," << oc.buildMs << ","
+              << oc.frameMs << "," << oc.kernelMs;
+        else
+          csv << ",,,,,,,";
+        csv << "\n";
         csv.flush();
       }
       if (!firstJson) json << ",\n";

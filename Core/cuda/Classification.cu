@@ -1,8 +1,16 @@
 // Brick value ranges and classification against the TF on the device (thin drivers over the
 // shared brickRange and OpacityRangeMaxView).
 #include "Classification.cuh"
+#include "spaceskip/Backend.h"
 
 #include <algorithm>
+
+#include <cub/device/device_scan.cuh>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <type_traits>
 
 namespace spaceskip::cuda {
 
@@ -94,6 +102,114 @@ __global__ void subMaskKernel(const T* data, vec3l dims, vec3i cellDims, vec3i b
   if (lane == 0 && set) atomicAdd(setParts + warp % kPartCounters, set);
 }
 
+// Part ranges. A brick is uniform when each of its parts (with a cell in the volume) has the
+// brick's own range [vmin, vmax]: its mask needs no stored bounds. Integer bricks with
+// vmin == vmax are uniform without reading them (every voxel has that value).
+constexpr uint32_t kUniformBrick = 0xffffffffu;
+constexpr int kRangeBlocksPerSM = 8;
+template <class T>
+struct PartRangeStore {  // bounds stored exactly: the 8/16-bit types as themselves, else float
+  using type = typename std::conditional<(sizeof(T) <= 2), T, float>::type;
+};
+
+// Launch shape: a fixed grid (kRangeBlocksPerSM blocks of 256 threads per SM); a warp per brick
+// in turn, two of its 64 parts a lane (subPartRange). Pass 1 (out == nullptr): slot[i] = 1 for
+// a brick that is not uniform, else 0. Pass 2: slot[i] holds the exclusive scan of pass 1's
+// flags and `flag` pass 1's flag; a non-uniform brick's bounds go to its slot, and slot[i]
+// becomes kUniformBrick for the others.
+template <class T>
+__global__ void partRangeKernel(const T* data, vec3l dims, vec3i cellDims, vec3i bdims, int brick, const float* vmin,
+                                const float* vmax, const uint32_t* flag, uint32_t* slot,
+                                typename PartRangeStore<T>::type* out) {
+  using S = typename PartRangeStore<T>::type;
+  const unsigned lane = threadIdx.x & 31;
+  const int64_t warp = (int64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
+  const int64_t warps = (int64_t(gridDim.x) * blockDim.x) >> 5;
+  const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
+  constexpr bool integral = std::numeric_limits<T>::is_integer;
+  for (int64_t i = warp; i < n; i += warps) {
+    const float lo = vmin[i], hi = vmax[i];
+    if (out) {
+      const uint32_t f = flag[i], s = slot[i];
+      __syncwarp();
+      if (!f) {
+        if (lane == 0) slot[i] = kUniformBrick;
+        continue;
+      }
+      const int64_t bx = i % bdims.x, by = (i / bdims.x) % bdims.y, bz = i / (int64_t(bdims.x) * bdims.y);
+      S* o = out + int64_t(s) * 128;
+      for (int k = int(lane); k < 64; k += 32) {
+        float a, b;
+        const bool in = subPartRange(data, dims, cellDims, brick, bx, by, bz, k, a, b);
+        o[k] = in ? S(a) : S(0);  // a part outside the volume is never read (subPartInVolume)
+        o[64 + k] = in ? S(b) : S(0);
+      }
+      continue;
+    }
+    if (integral && lo == hi) {
+      if (lane == 0) slot[i] = 0;
+      continue;
+    }
+    const int64_t bx = i % bdims.x, by = (i / bdims.x) % bdims.y, bz = i / (int64_t(bdims.x) * bdims.y);
+    bool differs = false;
+    for (int k = int(lane); k < 64; k += 32) {
+      float a, b;
+      if (subPartRange(data, dims, cellDims, brick, bx, by, bz, k, a, b) && !(a == lo && b == hi)) differs = true;
+    }
+    const bool any = __any_sync(0xffffffffu, differs);
+    if (lane == 0) slot[i] = any ? 1u : 0u;
+  }
+}
+
+// Launch shape: as subMaskKernel's grid; a half-warp per occupied brick of `list` (two bricks a
+// warp in turn), four of its 64 parts a lane (parts sub, sub + 16, sub + 32, sub + 48): twice
+// the loads in flight of a warp per brick, the kernel being bound by the chain list -> slot ->
+// bounds -> table. The mask from the stored bounds (or the brick's range for a uniform brick):
+// the bits subPartSet gives from the voxels.
+template <class S>
+__global__ void rangeMaskKernel(const S* ranges, const uint32_t* slot, const float* vmin, const float* vmax,
+                                vec3i cellDims, vec3i bdims, int brick, OpacityRangeMaxView rmq, int maxSet,
+                                const uint32_t* list, const unsigned* listCount, uint64_t* masks, uint8_t* state,
+                                unsigned long long* setParts) {
+  const unsigned lane = threadIdx.x & 31, half = lane >> 4, sub = lane & 15;
+  const unsigned warp = (blockIdx.x * blockDim.x + threadIdx.x) >> 5, warps = (gridDim.x * blockDim.x) >> 5;
+  const unsigned count = *listCount;
+  unsigned long long set = 0;
+  for (unsigned base = 2 * warp; base < count; base += 2 * warps) {
+    const unsigned w = base + half;
+    const bool valid = w < count;
+    int64_t i = 0, bx = 0, by = 0, bz = 0;
+    bool bit[4] = {false, false, false, false};
+    if (valid) {
+      i = list[w];
+      bx = i % bdims.x, by = (i / bdims.x) % bdims.y, bz = i / (int64_t(bdims.x) * bdims.y);
+      const uint32_t s = slot[i];
+      float lo[4], hi[4];
+      if (s == kUniformBrick) {
+        const float a = vmin[i], b = vmax[i];
+        for (int j = 0; j < 4; ++j) lo[j] = a, hi[j] = b;
+      } else {
+        const S* r = ranges + int64_t(s) * 128;
+        for (int j = 0; j < 4; ++j) {
+          lo[j] = float(r[int(sub) + 16 * j]);
+          hi[j] = float(r[64 + int(sub) + 16 * j]);
+        }
+      }
+      for (int j = 0; j < 4; ++j)
+        bit[j] = subPartInVolume(cellDims, brick, bx, by, bz, int(sub) + 16 * j) && rmq.query(lo[j], hi[j]) > 0.f;
+    }
+    uint64_t m = 0;
+    for (int j = 0; j < 4; ++j)
+      m |= uint64_t((__ballot_sync(0xffffffffu, bit[j]) >> (16 * half)) & 0xffffu) << (16 * j);
+    if (valid && sub == 0) {
+      masks[i] = m;
+      state[i] = subBrickState(true, m, maxSet);
+      set += unsigned(popcount64(m));
+    }
+  }
+  if (set) atomicAdd(setParts + warp % kPartCounters, set);
+}
+
 // Launch shape: one thread per brick, 256 per block. markedDistance; without states (no masks)
 // the marks are cleared.
 __global__ void markKernel(uint8_t* dist, const uint8_t* state, int64_t n) {
@@ -144,11 +260,88 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
   d_occ[1].reserve(nb);
   SS_CUDA_CHECK(brickRanges(v.d_voxels<unsigned char>(), vol.type, vol.components, vol.dims, bdims, brick, d_vmin.get(), d_vmax.get(),
                             stream));
+  computePartRanges(stream);
+}
+
+void BrickClassification::computePartRanges(cudaStream_t stream) {
+  d_partSlot_.release();
+  d_partRanges_.release();
+  partRangeBytes_ = 0;
+  if (!d_voxels_ || components_ != 1 || !usesSubMasks(brick)) return;
+  // SPACESKIP_PART_RANGES=0 (read at setVolume, a measurement switch): no bounds stored, the
+  // masks from the voxels on the frame after an edit's.
+  if (const char* e = std::getenv("SPACESKIP_PART_RANGES"))
+    if (e[0] == '0') return;
+  const int64_t nb = numBricks();
+  if (nb <= 0 || nb >= int64_t(kUniformBrick)) return;
+  if (numSMs_ == 0) {
+    int dev = 0;
+    if (cudaGetDevice(&dev) != cudaSuccess ||
+        cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
+      (void)cudaGetLastError();
+      numSMs_ = 1;
+    }
+  }
+  const size_t volumeBytes = size_t(dims_.x) * size_t(dims_.y) * size_t(dims_.z) * voxelSize(type_);
+  try {
+    DeviceBuffer<uint32_t> flags{size_t(nb)};
+    d_partSlot_.reserve(size_t(nb));
+    dispatchVoxelType(type_, [&](auto t) {
+      using T = decltype(t);
+      using S = typename PartRangeStore<T>::type;
+      const T* data = static_cast<const T*>(d_voxels_);
+      partRangeKernel<T><<<numSMs_ * kRangeBlocksPerSM, kThreads, 0, stream>>>(
+          data, dims_, cellDims, bdims, brick, d_vmin.get(), d_vmax.get(), nullptr, flags.get(), nullptr);
+      SS_CUDA_CHECK_LAUNCH(partRangeKernel);
+      size_t tempBytes = 0;
+      SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, tempBytes, flags.get(), d_partSlot_.get(), nb, stream));
+      DeviceBuffer<unsigned char> temp{std::max<size_t>(tempBytes, 1)};
+      SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), tempBytes, flags.get(), d_partSlot_.get(), nb, stream));
+      uint32_t last[2] = {0, 0};
+      SS_CUDA_CHECK(cudaMemcpyAsync(&last[0], d_partSlot_.get() + nb - 1, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
+      SS_CUDA_CHECK(cudaMemcpyAsync(&last[1], flags.get() + nb - 1, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
+      SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+      const size_t slots = size_t(last[0]) + size_t(last[1]);
+      const size_t bytes = slots * 128 * sizeof(S);
+      if (bytes + size_t(nb) * sizeof(uint32_t) > volumeBytes / 4) {
+        d_partSlot_.release();
+        return;
+      }
+      d_partRanges_.reserve(std::max<size_t>(bytes, 1));
+      partRangeKernel<T><<<numSMs_ * kRangeBlocksPerSM, kThreads, 0, stream>>>(
+          data, dims_, cellDims, bdims, brick, d_vmin.get(), d_vmax.get(), flags.get(), d_partSlot_.get(),
+          reinterpret_cast<S*>(d_partRanges_.get()));
+      SS_CUDA_CHECK_LAUNCH(partRangeKernel);
+      SS_CUDA_CHECK(cudaStreamSynchronize(stream));  // `flags` and `temp` are freed on return
+      partRangeBytes_ = bytes + size_t(nb) * sizeof(uint32_t);
+    });
+  } catch (const BackendError&) {
+    // No room on the device: the masks come from the voxels on the frame after an edit.
+    (void)cudaGetLastError();
+    d_partSlot_.release();
+    d_partRanges_.release();
+    partRangeBytes_ = 0;
+  }
+}
+
+void BrickClassification::masksFromRanges(cudaStream_t stream) {
+  const int maxSet = subMaskMaxSet();
+  dispatchVoxelType(type_, [&](auto t) {
+    using S = typename PartRangeStore<decltype(t)>::type;
+    rangeMaskKernel<S><<<numSMs_ * kMaskBlocksPerSM, kThreads, 0, stream>>>(
+        reinterpret_cast<const S*>(d_partRanges_.get()), d_partSlot_.get(), d_vmin.get(), d_vmax.get(), cellDims, bdims,
+        brick, rmq_, maxSet, d_list_.get(), &d_flags_.get()->listCount, d_sub_.get(), d_state_.get(),
+        d_flags_.get()->setParts);
+  });
+  SS_CUDA_CHECK_LAUNCH(rangeMaskKernel);
 }
 
 void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaStream_t stream) {
   haveOcc = false;
   d_voxels_ = nullptr;  // sparse residency: no voxels on the device, no sub-brick masks
+  d_partSlot_.release();
+  d_partRanges_.release();
+  partRangeBytes_ = 0;
   brick = r.brick;
   cellDims = vol.cellDims();
   bdims = r.dims;
@@ -164,9 +357,11 @@ void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaS
 bool BrickClassification::classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream) {
   // The sparse table over the TF's (uncorrected) opacity, built as on the CPU, queried on the device.
   const OpacityRangeMax table(tf);
+  const size_t levelBytes = table.levels().size() * sizeof(float);
   d_levels_.reserve(table.levels().size());
-  SS_CUDA_CHECK(cudaMemcpyAsync(d_levels_.get(), table.levels().data(), table.levels().size() * sizeof(float),
-                                cudaMemcpyHostToDevice, stream));
+  h_levels_.reserve(levelBytes);
+  std::memcpy(h_levels_.get(), table.levels().data(), levelBytes);
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_levels_.get(), h_levels_.get(), levelBytes, cudaMemcpyHostToDevice, stream));
   OpacityRangeMaxView rmq = table.view();
   rmq.levels = d_levels_.get();
 
@@ -183,18 +378,28 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   }
   SS_CUDA_CHECK(classifyBricks(d_vmin.get(), d_vmax.get(), bdims, brick, cellDims, rmq, cc, prev, next, d_flags_.get(),
                                stream, haveSub_ ? d_state_.get() : nullptr, haveSub_ ? d_list_.get() : nullptr));
+  rmq_ = rmq;
+  const bool fromRanges = haveSub_ && d_partSlot_.get() != nullptr;
+  if (fromRanges) masksFromRanges(stream);
   auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
   SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
+  const auto waitStart = std::chrono::steady_clock::now();
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
   cur = 1 - cur;
   const bool changed = !haveOcc || flags->changed != 0;
   grew = !haveOcc || flags->grew != 0;
   if (changed) ++generation;
   haveOcc = true;
   occupied = int64_t(flags->occupied);
-  // The masks follow on a later frame (refreshMasks): the edit's own frame marches whole bricks.
-  masksReady_ = false;
-  rmq_ = rmq;
+  if (fromRanges) {
+    unsigned long long set = 0;
+    for (int c = 0; c < kPartCounters; ++c) set += flags->setParts[c];
+    setFraction = occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
+  }
+  // Without part ranges the masks follow on a later frame (refreshMasks): the edit's own frame
+  // marches whole bricks.
+  masksReady_ = fromRanges;
   hostOccValid_ = false;
   return changed;
 }
@@ -235,6 +440,22 @@ void BrickClassification::markDistances(uint8_t* d_dist, cudaStream_t stream) co
   SS_CUDA_CHECK_LAUNCH(markKernel);
 }
 
+SubMasks BrickClassification::downloadMasks(cudaStream_t stream) {
+  SubMasks out;
+  if (!haveSub_) return out;
+  if (masksPending()) refreshMasks(stream);
+  const size_t n = size_t(numBricks());
+  out.mask.resize(n);
+  out.state.resize(n);
+  SS_CUDA_CHECK(cudaMemcpyAsync(out.mask.data(), d_sub_.get(), n * sizeof(uint64_t), cudaMemcpyDeviceToHost, stream));
+  SS_CUDA_CHECK(cudaMemcpyAsync(out.state.data(), d_state_.get(), n, cudaMemcpyDeviceToHost, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  for (size_t i = 0; i < n; ++i)
+    if (out.state[i] == kBrickEmpty) out.mask[i] = 0;
+  out.share = setFraction;
+  return out;
+}
+
 const OccupancyGrid& BrickClassification::occupancy(cudaStream_t stream) {
   if (!hostOccValid_) {
     hostOcc_ = OccupancyGrid{};
@@ -254,3 +475,19 @@ const OccupancyGrid& BrickClassification::occupancy(cudaStream_t stream) {
 }
 
 }  // namespace spaceskip::cuda
+
+namespace spaceskip {
+SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int brick, bool fromRanges,
+                             size_t* rangeBytes) {
+  std::string why;
+  if (!cudaAvailable(&why)) throw BackendError(why);
+  cuda::DeviceVolume dv;
+  cuda::BrickClassification cls;
+  dv.upload(v, nullptr);
+  cls.setVolume(dv, brick, nullptr);
+  if (!fromRanges) cls.dropPartRanges();
+  if (rangeBytes) *rangeBytes = cls.partRangeBytes();
+  cls.classify(tf, CropClip{}, nullptr);
+  return cls.downloadMasks(nullptr);
+}
+}  // namespace spaceskip

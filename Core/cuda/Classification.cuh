@@ -66,6 +66,24 @@ class BrickClassification {
   /// Computes the masks and states of the last classification (one warp per occupied brick)
   /// and their set share; waits for them.
   void refreshMasks(cudaStream_t stream);
+  /// Part ranges (sub-brick masks on the classification's path): after setVolume, the value
+  /// range of every part of every brick whose parts' ranges differ from the brick's own, stored
+  /// once (a warp per brick over the voxels, then a scan for the slots). With them classify()
+  /// computes the masks from 128 stored bounds a brick instead of the brick's voxels (at
+  /// N-body 2048^3 the voxel kernel took 0.59 ms, so it ran on the frame after the edit's and
+  /// the edit's frame marched whole bricks). Left out (masks on the next frame, from the
+  /// voxels, as before) when they would take more than a quarter of the volume's bytes or the
+  /// device has no room for them. Bytes held: partRangeBytes().
+  size_t partRangeBytes() const { return partRangeBytes_; }
+  /// Drops the part ranges (the masks then come from the voxels, refreshMasks): for tests.
+  void dropPartRanges() {
+    d_partSlot_.release();
+    d_partRanges_.release();
+    partRangeBytes_ = 0;
+  }
+  /// The masks and states of the last classification on the host (masks of bricks that are
+  /// not occupied: 0), computing them first when pending. For tests.
+  SubMasks downloadMasks(cudaStream_t stream);
   /// Marks DistanceGrid's field `d_dist` (one byte per brick) with markedDistance for the
   /// current states, or clears the marks when there are none (on `stream`, no synchronization).
   void markDistances(uint8_t* d_dist, cudaStream_t stream) const;
@@ -77,9 +95,23 @@ class BrickClassification {
   /// Set parts over all parts of the occupied bricks (after refreshMasks): the share of an
   /// occupied brick's volume a part-walking frame still marches.
   double setFraction = 1.0;
+  /// Of the last classify()'s host time, the seconds it waited for the device (its kernel, the
+  /// flags' copy and whatever was queued before them on the stream).
+  double waitSeconds = 0;
 
  private:
   DeviceBuffer<float> d_levels_;  ///< OpacityRangeMax's levels
+  /// Part ranges: per brick its slot in d_partRanges_ (kUniformBrick: every part's range is the
+  /// brick's), and per slot 64 lower then 64 upper bounds (PartRangeStore of the voxel type).
+  DeviceBuffer<uint32_t> d_partSlot_;
+  DeviceBuffer<unsigned char> d_partRanges_;
+  size_t partRangeBytes_ = 0;
+  void computePartRanges(cudaStream_t stream);
+  void masksFromRanges(cudaStream_t stream);
+  /// The levels on their way to d_levels_: a pageable copy would wait for the whole stream and
+  /// go through the driver's staging; classify() synchronizes before it returns, so the next
+  /// classification may write it again.
+  PinnedBuffer h_levels_;
   DeviceBuffer<uint64_t> d_sub_;
   DeviceBuffer<uint8_t> d_state_;
   DeviceBuffer<uint32_t> d_list_;  ///< the occupied bricks' indices (mask kernel's work list)

@@ -68,6 +68,7 @@ class CudaBackend final : public Backend {
   // Sparse residency loads the bricks the current occupancy needs: a structure that visits
   // more would sample bricks that are not resident.
   bool lastClassifyOnlyEmptied() const override { return !cls_.grew && !pool_.active(); }
+  double lastClassifyWaitSeconds() const override { return cls_.waitSeconds; }
 
   void setMemoryBudget(int64_t bytes, int poolBrick) override {
     budget_ = bytes > 0 ? bytes : 0;
@@ -136,8 +137,10 @@ class CudaBackend final : public Backend {
   static constexpr double kPartsShare = 0.2;
 
   void render(FrameView f, FilterMode filter, const float* depth, Image& out) override {
-    // Sub-brick masks after an opacity edit: its own frame marches whole bricks (no mask kernel
-    // on the edit's path: 0.59 ms at N-body 2048^3); the frame after computes them.
+    // Sub-brick masks after an opacity edit: with part ranges (BrickClassification) the
+    // classification computed them; without, the edit's own frame marches whole bricks (no
+    // voxel mask kernel on the edit's path: 0.59 ms at N-body 2048^3) and the frame after
+    // computes them.
     if (classifiedSinceRender_) {
       classifiedSinceRender_ = false;
     } else if (cls_.masksPending()) {

@@ -27,6 +27,8 @@ class Backend {
   /// occupied now was occupied before): a structure built before it still covers every
   /// occupied brick, so drawing with it stays lossless (it only visits bricks that are empty now).
   virtual bool lastClassifyOnlyEmptied() const { return false; }
+  /// Of the last classify(), the seconds the host waited for the device (0 on the CPU).
+  virtual double lastClassifyWaitSeconds() const { return 0; }
   /// The opacity-corrected table the integrator samples.
   virtual void setTransferTable(const std::vector<vec4f>& corrected, float lo, float scale) = 0;
   /// Builds the hierarchy `p.builder` asks for; throws BackendError when this backend cannot.

@@ -127,16 +127,27 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, cons
 /// voxels (`cellDims` cells): can a sample inside it have opacity > 0? `voxel(x, y, z)` gives
 /// a voxel's value as float (global indices). NaN voxels are skipped, as in brickRange. A part
 /// with no cell inside the volume: false.
-template <class Voxel, class RangeMax>
-SS_FUNC bool subPartSetWith(const Voxel& voxel, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz,
-                            int k, const RangeMax& rmq) {
+/// Whether part k of brick (bx, by, bz) has a cell of the volume (else its bit is never set).
+SS_FUNC bool subPartInVolume(vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz, int k) {
+  const int s = brick / kSubPerAxis;
+  return bx * brick + (k & 3) * s < cellDims.x && by * brick + ((k >> 2) & 3) * s < cellDims.y &&
+         bz * brick + (k >> 4) * s < cellDims.z;
+}
+
+/// The value range [lo, hi] of part k's voxels (its cells with the +1 halo, clamped), NaN
+/// skipped ((+inf, -inf) when all are NaN); false for a part with no cell of the volume.
+/// `voxel(x, y, z)` gives a voxel's value as float (global indices).
+template <class Voxel>
+SS_FUNC bool subPartRangeWith(const Voxel& voxel, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by,
+                              int64_t bz, int k, float& lo, float& hi) {
+  lo = INFINITY;
+  hi = -INFINITY;
+  if (!subPartInVolume(cellDims, brick, bx, by, bz, k)) return false;
   const int s = brick / kSubPerAxis;
   const int64_t c0[3] = {bx * brick + (k & 3) * s, by * brick + ((k >> 2) & 3) * s, bz * brick + (k >> 4) * s};
-  if (c0[0] >= cellDims.x || c0[1] >= cellDims.y || c0[2] >= cellDims.z) return false;  // no cell of the volume
   const int64_t n[3] = {dims.x, dims.y, dims.z};
   int64_t v1[3];
   for (int a = 0; a < 3; ++a) v1[a] = c0[a] + s < n[a] - 1 ? c0[a] + s : n[a] - 1;
-  float lo = INFINITY, hi = -INFINITY;
   for (int64_t z = c0[2]; z <= v1[2]; ++z)
     for (int64_t y = c0[1]; y <= v1[1]; ++y)
       for (int64_t x = c0[0]; x <= v1[0]; ++x) {
@@ -145,7 +156,22 @@ SS_FUNC bool subPartSetWith(const Voxel& voxel, vec3l dims, vec3i cellDims, int 
         lo = v < lo ? v : lo;
         hi = v > hi ? v : hi;
       }
-  return rmq.query(lo, hi) > 0.f;
+  return true;
+}
+
+template <class Voxel, class RangeMax>
+SS_FUNC bool subPartSetWith(const Voxel& voxel, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz,
+                            int k, const RangeMax& rmq) {
+  float lo, hi;
+  return subPartRangeWith(voxel, dims, cellDims, brick, bx, by, bz, k, lo, hi) && rmq.query(lo, hi) > 0.f;
+}
+
+/// subPartRangeWith on the voxels of a volume in memory.
+template <class T>
+SS_FUNC bool subPartRange(const T* data, vec3l dims, vec3i cellDims, int brick, int64_t bx, int64_t by, int64_t bz, int k,
+                          float& lo, float& hi) {
+  auto voxel = [&](int64_t x, int64_t y, int64_t z) { return float(data[x + dims.x * (y + dims.y * z)]); };
+  return subPartRangeWith(voxel, dims, cellDims, brick, bx, by, bz, k, lo, hi);
 }
 
 /// subPartSetWith on the voxels of a volume in memory.
@@ -201,6 +227,11 @@ struct SubMasks {
   double share = 1.0;  ///< set parts over all parts of the occupied bricks
 };
 SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf);
+/// The CUDA backend's masks for `v` classified against `tf` at `brick` (tests): from the part
+/// ranges stored at setVolume (`fromRanges`, when it stores them: *rangeBytes says what they
+/// take, 0 when none) or from the voxels. Throws BackendError without a device.
+SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int brick, bool fromRanges,
+                             size_t* rangeBytes = nullptr);
 /// Whether the backends compute sub-brick masks: yes unless SPACESKIP_SUB_MASKS=0 (read at each
 /// classification; a measurement switch: without masks an occupied brick is marched whole).
 bool subMasksEnabled();

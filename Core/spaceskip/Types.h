@@ -162,6 +162,7 @@ struct BuildStats {
   std::string builtOn;       ///< "cpu" or "cuda"
   double seconds = 0;        ///< hierarchy construction
   double classifySeconds = 0;
+  double classifyWaitSeconds = 0;  ///< of classifySeconds, the host's wait for the device (CUDA)
   int64_t nodes = 0;
   int height = 0;
   int64_t leaves = 0;

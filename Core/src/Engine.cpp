@@ -556,6 +556,7 @@ struct Engine::Impl {
       auto t0 = Clock::now();
       bool changed = backend->classify(scaledTF(), cropClip);
       stats.classifySeconds = since(t0);
+      stats.classifyWaitSeconds = backend->lastClassifyWaitSeconds();
       ++counters.classifications;
       if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
       opacityDirty = cropClipDirty = false;
@@ -631,6 +632,7 @@ struct Engine::Impl {
       }
       s.builder = p.builder;
       s.classifySeconds = stats.classifySeconds;
+      s.classifyWaitSeconds = stats.classifyWaitSeconds;
       s.occupancy = backend->occupiedFraction();
       if (isAuto) {
         autoState.built = use;
@@ -965,7 +967,8 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     for (unsigned c : counts) d.frame.samples += c;
   }
   d.frame.backend = d.backend->name();
-  // Every frame: the CUDA backend computes the masks on the frame after a classification's.
+  // Every frame: without part ranges the CUDA backend computes the masks on the frame after a
+  // classification's.
   d.stats.partsShare = d.backend->subMaskShare();
   d.frame.residency = d.backend->residency();
   if (d.frame.residency.sparse && d.render.filter == FilterMode::Hardware)

@@ -290,8 +290,9 @@ TEST(CudaBackend, PartWalkEqualsWholeBricksAndTheCpu) {
       Image hw[2];
       for (int forced = 0; forced < 2; ++forced) {
         setenv("SPACESKIP_CUDA_PARTS_SHARE", forced ? "1" : "0", 1);
-        // The masks are computed on the frame after the classification's: frame 1 marches whole
-        // bricks, frame 2 walks the parts where forced.
+        // With part ranges (N-body, vessels) the classification computes the masks; without
+        // (dense noise at brick 8) the frame after the classification's does: frame 1 marches
+        // whole bricks, frame 2 walks the parts where forced.
         for (FilterMode filter : {FilterMode::Exact, FilterMode::Hardware}) {
           Engine e(BackendKind::CUDA);
           e.setLogger([](const std::string&) {});
@@ -330,6 +331,60 @@ TEST(CudaBackend, PartWalkEqualsWholeBricksAndTheCpu) {
       EXPECT_LE(samples[1], samples[0]) << c.shape << " " << builderName(k) << ": parts " << samples[1] << ", whole "
                                         << samples[0];
     }
+  }
+}
+
+TEST(CudaBackend, MasksFromPartRangesEqualTheCpu) {
+  // Sub-brick masks on the classification's path, from the part bounds stored at setVolume, and
+  // from the voxels (the frame after an edit's, without bounds), equal the oneTBB masks bit for
+  // bit: every voxel type, bricks 8, 12 and 16 (parts of 2, 3 and 4 cells), dims that leave
+  // partial bricks and parts outside the volume, all-NaN parts, three TFs. Dense noise at brick 8
+  // stores no bounds (more than a quarter of the volume's bytes) and takes the voxel path.
+  REQUIRE_CUDA();
+  const Volume nbody = generateVolume("nbody", vec3l{83, 70, 61}, 7);
+  Volume noise = convert(generateVolume("noise", vec3l{40, 33, 29}, 3), VoxelType::Float32);
+  std::vector<Volume> vs;
+  for (VoxelType t : {VoxelType::UInt8, VoxelType::Int8, VoxelType::UInt16, VoxelType::Int16, VoxelType::Float32,
+                      VoxelType::Float64})
+    vs.push_back(t == nbody.type ? nbody : convert(nbody, t));
+  {
+    // Two cubes of NaN: parts whose every voxel is NaN (range (+inf, -inf): never set).
+    float* f = reinterpret_cast<float*>(vs[4].mutableData());
+    for (int z = 10; z <= 14; ++z)
+      for (int y = 10; y <= 14; ++y)
+        for (int x = 10; x <= 14; ++x) {
+          f[x + 83 * (y + 70 * z)] = std::nanf("");
+          f[(x + 40) + 83 * ((y + 30) + 70 * (z + 20))] = std::nanf("");
+        }
+  }
+  vs.push_back(noise);
+  for (size_t vi = 0; vi < vs.size(); ++vi) {
+    const Volume& v = vs[vi];
+    for (int brick : {8, 12, 16})
+      for (const char* preset : {"ramp", "band", "spike"}) {
+        SCOPED_TRACE(std::string(voxelTypeName(v.type)) + (vi == 6 ? " noise" : " nbody") + " brick " +
+                     std::to_string(brick) + " tf " + preset);
+        const TransferFunction tf = tfFor(v, preset);
+        const OccupancyGrid occ = classify(computeRangeGrid(v, brick), tf);
+        const SubMasks cpu = computeSubMasks(v, occ, tf);
+        ASSERT_FALSE(cpu.mask.empty());
+        size_t bytes = 0;
+        const SubMasks fromRanges = computeSubMasksCuda(v, tf, brick, true, &bytes);
+        const SubMasks fromVoxels = computeSubMasksCuda(v, tf, brick, false);
+        if (vi != 6) EXPECT_GT(bytes, 0u) << "test premise: the part bounds are stored";
+        else if (brick == 8) EXPECT_EQ(bytes, 0u) << "dense noise at brick 8: its bounds would be 1/4 of its bytes";
+        for (const SubMasks* g : {&fromRanges, &fromVoxels}) {
+          ASSERT_EQ(g->mask.size(), cpu.mask.size());
+          int64_t badMask = 0, badState = 0;
+          for (size_t i = 0; i < cpu.mask.size(); ++i) {
+            badMask += g->mask[i] != cpu.mask[i];
+            badState += g->state[i] != cpu.state[i];
+          }
+          EXPECT_EQ(badMask, 0) << (g == &fromRanges ? "from ranges" : "from voxels");
+          EXPECT_EQ(badState, 0) << (g == &fromRanges ? "from ranges" : "from voxels");
+          EXPECT_EQ(g->share, cpu.share);
+        }
+      }
   }
 }
 

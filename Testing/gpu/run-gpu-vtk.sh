@@ -16,7 +16,8 @@
 #          window blended), :float (float interop texture), alone and all together, twice in one
 #          process: FRAME_ITEMS) interop-memcheck (compute-sanitizer memcheck on the window
 #          benchmark with the image kept on the GPU, 8-bit and float: memcheck.log)
-#          nsys-frame (Nsight Systems timeline of the window benchmark, N-body 2048^3 Auto:hw and
+#          bench-ab (window benchmark processes alternating SPACESKIP_PART_RANGES: AB_RUNS,
+#          AB_ITEMS) nsys-frame (Nsight Systems timeline of the window benchmark, N-body 2048^3 Auto:hw and
 #          :sync:full:float, 8 frames and 2 edits each: CUDA API and GPU work per call, OpenGL
 #          calls, waits; summaries in nsys.log, the CUDA/GL traces as CSV in logs.tgz)
 #          bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
@@ -209,7 +210,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
 # vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -241,6 +242,13 @@ has bench-hw && ITEMS=${HW_ITEMS:-DistanceGrid,DistanceGrid:hw,Auto,Auto:hw} win
 # The frame around the kernel (issue 13): each change against the state before it, in one process.
 has bench-frame && ITEMS=${FRAME_ITEMS:-Auto:hw,Auto:hw:sync:full:float,Auto:hw:sync,Auto:hw:full,Auto:hw:float,Auto:hw,Auto:hw:sync:full:float} \
   window_bench nbody 2048 "${v2[@]}"
+# Part ranges off and on (SPACESKIP_PART_RANGES per process: the sub-brick masks on the edit's
+# path or on the frame after it), N-body 2048^3, alternated: AB_RUNS (e.g. "0 1 0 1"), AB_ITEMS.
+for r in ${AB_RUNS:-}; do
+  has bench-ab || break
+  echo "==== SPACESKIP_PART_RANGES=$r" >> "$work/bench.log"
+  (export SPACESKIP_PART_RANGES=$r; ITEMS=${AB_ITEMS:-Auto,DistanceGrid,Auto:hw} window_bench nbody 2048 "${v2[@]}")
+done
 # The interop path under compute-sanitizer (the mapper tests draw through host memory on Mesa).
 if has interop-memcheck && ! late; then
   log "interop memcheck"
