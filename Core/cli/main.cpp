@@ -1,5 +1,6 @@
 // spaceskip: command-line renderer, generator and benchmark over Core (no VTK).
 #include "Options.h"
+#include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
 #include "spaceskip/BrickPool.h"
 #include "spaceskip/Engine.h"
@@ -401,8 +402,8 @@ void measureEdits(Engine& engine, const TransferFunction& tf, const Camera& cam,
                   k.ms, k.classifyMs, k.waitMs, k.buildMs, k.builds, k.frameMs, k.kernelMs, k.nextMs, k.nextKernelMs);
     return std::string(b);
   };
-  std::printf("  edits: %s: occupying %s; emptying %s\n", row.label.c_str(), text(row.edits[1]).c_str(),
-              text(row.edits[0]).c_str());
+  std::printf("  edits: %s: occupying %s; emptying %s; device memory in use %.1f MiB\n", row.label.c_str(),
+              text(row.edits[1]).c_str(), text(row.edits[0]).c_str(), double(cudaDeviceBytesInUse()) / 1048576.0);
 }
 
 const char* leafName(LeafCriterion l) {

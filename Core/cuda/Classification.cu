@@ -106,6 +106,17 @@ __global__ void subMaskKernel(const T* data, vec3l dims, vec3i cellDims, vec3i b
 // brick's own range [vmin, vmax]: its mask needs no stored bounds. Integer bricks with
 // vmin == vmax are uniform without reading them (every voxel has that value).
 constexpr uint32_t kUniformBrick = 0xffffffffu;
+
+// The current device's multiprocessors (1 when it cannot be asked): the fixed grids' size.
+int multiprocessors() {
+  int dev = 0, n = 0;
+  if (cudaGetDevice(&dev) != cudaSuccess || cudaDeviceGetAttribute(&n, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess ||
+      n < 1) {
+    (void)cudaGetLastError();
+    return 1;
+  }
+  return n;
+}
 constexpr int kRangeBlocksPerSM = 8;
 template <class T>
 struct PartRangeStore {  // bounds stored exactly: the 8/16-bit types as themselves, else float
@@ -161,19 +172,20 @@ __global__ void partRangeKernel(const T* data, vec3l dims, vec3i cellDims, vec3i
   }
 }
 
-// Launch shape: as subMaskKernel's grid; a half-warp per occupied brick of `list` (two bricks a
-// warp in turn), four of its 64 parts a lane (parts sub, sub + 16, sub + 32, sub + 48): twice
-// the loads in flight of a warp per brick, the kernel being bound by the chain list -> slot ->
-// bounds -> table. The mask from the stored bounds (or the brick's range for a uniform brick):
+// Launch shape: as subMaskKernel's grid; nothing when more than `maxCount` bricks are listed;
+// else a half-warp per occupied brick of `list` (two bricks a warp in turn), four of its 64
+// parts a lane (parts sub, sub + 16, sub + 32, sub + 48): twice the loads in flight of a warp
+// per brick, the kernel being bound by the chain list -> slot -> bounds -> table. The mask from the stored bounds (or the brick's range for a uniform brick):
 // the bits subPartSet gives from the voxels.
 template <class S>
 __global__ void rangeMaskKernel(const S* ranges, const uint32_t* slot, const float* vmin, const float* vmax,
                                 vec3i cellDims, vec3i bdims, int brick, OpacityRangeMaxView rmq, int maxSet,
-                                const uint32_t* list, const unsigned* listCount, uint64_t* masks, uint8_t* state,
-                                unsigned long long* setParts) {
+                                const uint32_t* list, const unsigned* listCount, unsigned maxCount, uint64_t* masks,
+                                uint8_t* state, unsigned long long* setParts) {
   const unsigned lane = threadIdx.x & 31, half = lane >> 4, sub = lane & 15;
   const unsigned warp = (blockIdx.x * blockDim.x + threadIdx.x) >> 5, warps = (gridDim.x * blockDim.x) >> 5;
   const unsigned count = *listCount;
+  if (count > maxCount) return;  // too many occupied bricks for the edit's path: a later frame's
   unsigned long long set = 0;
   for (unsigned base = 2 * warp; base < count; base += 2 * warps) {
     const unsigned w = base + half;
@@ -246,6 +258,7 @@ cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims
 void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t stream) {
   const Volume& vol = v.volume();
   haveOcc = false;
+  setFraction = 1.0;
   brick = std::max(1, b);
   cellDims = vol.cellDims();
   d_voxels_ = v.d_voxels<unsigned char>();
@@ -274,14 +287,7 @@ void BrickClassification::computePartRanges(cudaStream_t stream) {
     if (e[0] == '0') return;
   const int64_t nb = numBricks();
   if (nb <= 0 || nb >= int64_t(kUniformBrick)) return;
-  if (numSMs_ == 0) {
-    int dev = 0;
-    if (cudaGetDevice(&dev) != cudaSuccess ||
-        cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
-      (void)cudaGetLastError();
-      numSMs_ = 1;
-    }
-  }
+  if (numSMs_ == 0) numSMs_ = multiprocessors();
   const size_t volumeBytes = size_t(dims_.x) * size_t(dims_.y) * size_t(dims_.z) * voxelSize(type_);
   try {
     DeviceBuffer<uint32_t> flags{size_t(nb)};
@@ -324,13 +330,13 @@ void BrickClassification::computePartRanges(cudaStream_t stream) {
   }
 }
 
-void BrickClassification::masksFromRanges(cudaStream_t stream) {
+void BrickClassification::masksFromRanges(cudaStream_t stream, unsigned maxCount) {
   const int maxSet = subMaskMaxSet();
   dispatchVoxelType(type_, [&](auto t) {
     using S = typename PartRangeStore<decltype(t)>::type;
     rangeMaskKernel<S><<<numSMs_ * kMaskBlocksPerSM, kThreads, 0, stream>>>(
         reinterpret_cast<const S*>(d_partRanges_.get()), d_partSlot_.get(), d_vmin.get(), d_vmax.get(), cellDims, bdims,
-        brick, rmq_, maxSet, d_list_.get(), &d_flags_.get()->listCount, d_sub_.get(), d_state_.get(),
+        brick, rmq_, maxSet, d_list_.get(), &d_flags_.get()->listCount, maxCount, d_sub_.get(), d_state_.get(),
         d_flags_.get()->setParts);
   });
   SS_CUDA_CHECK_LAUNCH(rangeMaskKernel);
@@ -338,6 +344,7 @@ void BrickClassification::masksFromRanges(cudaStream_t stream) {
 
 void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaStream_t stream) {
   haveOcc = false;
+  setFraction = 1.0;
   d_voxels_ = nullptr;  // sparse residency: no voxels on the device, no sub-brick masks
   d_partSlot_.release();
   d_partRanges_.release();
@@ -379,8 +386,12 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   SS_CUDA_CHECK(classifyBricks(d_vmin.get(), d_vmax.get(), bdims, brick, cellDims, rmq, cc, prev, next, d_flags_.get(),
                                stream, haveSub_ ? d_state_.get() : nullptr, haveSub_ ? d_list_.get() : nullptr));
   rmq_ = rmq;
-  const bool fromRanges = haveSub_ && d_partSlot_.get() != nullptr;
-  if (fromRanges) masksFromRanges(stream);
+  // The masks on the edit's path where the part walk can pay: at most 1/editMaskShare of the
+  // bricks occupied (the kernel learns the count on the device and does nothing above it).
+  const unsigned editMaxCount =
+      unsigned(std::min<int64_t>(nb / std::max<int64_t>(editMaskShare, 1), int64_t(kUniformBrick)));
+  const bool onPath = haveSub_ && d_partSlot_.get() != nullptr && setFraction <= editMaskMaxShare;
+  if (onPath) masksFromRanges(stream, editMaxCount);
   auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
   SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
   const auto waitStart = std::chrono::steady_clock::now();
@@ -392,37 +403,36 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   if (changed) ++generation;
   haveOcc = true;
   occupied = int64_t(flags->occupied);
-  if (fromRanges) {
+  const bool masked = onPath && flags->listCount <= editMaxCount;
+  if (masked) {
     unsigned long long set = 0;
     for (int c = 0; c < kPartCounters; ++c) set += flags->setParts[c];
     setFraction = occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
   }
-  // Without part ranges the masks follow on a later frame (refreshMasks): the edit's own frame
-  // marches whole bricks.
-  masksReady_ = fromRanges;
+  // Otherwise the masks follow on a later frame (refreshMasks): the edit's own frame marches
+  // whole bricks.
+  masksReady_ = masked;
   hostOccValid_ = false;
   return changed;
 }
 
 void BrickClassification::refreshMasks(cudaStream_t stream) {
   if (!masksPending()) return;
-  if (numSMs_ == 0) {
-    int dev = 0;
-    if (cudaGetDevice(&dev) != cudaSuccess ||
-        cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
-      (void)cudaGetLastError();
-      numSMs_ = 1;
-    }
-  }
+  if (numSMs_ == 0) numSMs_ = multiprocessors();
   const int maxSet = subMaskMaxSet();
-  // setParts is zeroed by classify()'s memset; the list and its count are classify()'s.
-  dispatchVoxelType(type_, [&](auto t) {
-    using T = decltype(t);
-    subMaskKernel<T><<<numSMs_ * kMaskBlocksPerSM, kThreads, 0, stream>>>(
-        static_cast<const T*>(d_voxels_), dims_, cellDims, bdims, brick, rmq_, maxSet, d_list_.get(),
-        &d_flags_.get()->listCount, d_sub_.get(), d_state_.get(), d_flags_.get()->setParts);
-  });
-  SS_CUDA_CHECK_LAUNCH(subMaskKernel);
+  // setParts is zeroed by classify()'s memset (a range mask kernel over its limit added nothing);
+  // the list and its count are classify()'s.
+  if (d_partSlot_.get()) {
+    masksFromRanges(stream, kUniformBrick);
+  } else {
+    dispatchVoxelType(type_, [&](auto t) {
+      using T = decltype(t);
+      subMaskKernel<T><<<numSMs_ * kMaskBlocksPerSM, kThreads, 0, stream>>>(
+          static_cast<const T*>(d_voxels_), dims_, cellDims, bdims, brick, rmq_, maxSet, d_list_.get(),
+          &d_flags_.get()->listCount, d_sub_.get(), d_state_.get(), d_flags_.get()->setParts);
+    });
+    SS_CUDA_CHECK_LAUNCH(subMaskKernel);
+  }
   auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
   SS_CUDA_CHECK(cudaMemcpyAsync(flags->setParts, d_flags_.get()->setParts, sizeof(flags->setParts),
                                 cudaMemcpyDeviceToHost, stream));
@@ -477,15 +487,16 @@ const OccupancyGrid& BrickClassification::occupancy(cudaStream_t stream) {
 }  // namespace spaceskip::cuda
 
 namespace spaceskip {
-SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int brick, bool fromRanges,
-                             size_t* rangeBytes) {
+SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int brick, int path, size_t* rangeBytes) {
   std::string why;
   if (!cudaAvailable(&why)) throw BackendError(why);
   cuda::DeviceVolume dv;
   cuda::BrickClassification cls;
   dv.upload(v, nullptr);
   cls.setVolume(dv, brick, nullptr);
-  if (!fromRanges) cls.dropPartRanges();
+  if (path == 0) cls.dropPartRanges();
+  cls.editMaskShare = path == 1 ? 1 : int64_t(1) << 40;  // every brick may be listed, or none
+  cls.editMaskMaxShare = path == 1 ? 2.0 : 0.0;
   if (rangeBytes) *rangeBytes = cls.partRangeBytes();
   cls.classify(tf, CropClip{}, nullptr);
   return cls.downloadMasks(nullptr);

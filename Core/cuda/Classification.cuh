@@ -68,13 +68,22 @@ class BrickClassification {
   void refreshMasks(cudaStream_t stream);
   /// Part ranges (sub-brick masks on the classification's path): after setVolume, the value
   /// range of every part of every brick whose parts' ranges differ from the brick's own, stored
-  /// once (a warp per brick over the voxels, then a scan for the slots). With them classify()
-  /// computes the masks from 128 stored bounds a brick instead of the brick's voxels (at
-  /// N-body 2048^3 the voxel kernel took 0.59 ms, so it ran on the frame after the edit's and
-  /// the edit's frame marched whole bricks). Left out (masks on the next frame, from the
+  /// once (a warp per brick over the voxels, then a scan for the slots). With them the masks
+  /// come from 128 stored bounds a brick instead of the brick's voxels (at N-body 2048^3 the
+  /// voxel kernel took 0.59 ms, so it ran on the frame after the edit's and the edit's frame
+  /// marched whole bricks), and classify() computes them itself where few bricks are occupied
+  /// (editMaskShare), else the next frame does. Left out (masks on the next frame, from the
   /// voxels, as before) when they would take more than a quarter of the volume's bytes or the
   /// device has no room for them. Bytes held: partRangeBytes().
   size_t partRangeBytes() const { return partRangeBytes_; }
+  /// classify() computes the masks from the part ranges when at most 1/editMaskShare of the
+  /// bricks are occupied (sparse data, where the part walk pays); denser occupancies leave them
+  /// to the next frame. On the H100 the range mask kernel took 3.4 ms at Richtmyer-Meshkov
+  /// 2048^2x1920 (about 8 M occupied bricks) and about 0.05 ms at N-body 2048^3 (183 k).
+  int64_t editMaskShare = 16;
+  /// ... and only when the last masks had at most this share of their parts set (the frames
+  /// walk parts then, CudaBackend's kPartsShare; else the edit's frame would not use them).
+  double editMaskMaxShare = 0.2;
   /// Drops the part ranges (the masks then come from the voxels, refreshMasks): for tests.
   void dropPartRanges() {
     d_partSlot_.release();
@@ -107,7 +116,7 @@ class BrickClassification {
   DeviceBuffer<unsigned char> d_partRanges_;
   size_t partRangeBytes_ = 0;
   void computePartRanges(cudaStream_t stream);
-  void masksFromRanges(cudaStream_t stream);
+  void masksFromRanges(cudaStream_t stream, unsigned maxCount);
   /// The levels on their way to d_levels_: a pageable copy would wait for the whole stream and
   /// go through the driver's staging; classify() synchronizes before it returns, so the next
   /// classification may write it again.

@@ -55,6 +55,7 @@ class CudaBackend final : public Backend {
 
   bool classify(const TransferFunction& tf, const CropClip& cc) override {
     tf_ = tf;
+    cls_.editMaskMaxShare = partsShareLimit();
     const bool changed = cls_.classify(tf, cc, stream_);
     classifiedSinceRender_ = true;
     // The field kept across an edit that changed no occupancy (or drawn stale after one that only
@@ -135,6 +136,11 @@ class CudaBackend final : public Backend {
   /// the paper's stand-ins 5-26% slower where the share was 0.28 and more, and N-body
   /// 1024^3 / 2048^3 (shares 0.11 / 0.06) 1.12x / 1.59x faster (docs/results/round9-h100).
   static constexpr double kPartsShare = 0.2;
+  // SPACESKIP_CUDA_PARTS_SHARE (read per frame): another threshold, a measurement and test switch.
+  static double partsShareLimit() {
+    const char* share = std::getenv("SPACESKIP_CUDA_PARTS_SHARE");
+    return share ? std::atof(share) : kPartsShare;
+  }
 
   void render(FrameView f, FilterMode filter, const float* depth, Image& out) override {
     // Sub-brick masks after an opacity edit: with part ranges (BrickClassification) the
@@ -151,9 +157,7 @@ class CudaBackend final : public Backend {
     if (distMarksStale_ && d_distField_) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
     distMarksStale_ = false;
     f.traversal = traversal_;
-    // SPACESKIP_CUDA_PARTS_SHARE (read per frame): another threshold, a measurement and test switch.
-    const char* share = std::getenv("SPACESKIP_CUDA_PARTS_SHARE");
-    const double maxShare = share ? std::atof(share) : kPartsShare;
+    const double maxShare = partsShareLimit();
     const bool parts = traversal_ == TraversalKind::Grid && cls_.subMasks() && cls_.setFraction <= maxShare;
     if (traversal_ == TraversalKind::Hybrid && hybridGridValid_)
       f.grid = GridView{d_hybrid_.get(), hybridDims_, hybridBrick_};

@@ -227,10 +227,11 @@ struct SubMasks {
   double share = 1.0;  ///< set parts over all parts of the occupied bricks
 };
 SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf);
-/// The CUDA backend's masks for `v` classified against `tf` at `brick` (tests): from the part
-/// ranges stored at setVolume (`fromRanges`, when it stores them: *rangeBytes says what they
-/// take, 0 when none) or from the voxels. Throws BackendError without a device.
-SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int brick, bool fromRanges,
+/// The CUDA backend's masks for `v` classified against `tf` at `brick` (tests): `path` 0 from the
+/// voxels (the next frame's kernel), 1 from the part ranges stored at setVolume in the
+/// classification, 2 from them on the next frame (*rangeBytes says what they take, 0 when none
+/// are stored: then the voxels). Throws BackendError without a device.
+SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int brick, int path,
                              size_t* rangeBytes = nullptr);
 /// Whether the backends compute sub-brick masks: yes unless SPACESKIP_SUB_MASKS=0 (read at each
 /// classification; a measurement switch: without masks an occupied brick is marched whole).

@@ -213,7 +213,7 @@ int64_t cudaDeviceBytesInUse() { return 0; }
 std::vector<uint8_t> computeDistanceFieldCuda(const OccupancyGrid&, int) {
   throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
 }
-SubMasks computeSubMasksCuda(const Volume&, const TransferFunction&, int, bool, size_t*) {
+SubMasks computeSubMasksCuda(const Volume&, const TransferFunction&, int, int, size_t*) {
   throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
 }
 

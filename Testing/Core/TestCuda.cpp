@@ -335,8 +335,9 @@ TEST(CudaBackend, PartWalkEqualsWholeBricksAndTheCpu) {
 }
 
 TEST(CudaBackend, MasksFromPartRangesEqualTheCpu) {
-  // Sub-brick masks on the classification's path, from the part bounds stored at setVolume, and
-  // from the voxels (the frame after an edit's, without bounds), equal the oneTBB masks bit for
+  // Sub-brick masks from the part bounds stored at setVolume (in the classification, and on the
+  // frame after it where too many bricks are occupied) and from the voxels (the frame after an
+  // edit's, without bounds) equal the oneTBB masks bit for
   // bit: every voxel type, bricks 8, 12 and 16 (parts of 2, 3 and 4 cells), dims that leave
   // partial bricks and parts outside the volume, all-NaN parts, three TFs. Dense noise at brick 8
   // stores no bounds (more than a quarter of the volume's bytes) and takes the voxel path.
@@ -369,20 +370,22 @@ TEST(CudaBackend, MasksFromPartRangesEqualTheCpu) {
         const SubMasks cpu = computeSubMasks(v, occ, tf);
         ASSERT_FALSE(cpu.mask.empty());
         size_t bytes = 0;
-        const SubMasks fromRanges = computeSubMasksCuda(v, tf, brick, true, &bytes);
-        const SubMasks fromVoxels = computeSubMasksCuda(v, tf, brick, false);
+        const SubMasks fromRanges = computeSubMasksCuda(v, tf, brick, 1, &bytes);
+        const SubMasks nextFrame = computeSubMasksCuda(v, tf, brick, 2);
+        const SubMasks fromVoxels = computeSubMasksCuda(v, tf, brick, 0);
         if (vi != 6) EXPECT_GT(bytes, 0u) << "test premise: the part bounds are stored";
         else if (brick == 8) EXPECT_EQ(bytes, 0u) << "dense noise at brick 8: its bounds would be 1/4 of its bytes";
-        for (const SubMasks* g : {&fromRanges, &fromVoxels}) {
+        for (const SubMasks* g : {&fromRanges, &nextFrame, &fromVoxels}) {
+          const char* which = g == &fromRanges ? "from ranges" : g == &nextFrame ? "from ranges, next frame" : "from voxels";
           ASSERT_EQ(g->mask.size(), cpu.mask.size());
           int64_t badMask = 0, badState = 0;
           for (size_t i = 0; i < cpu.mask.size(); ++i) {
             badMask += g->mask[i] != cpu.mask[i];
             badState += g->state[i] != cpu.state[i];
           }
-          EXPECT_EQ(badMask, 0) << (g == &fromRanges ? "from ranges" : "from voxels");
-          EXPECT_EQ(badState, 0) << (g == &fromRanges ? "from ranges" : "from voxels");
-          EXPECT_EQ(g->share, cpu.share);
+          EXPECT_EQ(badMask, 0) << which;
+          EXPECT_EQ(badState, 0) << which;
+          EXPECT_EQ(g->share, cpu.share) << which;
         }
       }
   }

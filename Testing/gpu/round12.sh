@@ -7,7 +7,7 @@
 # Results: docs/results/round12-h100/NOTES.md. The column tool is not on the device: raw CSV.
 #
 #   Testing/gpu/round12.sh OUTDIR [phases]
-#   phases (default all): tests memcheck edits ncu
+#   phases (default: tests memcheck edits ncu): tests memcheck edits all ncu
 #   env: DEADLINE (epoch s: no phase starts after), EDITS (16), ITEMS (distance-grid,distance-grid:hw,auto)
 # Built on the device from the carried tree (quick-build.sh, into build-gpu) when
 # build-bench/both.tar.xz is not carried.
@@ -45,6 +45,16 @@ if has edits && ! late; then
   bench ranges1b build-new/spaceskip
   [ -x build-old/spaceskip ] && bench old build-old/spaceskip
 fi
+# Every stand-in of the paper (its dims), DistanceGrid and Auto, 4 edits each, part ranges off
+# and on: the edits, the frames (unchanged path), and the device memory in use (the bounds).
+if has all && ! late; then
+  all=aneurism,xmas_tree,magnetic,stag_beetle,kingsnake,menger_sponge,richtmyer_meshkov,nbody_256,nbody_512,nbody_1024,nbody_2048
+  for r in 0 1; do
+    SPACESKIP_PART_RANGES=$r timeout 280 build-new/spaceskip bench --paper --datasets "$all" \
+      --builders distance-grid,auto --frames 8 --edits 4 --csv "$out/all-ranges$r.csv" > "$out/all-ranges$r.log" 2>&1
+    log "all ranges$r rc=$?"
+  done
+fi
 if has ncu && ! late; then
   ncu=$(command -v ncu || ls /usr/local/cuda/bin/ncu 2>/dev/null)
   timeout 150 "$ncu" -k regex:"classifyKernel|subMaskKernel|rangeMaskKernel|partRangeKernel|stagedLineKernel" --launch-count 12 \
@@ -54,8 +64,8 @@ if has ncu && ! late; then
   log "ncu rc=$?"
 fi
 {
-  grep -h "edits:" "$out"/nb-*.log
-  for f in "$out"/nb-*.csv; do
+  grep -h "edits:" "$out"/nb-*.log "$out"/all-*.log
+  for f in "$out"/nb-*.csv "$out"/all-*.csv; do
     [ -f "$f" ] && { echo "== $f"; cut -d, -f6,7,14,17,18,33- "$f"; }
   done
   grep -h "time_duration\|Kernel\|  [a-zA-Z]*Kernel" "$out"/ncu-*.txt 2>/dev/null
