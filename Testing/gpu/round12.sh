@@ -7,7 +7,7 @@
 # Results: docs/results/round12-h100/NOTES.md. The column tool is not on the device: raw CSV.
 #
 #   Testing/gpu/round12.sh OUTDIR [phases]
-#   phases (default: tests memcheck edits ncu): tests memcheck edits all ncu
+#   phases (default: tests memcheck edits ncu): tests memcheck edits all maxset ncurender ncu
 #   env: DEADLINE (epoch s: no phase starts after), EDITS (16), ITEMS (distance-grid,distance-grid:hw,auto)
 # Built on the device from the carried tree (quick-build.sh, into build-gpu) when
 # build-bench/both.tar.xz is not carried.
@@ -55,6 +55,29 @@ if has all && ! late; then
     log "all ranges$r rc=$?"
   done
 fi
+# The most set parts a brick may have to be walked part by part (SPACESKIP_SUB_MASK_MAX, default
+# 24 of 64), every stand-in, one process per setting, alternated: MAXSETS (e.g. "24 64 40 24 64 40").
+if has maxset && ! late; then
+  all=aneurism,xmas_tree,magnetic,stag_beetle,kingsnake,menger_sponge,richtmyer_meshkov,nbody_256,nbody_512,nbody_1024,nbody_2048
+  n=0
+  for m in ${MAXSETS:-24 64 40 24 64 40}; do
+    n=$((n + 1))
+    late && break
+    SPACESKIP_SUB_MASK_MAX=$m timeout 200 build-new/spaceskip bench --paper --datasets "$all" \
+      --builders distance-grid,distance-grid:hw,auto --frames 8 --csv "$out/maxset$m-$n.csv" > "$out/maxset$m-$n.log" 2>&1
+    log "maxset $m ($n) rc=$?"
+  done
+fi
+# Nsight Compute on one frame of the part walk at N-body 2048^3 (DistanceGrid, hardware filter):
+# where the kernel's time goes now (the window's remaining goal is its frame rate).
+if has ncurender && ! late; then
+  ncu=$(command -v ncu || ls /usr/local/cuda/bin/ncu 2>/dev/null)
+  timeout 200 "$ncu" -k regex:"render" --launch-skip 4 --launch-count 1 --section SpeedOfLight \
+    --section Occupancy --section LaunchStats --section WarpStateStats --section MemoryWorkloadAnalysis \
+    build-new/spaceskip bench gen:nbody:2048 --backend cuda --builders distance-grid:hw --frames 4 \
+    > "$out/ncu-render.txt" 2>&1
+  log "ncu render rc=$?"
+fi
 if has ncu && ! late; then
   ncu=$(command -v ncu || ls /usr/local/cuda/bin/ncu 2>/dev/null)
   timeout 150 "$ncu" -k regex:"classifyKernel|subMaskKernel|rangeMaskKernel|partRangeKernel|stagedLineKernel" --launch-count 12 \
@@ -65,7 +88,7 @@ if has ncu && ! late; then
 fi
 {
   grep -h "edits:" "$out"/nb-*.log "$out"/all-*.log
-  for f in "$out"/nb-*.csv "$out"/all-*.csv; do
+  for f in "$out"/nb-*.csv "$out"/all-*.csv "$out"/maxset*.csv; do
     [ -f "$f" ] && { echo "== $f"; cut -d, -f6,7,14,17,18,33- "$f"; }
   done
   grep -h "time_duration\|Kernel\|  [a-zA-Z]*Kernel" "$out"/ncu-*.txt 2>/dev/null
