@@ -236,8 +236,12 @@ SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int br
 /// Whether the backends compute sub-brick masks: yes unless SPACESKIP_SUB_MASKS=0 (read at each
 /// classification; a measurement switch: without masks an occupied brick is marched whole).
 bool subMasksEnabled();
-/// The most set parts a brick may have to be walked part by part (subBrickState): 24 of 64,
+/// The most set parts a brick may have to be walked part by part (subBrickState): 40 of 64
+/// (round 12: on the H100 1.02-1.06x kernel fps over 24 where frames walk parts, N-body 1024^3
+/// and 2048^3, the other stand-ins unchanged; the oneTBB frames of the 11 stand-ins at 1/8 scale
+/// 0.99-1.11x, geometric mean 1.05, in adjacent processes: docs/results/round12-h100),
 /// or SPACESKIP_SUB_MASK_MAX (0..64, read at each classification; a measurement switch).
+constexpr int kSubMaskMaxSetDefault = 40;
 int subMaskMaxSet();
 
 }  // namespace spaceskip

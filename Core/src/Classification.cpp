@@ -96,7 +96,7 @@ bool subMasksEnabled() {
 
 int subMaskMaxSet() {
   const char* e = std::getenv("SPACESKIP_SUB_MASK_MAX");
-  const int v = e ? std::atoi(e) : 24;
+  const int v = e ? std::atoi(e) : kSubMaskMaxSetDefault;
   return std::clamp(v, 0, 64);
 }
 
