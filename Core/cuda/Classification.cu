@@ -107,6 +107,13 @@ __global__ void subMaskKernel(const T* data, vec3l dims, vec3i cellDims, vec3i b
 // vmin == vmax are uniform without reading them (every voxel has that value).
 constexpr uint32_t kUniformBrick = 0xffffffffu;
 
+// The share of set parts over all parts of `occupied` bricks, from the mask kernels' counters.
+double setShare(const unsigned long long* setParts, int64_t occupied) {
+  unsigned long long set = 0;
+  for (int c = 0; c < kPartCounters; ++c) set += setParts[c];
+  return occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
+}
+
 // The current device's multiprocessors (1 when it cannot be asked): the fixed grids' size.
 int multiprocessors() {
   int dev = 0, n = 0;
@@ -139,7 +146,6 @@ __global__ void partRangeKernel(const T* data, vec3l dims, vec3i cellDims, vec3i
   const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
   constexpr bool integral = std::numeric_limits<T>::is_integer;
   for (int64_t i = warp; i < n; i += warps) {
-    const float lo = vmin[i], hi = vmax[i];
     if (out) {
       const uint32_t f = flag[i], s = slot[i];
       __syncwarp();
@@ -157,6 +163,7 @@ __global__ void partRangeKernel(const T* data, vec3l dims, vec3i cellDims, vec3i
       }
       continue;
     }
+    const float lo = vmin[i], hi = vmax[i];
     if (integral && lo == hi) {
       if (lane == 0) slot[i] = 0;
       continue;
@@ -175,8 +182,9 @@ __global__ void partRangeKernel(const T* data, vec3l dims, vec3i cellDims, vec3i
 // Launch shape: as subMaskKernel's grid; nothing when more than `maxCount` bricks are listed;
 // else a half-warp per occupied brick of `list` (two bricks a warp in turn), four of its 64
 // parts a lane (parts sub, sub + 16, sub + 32, sub + 48): twice the loads in flight of a warp
-// per brick, the kernel being bound by the chain list -> slot -> bounds -> table. The mask from the stored bounds (or the brick's range for a uniform brick):
-// the bits subPartSet gives from the voxels.
+// per brick, the kernel being bound by the chain list -> slot -> bounds -> table. The mask from
+// the stored bounds (or the brick's range for a uniform brick): the bits subPartSet gives from
+// the voxels.
 template <class S>
 __global__ void rangeMaskKernel(const S* ranges, const uint32_t* slot, const float* vmin, const float* vmax,
                                 vec3i cellDims, vec3i bdims, int brick, OpacityRangeMaxView rmq, int maxSet,
@@ -404,11 +412,7 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   haveOcc = true;
   occupied = int64_t(flags->occupied);
   const bool masked = onPath && flags->listCount <= editMaxCount;
-  if (masked) {
-    unsigned long long set = 0;
-    for (int c = 0; c < kPartCounters; ++c) set += flags->setParts[c];
-    setFraction = occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
-  }
+  if (masked) setFraction = setShare(flags->setParts, occupied);
   // Otherwise the masks follow on a later frame (refreshMasks): the edit's own frame marches
   // whole bricks.
   masksReady_ = masked;
@@ -437,9 +441,7 @@ void BrickClassification::refreshMasks(cudaStream_t stream) {
   SS_CUDA_CHECK(cudaMemcpyAsync(flags->setParts, d_flags_.get()->setParts, sizeof(flags->setParts),
                                 cudaMemcpyDeviceToHost, stream));
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-  unsigned long long set = 0;
-  for (int c = 0; c < kPartCounters; ++c) set += flags->setParts[c];
-  setFraction = occupied > 0 ? double(set) / (64.0 * double(occupied)) : 1.0;
+  setFraction = setShare(flags->setParts, occupied);
   masksReady_ = true;
 }
 
