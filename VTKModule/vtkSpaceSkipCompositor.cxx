@@ -43,6 +43,39 @@ bool EnvOn(const char* name)
   const char* v = std::getenv(name);
   return v && v[0] == '1';
 }
+
+// The framebuffer pixels a blend of `rect` (VisibleRect: pixels of the viewport) may write, as x,
+// y, w, h: the rectangle moved to the viewport's origin `vp` and cut to the scissor box in force.
+// False when that leaves none.
+bool DrawBox(vtkOpenGLState* ostate, const int rect[4], int vp[4], int box[4])
+{
+  if (rect[2] <= 0 || rect[3] <= 0)
+  {
+    return false;
+  }
+  ostate->vtkglGetIntegerv(GL_VIEWPORT, vp);
+  box[0] = rect[0] + vp[0];
+  box[1] = rect[1] + vp[1];
+  box[2] = rect[2];
+  box[3] = rect[3];
+  if (ostate->GetEnumState(GL_SCISSOR_TEST))
+  {
+    int cur[4];
+    ostate->vtkglGetIntegerv(GL_SCISSOR_BOX, cur);
+    const int x0 = std::max(box[0], cur[0]), y0 = std::max(box[1], cur[1]);
+    const int x1 = std::min(box[0] + box[2], cur[0] + cur[2]);
+    const int y1 = std::min(box[1] + box[3], cur[1] + cur[3]);
+    if (x1 <= x0 || y1 <= y0)
+    {
+      return false;
+    }
+    box[0] = x0;
+    box[1] = y0;
+    box[2] = x1 - x0;
+    box[3] = y1 - y0;
+  }
+  return true;
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -216,10 +249,18 @@ void vtkSpaceSkipCompositor::VisibleRect(const spaceskip::Camera& camera, vtkIma
 bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image,
   void* stream, int width, int height, const int rect[4], bool eightBit)
 {
+  if (this->BlendIntoFramebuffer(renWin, image, stream, width, height, rect, eightBit))
+  {
+    this->Direct = true;
+    this->CompositePath = "gpu";
+    this->BlendPath = "cuda";
+    return true;
+  }
   if (this->CopyToInteropTexture(renWin, image, stream, width, height, rect, eightBit))
   {
     this->Interop = true;
     this->CompositePath = "gpu";
+    this->BlendPath = "gl";
     return true;
   }
   // Not this GL (Mesa, another device) or a CUDA error: the host path from now on.
@@ -236,6 +277,11 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, cons
 bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip::Image& image,
   int width, int height, bool eightBit, const int rect[4])
 {
+  if (this->Direct)
+  {
+    this->Direct = false;
+    return true; // CopyDeviceImage blended this frame into the framebuffer
+  }
   vtkTextureObject* texture = this->Interop ? this->InteropTexture.GetPointer() : nullptr;
   this->Interop = false;
   this->UploadHostImage(renWin, texture ? nullptr : &image, width, height, eightBit);
@@ -243,6 +289,7 @@ bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip
   {
     texture = this->Texture;
     this->CompositePath = "host";
+    this->BlendPath = "gl";
   }
   const int whole[4] = { 0, 0, width, height };
   return this->Blend(renWin, texture, rect ? rect : whole);
@@ -323,35 +370,19 @@ bool vtkSpaceSkipCompositor::Blend(
   }
 
   vtkOpenGLState* ostate = renWin->GetState();
+  // Only the pixels the rays can colour (VisibleRect, in the viewport), within the scissor box
+  // in force (VTK's viewport).
+  int vp[4], box[4];
+  if (!DrawBox(ostate, rect, vp, box))
+  {
+    return true;
+  }
   vtkOpenGLState::ScopedglEnableDisable blendSaver(ostate, GL_BLEND);
   vtkOpenGLState::ScopedglEnableDisable depthSaver(ostate, GL_DEPTH_TEST);
   vtkOpenGLState::ScopedglBlendFuncSeparate blendFuncSaver(ostate);
   vtkOpenGLState::ScopedglDepthMask depthMaskSaver(ostate);
-  const bool scissorTest = ostate->GetEnumState(GL_SCISSOR_TEST);
   vtkOpenGLState::ScopedglEnableDisable scissorTestSaver(ostate, GL_SCISSOR_TEST);
   vtkOpenGLState::ScopedglScissor scissorSaver(ostate);
-  // Only the pixels the rays can colour (VisibleRect, in the viewport), within the scissor box
-  // in force (VTK's viewport).
-  int vp[4], box[4] = { rect[0], rect[1], rect[2], rect[3] };
-  ostate->vtkglGetIntegerv(GL_VIEWPORT, vp);
-  box[0] += vp[0];
-  box[1] += vp[1];
-  if (scissorTest)
-  {
-    int cur[4];
-    ostate->vtkglGetIntegerv(GL_SCISSOR_BOX, cur);
-    const int x0 = std::max(box[0], cur[0]), y0 = std::max(box[1], cur[1]);
-    const int x1 = std::min(box[0] + box[2], cur[0] + cur[2]);
-    const int y1 = std::min(box[1] + box[3], cur[1] + cur[3]);
-    if (x1 <= x0 || y1 <= y0)
-    {
-      return true;
-    }
-    box[0] = x0;
-    box[1] = y0;
-    box[2] = x1 - x0;
-    box[3] = y1 - y0;
-  }
   ostate->vtkglEnable(GL_SCISSOR_TEST);
   ostate->vtkglScissor(box[0], box[1], box[2], box[3]);
   ostate->vtkglEnable(GL_BLEND);
@@ -379,6 +410,169 @@ void vtkSpaceSkipCompositor::ReleaseInterop()
 #endif
   this->InteropResource = nullptr;
   this->InteropSize[0] = this->InteropSize[1] = 0;
+  this->ReleaseTarget();
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipCompositor::ReleaseTarget()
+{
+#ifdef SPACESKIP_HAVE_CUDA
+  if (this->TargetResource)
+  {
+    if (this->ImageCopy)
+    {
+      this->ImageCopy->releaseSurface(); // waits for the blends still queued
+    }
+    cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->TargetResource));
+    cudaGetLastError();
+  }
+#endif
+  this->TargetResource = nullptr;
+  this->TargetTexture = nullptr;
+  this->TargetHandle = 0;
+  this->TargetSize[0] = this->TargetSize[1] = 0;
+}
+
+//------------------------------------------------------------------------------
+// GPUComposite's first choice: the image blended by CUDA straight into the colour texture of the
+// framebuffer being drawn, when that is the window's render framebuffer with a single-sample
+// RGBA8 texture written through draw buffer 0 with every channel enabled (VTK's default). No
+// texture copy and no GL draw: a draw over the whole window costs the H100's few graphics
+// units more than the blend kernel costs its SMs. False (the texture path then draws this
+// frame) for any other target, with SPACESKIP_CUDA_BLEND=0 (a measurement switch), and from a
+// CUDA failure on (said once at INFO verbosity).
+bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
+  const void* image, void* stream, int w, int h, const int rect[4], bool eightBit)
+{
+#ifdef SPACESKIP_HAVE_CUDA
+  const char* off = std::getenv("SPACESKIP_CUDA_BLEND");
+  if (this->TargetFailed || (off && off[0] == '0'))
+  {
+    return false;
+  }
+  vtkOpenGLFramebufferObject* fbo = renWin->GetRenderFramebuffer();
+  GLint bound = 0;
+  glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+  if (!fbo || bound <= 0 || static_cast<unsigned>(bound) != fbo->GetFBOIndex())
+  {
+    return false;
+  }
+  vtkTextureObject* tex = fbo->GetColorAttachmentAsTextureObject(0);
+  if (!tex || tex->GetTarget() != GL_TEXTURE_2D || tex->GetHandle() == 0)
+  {
+    return false;
+  }
+  auto attachment = [](GLenum what) {
+    GLint v = 0;
+    glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, what, &v);
+    return v;
+  };
+  GLint buffer0 = 0, buffer1 = 0;
+  glGetIntegerv(GL_DRAW_BUFFER0, &buffer0);
+  glGetIntegerv(GL_DRAW_BUFFER1, &buffer1);
+  GLboolean mask[4] = { GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE };
+  glGetBooleanv(GL_COLOR_WRITEMASK, mask);
+  if (buffer0 != GL_COLOR_ATTACHMENT0 || buffer1 != GL_NONE || !(mask[0] && mask[1] && mask[2] && mask[3]) ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) != GL_TEXTURE ||
+    static_cast<unsigned>(attachment(GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME)) != tex->GetHandle() ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_TEXTURE_LEVEL) != 0 ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE) != GL_UNSIGNED_NORMALIZED ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING) != GL_LINEAR ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE) != 8 ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_GREEN_SIZE) != 8 ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_BLUE_SIZE) != 8 ||
+    attachment(GL_FRAMEBUFFER_ATTACHMENT_ALPHA_SIZE) != 8)
+  {
+    while (glGetError() != GL_NO_ERROR)
+    {
+    }
+    return false;
+  }
+  int vp[4], box[4];
+  if (!DrawBox(renWin->GetState(), rect, vp, box))
+  {
+    return true; // no pixel to blend
+  }
+  const int tw = static_cast<int>(tex->GetWidth()), th = static_cast<int>(tex->GetHeight());
+  // The image is the viewport's: image pixel (x, y) is framebuffer pixel (vp[0] + x, vp[1] + y).
+  if (vp[2] != w || vp[3] != h || box[0] < 0 || box[1] < 0 || box[0] + box[2] > tw || box[1] + box[3] > th)
+  {
+    return false;
+  }
+  auto failed = [this](const char* what, cudaError_t e) {
+    this->TargetProblem = std::string(what) + ": " + cudaGetErrorString(e);
+    cudaGetLastError();
+    this->TargetFailed = true;
+    this->ReleaseTarget();
+    vtkVLogF(vtkLogger::VERBOSITY_INFO,
+      "vtkSpaceSkippingVolumeMapper: the image cannot be blended by CUDA into the framebuffer "
+      "(%s); it goes through a texture drawn by GL",
+      this->TargetProblem.c_str());
+    return false;
+  };
+  // A texture VTK reallocated (the window resized) or replaced: registered anew.
+  if (this->TargetTexture != tex || this->TargetHandle != tex->GetHandle() || this->TargetSize[0] != tw ||
+    this->TargetSize[1] != th)
+  {
+    this->ReleaseTarget();
+    const char* vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
+    if (!vendor || !std::strstr(vendor, "NVIDIA"))
+    {
+      return false; // only NVIDIA's GL shares with CUDA (CopyToInteropTexture says so)
+    }
+    cudaGraphicsResource_t r = nullptr;
+    const cudaError_t e = cudaGraphicsGLRegisterImage(
+      &r, tex->GetHandle(), GL_TEXTURE_2D, cudaGraphicsRegisterFlagsSurfaceLoadStore);
+    if (e != cudaSuccess)
+    {
+      return failed("cudaGraphicsGLRegisterImage", e);
+    }
+    this->TargetResource = r;
+    this->TargetTexture = tex;
+    this->TargetHandle = tex->GetHandle();
+    this->TargetSize[0] = tw;
+    this->TargetSize[1] = th;
+  }
+  if (!this->ImageCopy)
+  {
+    this->ImageCopy.reset(new spaceskip::DeviceImageCopy);
+  }
+  // As CopyToInteropTexture: on the engine's stream after its frame; the map waits (on the GPU)
+  // for GL's drawing so far, GL's next drawing for the unmap.
+  const cudaStream_t s = EnvOn("SPACESKIP_SYNC_FRAME") ? nullptr : static_cast<cudaStream_t>(stream);
+  cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(this->TargetResource);
+  cudaError_t e = cudaGraphicsMapResources(1, &r, s);
+  if (e != cudaSuccess)
+  {
+    return failed("cudaGraphicsMapResources", e);
+  }
+  cudaArray_t array = nullptr;
+  e = cudaGraphicsSubResourceGetMappedArray(&array, r, 0, 0);
+  if (e == cudaSuccess)
+  {
+    e = static_cast<cudaError_t>(this->ImageCopy->blendOver(image, w, h, array, tw, th, box[0] - vp[0],
+      box[1] - vp[1], box[2], box[3], vp[0], vp[1], eightBit, s));
+  }
+  const cudaError_t u = cudaGraphicsUnmapResources(1, &r, s);
+  if (e != cudaSuccess)
+  {
+    return failed("blend into the framebuffer texture", e);
+  }
+  if (u != cudaSuccess)
+  {
+    return failed("cudaGraphicsUnmapResources", u);
+  }
+  return true;
+#else
+  (void)renWin;
+  (void)image;
+  (void)stream;
+  (void)w;
+  (void)h;
+  (void)rect;
+  (void)eightBit;
+  return false;
+#endif
 }
 
 //------------------------------------------------------------------------------

@@ -60,7 +60,10 @@ public:
     int height, int rect[4]);
 
   /**
-   * Copies `rect` (VisibleRect) of the engine's device image (float4 RGBA) into a GL texture
+   * Blends `rect` (VisibleRect) of the engine's device image (float4 RGBA) by CUDA straight into
+   * the colour texture of the window's render framebuffer when that is the target being drawn
+   * (single-sample RGBA8, draw buffer 0, all channels written), as GL's blend would (Draw() then
+   * has nothing left to do); otherwise copies it into a GL texture
    * registered with CUDA, the one Draw() then blends: float texels, or with `eightBit` RGBA8
    * rounded as the host path rounds (a quarter of the bytes for the blend to read). The map,
    * copy and unmap are queued on `stream` (the engine's, Engine::deviceImageStream()) after the
@@ -83,10 +86,14 @@ public:
 
   /// "gpu", "host" or "none": how the last image reached the window.
   const std::string& GetCompositePath() const { return this->CompositePath; }
+  /// "cuda" (blended into the framebuffer by CUDA), "gl" (drawn from a texture) or "none".
+  const std::string& GetBlendPath() const { return this->BlendPath; }
+  /// Why the image cannot be blended by CUDA (empty until it failed once).
+  const std::string& GetTargetProblem() const { return this->TargetProblem; }
   bool GetInteropFailed() const { return this->InteropFailed; }
   const std::string& GetInteropProblem() const { return this->InteropProblem; }
-  /// Whether this frame's image is the interop texture (CopyDeviceImage succeeded).
-  bool HasDeviceImage() const { return this->Interop; }
+  /// Whether this frame's image came through CUDA-GL interop (CopyDeviceImage succeeded).
+  bool HasDeviceImage() const { return this->Interop || this->Direct; }
 
   void ReleaseGraphicsResources(vtkWindow* win);
 
@@ -95,6 +102,9 @@ private:
     int height, bool eightBit);
   bool Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture, const int rect[4]);
   void ReleaseInterop();
+  void ReleaseTarget();
+  bool BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,
+    int h, const int rect[4], bool eightBit);
   bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,
     int h, const int rect[4], bool eightBit);
 
@@ -116,6 +126,16 @@ private:
   bool Interop = false;       // this frame's image is InteropTexture
   std::string InteropProblem;
   std::string CompositePath = "none";
+  std::string BlendPath = "none";
+
+  // GPUComposite blended by CUDA: the render framebuffer's colour texture registered with CUDA.
+  void* TargetResource = nullptr;            // cudaGraphicsResource_t
+  vtkTextureObject* TargetTexture = nullptr; // VTK's (not owned): registered anew when it changes
+  unsigned int TargetHandle = 0;
+  int TargetSize[2] = { 0, 0 };
+  bool TargetFailed = false; // once failed: the texture path from then on
+  bool Direct = false;       // this frame's image is already blended (Draw has nothing to do)
+  std::string TargetProblem;
 };
 
 #endif

@@ -434,7 +434,8 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::Composite(vtkOpenGLRenderWindow
 void vtkSpaceSkippingVolumeMapper::vtkInternals::ReportPaths()
 {
   const vtkSpaceSkipCompositor& c = this->Compositor;
-  if (!this->Report || this->Reported == this->BackendUsed + this->BuilderUsed + c.GetCompositePath())
+  if (!this->Report ||
+    this->Reported == this->BackendUsed + this->BuilderUsed + c.GetCompositePath() + c.GetBlendPath())
   {
     return;
   }
@@ -444,10 +445,11 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::ReportPaths()
             << ", GL_RENDERER " << (glRenderer ? reinterpret_cast<const char*>(glRenderer) : "?")
             << ", GL_VENDOR " << (glVendor ? reinterpret_cast<const char*>(glVendor) : "?")
             << ", image "
-            << (c.HasDeviceImage() ? "on the GPU (CUDA-GL interop)" : "through host memory")
+            << (c.HasDeviceImage() ? "on the GPU (CUDA-GL interop, blended by " + c.GetBlendPath() + ")"
+                                   : std::string("through host memory"))
             << (c.GetInteropFailed() ? " (interop: " + c.GetInteropProblem() + ")" : std::string())
             << std::endl;
-  this->Reported = this->BackendUsed + this->BuilderUsed + c.GetCompositePath();
+  this->Reported = this->BackendUsed + this->BuilderUsed + c.GetCompositePath() + c.GetBlendPath();
 }
 
 vtkStandardNewMacro(vtkSpaceSkippingVolumeMapper);
@@ -626,6 +628,14 @@ const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
     return this->Internals->Blocks.GetCompositePath(); // the blended blocks' way to the window
   }
   return this->Internals->Compositor.GetCompositePath().c_str();
+}
+const char* vtkSpaceSkippingVolumeMapper::GetCompositeBlendUsed()
+{
+  if (this->Internals->Blocks.IsActive())
+  {
+    return "gl"; // the blocks' images are drawn by GL
+  }
+  return this->Internals->Compositor.GetBlendPath().c_str();
 }
 void vtkSpaceSkippingVolumeMapper::GetLastCompositeRect(int rect[4])
 {
@@ -1087,6 +1097,7 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EightBitComposite: " << (this->EightBitComposite ? "On" : "Off") << "\n";
   os << indent << "GPUComposite: " << (this->GPUComposite ? "On" : "Off") << "\n";
   os << indent << "CompositePathUsed: " << this->Internals->Compositor.GetCompositePath() << "\n";
+  os << indent << "CompositeBlendUsed: " << this->Internals->Compositor.GetBlendPath() << "\n";
   os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
   os << indent << "DeviceMemoryBudget: " << this->DeviceMemoryBudget << " MiB\n";
   os << indent << "VectorMode: " << this->VectorMode << "\n";

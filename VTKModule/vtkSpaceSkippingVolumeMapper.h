@@ -227,11 +227,16 @@ public:
    * blended (rounded to 8 bits on the GPU with EightBitComposite, as the host path rounds). When interop is not possible (another GL
    * such as Mesa, another device, a CUDA error) the mapper says so once at INFO verbosity and
    * uses host memory from then on. GetCompositePathUsed(): "gpu", "host" or "none".
+   * When the window draws into its own single-sample RGBA8 framebuffer (VTK's default), the
+   * image is not copied at all: CUDA blends it into that framebuffer's colour texture as GL's
+   * blend would, and GL draws nothing for it. GetCompositeBlendUsed(): "cuda" (that path), "gl"
+   * (a texture drawn by GL) or "none".
    */
   vtkSetMacro(GPUComposite, vtkTypeBool);
   vtkGetMacro(GPUComposite, vtkTypeBool);
   vtkBooleanMacro(GPUComposite, vtkTypeBool);
   const char* GetCompositePathUsed();
+  const char* GetCompositeBlendUsed();
   /**
    * The rectangle of the renderer's viewport the last frame copied and blended (x, y, width,
    * height in pixels): where the volume's box projects (width or height 0 when it projects

@@ -8,18 +8,41 @@ namespace spaceskip {
 
 namespace {
 
-// Launch shape: 2-D grid of 32x8 blocks over the w x h rectangle, one thread per pixel. Rounds
-// as the mapper's host path does (vtkSpaceSkipCompositor::UploadHostImage: clamp, v * 255 + 0.5,
-// truncate); __fmul_rn/__fadd_rn keep the multiply and the add apart, as the host computes them.
+// Rounds as the mapper's host path does (vtkSpaceSkipCompositor::UploadHostImage: clamp,
+// v * 255 + 0.5, truncate); __fmul_rn/__fadd_rn keep the multiply and the add apart, as the host
+// computes them.
+__device__ unsigned char roundTo8(float v) {
+  v = fminf(fmaxf(v, 0.f), 1.f);
+  return static_cast<unsigned char>(static_cast<unsigned>(__fadd_rn(__fmul_rn(v, 255.f), 0.5f)));
+}
+
+// Launch shape (both kernels): 2-D grid of 32x8 blocks over the w x h rectangle, one thread per pixel.
 __global__ void roundToRgba8Kernel(const float4* image, int imageWidth, int x0, int y0, int w, int h, uchar4* out) {
   const int x = int(blockIdx.x * blockDim.x + threadIdx.x), y = int(blockIdx.y * blockDim.y + threadIdx.y);
   if (x >= w || y >= h) return;
   const float4 c = image[int64_t(y0 + y) * imageWidth + (x0 + x)];
-  auto q = [](float v) {
-    v = fminf(fmaxf(v, 0.f), 1.f);
-    return static_cast<unsigned char>(static_cast<unsigned>(__fadd_rn(__fmul_rn(v, 255.f), 0.5f)));
+  out[int64_t(y) * w + x] = make_uchar4(roundTo8(c.x), roundTo8(c.y), roundTo8(c.z), roundTo8(c.w));
+}
+
+// Premultiplied "over" into RGBA8 surface texels at (x0 + x + dx, y0 + y + dy): what GL's blend
+// (ONE, ONE_MINUS_SRC_ALPHA) writes into an 8-bit normalized colour buffer.
+__global__ void blendOverKernel(const float4* image, int imageWidth, int x0, int y0, int w, int h, int dx, int dy,
+                                bool eightBit, cudaSurfaceObject_t target) {
+  const int x = int(blockIdx.x * blockDim.x + threadIdx.x), y = int(blockIdx.y * blockDim.y + threadIdx.y);
+  if (x >= w || y >= h) return;
+  const float4 c = image[int64_t(y0 + y) * imageWidth + (x0 + x)];
+  if (c.x == 0.f && c.y == 0.f && c.z == 0.f && c.w == 0.f) return;  // d' = d
+  auto source = [eightBit](float v) {
+    return eightBit ? float(roundTo8(v)) * (1.f / 255.f) : fminf(fmaxf(v, 0.f), 1.f);
   };
-  out[int64_t(y) * w + x] = make_uchar4(q(c.x), q(c.y), q(c.z), q(c.w));
+  const float s[4] = {source(c.x), source(c.y), source(c.z), source(c.w)};
+  const int tx = x0 + x + dx, ty = y0 + y + dy;
+  const uchar4 d = surf2Dread<uchar4>(target, tx * int(sizeof(uchar4)), ty);
+  const unsigned char dv[4] = {d.x, d.y, d.z, d.w};
+  unsigned char o[4];
+  const float keep = 1.f - s[3];
+  for (int i = 0; i < 4; ++i) o[i] = roundTo8(fmaf(float(dv[i]) * (1.f / 255.f), keep, s[i]));
+  surf2Dwrite(make_uchar4(o[0], o[1], o[2], o[3]), target, tx * int(sizeof(uchar4)), ty);
 }
 
 }  // namespace
@@ -28,12 +51,28 @@ struct DeviceImageCopy::Impl {
   cuda::DeviceBuffer<uchar4> scratch;  ///< the rounded rectangle (eightBit)
   cudaStream_t lastStream = nullptr;
   bool used = false;
+  // blendOver's surface of the last array (a mapped texture keeps its array from map to map).
+  cudaArray_t surfaceArray = nullptr;
+  cudaSurfaceObject_t surface = 0;
+
+  /// Another stream than the last call's (a new engine): the last call's work may still use the
+  /// scratch memory or the surface.
+  cudaError_t useStream(cudaStream_t s) {
+    if (used && s != lastStream) {
+      const cudaError_t e = cudaDeviceSynchronize();
+      if (e != cudaSuccess) return e;
+    }
+    lastStream = s;
+    used = true;
+    return cudaSuccess;
+  }
 };
 
 DeviceImageCopy::DeviceImageCopy() : impl_(new Impl) {}
 
 DeviceImageCopy::~DeviceImageCopy() {
   if (impl_->used) cudaDeviceSynchronize();  // a queued copy may still read the scratch memory
+  if (impl_->surface) cudaDestroySurfaceObject(impl_->surface);
   (void)cudaGetLastError();
 }
 
@@ -43,13 +82,7 @@ int DeviceImageCopy::copy(const void* image, int imageWidth, int imageHeight, vo
     return int(cudaErrorInvalidValue);
   Impl& d = *impl_;
   const cudaStream_t s = static_cast<cudaStream_t>(stream);
-  // Another stream (a new engine): the scratch memory may still be read by the old one's copy.
-  if (d.used && s != d.lastStream) {
-    const cudaError_t e = cudaDeviceSynchronize();
-    if (e != cudaSuccess) return int(e);
-  }
-  d.lastStream = s;
-  d.used = true;
+  if (const cudaError_t e = d.useStream(s); e != cudaSuccess) return int(e);
   const cudaArray_t a = static_cast<cudaArray_t>(array);
   const auto* src = static_cast<const float4*>(image);
   if (!eightBit) {
@@ -71,6 +104,41 @@ int DeviceImageCopy::copy(const void* image, int imageWidth, int imageHeight, vo
   const size_t row = size_t(w) * sizeof(uchar4);
   return int(cudaMemcpy2DToArrayAsync(a, size_t(x0) * sizeof(uchar4), size_t(y0), d.scratch.get(), row, row,
                                       size_t(h), cudaMemcpyDeviceToDevice, s));
+}
+
+int DeviceImageCopy::blendOver(const void* image, int imageWidth, int imageHeight, void* array, int arrayWidth,
+                               int arrayHeight, int x0, int y0, int w, int h, int dx, int dy, bool eightBit,
+                               void* stream) {
+  if (!image || !array || x0 < 0 || y0 < 0 || w <= 0 || h <= 0 || x0 + w > imageWidth || y0 + h > imageHeight ||
+      x0 + dx < 0 || y0 + dy < 0 || x0 + dx + w > arrayWidth || y0 + dy + h > arrayHeight)
+    return int(cudaErrorInvalidValue);
+  Impl& d = *impl_;
+  const cudaStream_t s = static_cast<cudaStream_t>(stream);
+  if (const cudaError_t e = d.useStream(s); e != cudaSuccess) return int(e);
+  const cudaArray_t a = static_cast<cudaArray_t>(array);
+  if (a != d.surfaceArray) {
+    releaseSurface();
+    cudaResourceDesc r{};
+    r.resType = cudaResourceTypeArray;
+    r.res.array.array = a;
+    if (const cudaError_t e = cudaCreateSurfaceObject(&d.surface, &r); e != cudaSuccess) return int(e);
+    d.surfaceArray = a;
+  }
+  const dim3 block(32, 8);
+  const dim3 grid(unsigned((w + 31) / 32), unsigned((h + 7) / 8));
+  blendOverKernel<<<grid, block, 0, s>>>(static_cast<const float4*>(image), imageWidth, x0, y0, w, h, dx, dy, eightBit,
+                                         d.surface);
+  return int(cudaPeekAtLastError());
+}
+
+void DeviceImageCopy::releaseSurface() {
+  Impl& d = *impl_;
+  if (!d.surface) return;
+  cudaDeviceSynchronize();  // a queued blend may still write through it
+  cudaDestroySurfaceObject(d.surface);
+  (void)cudaGetLastError();
+  d.surface = 0;
+  d.surfaceArray = nullptr;
 }
 
 }  // namespace spaceskip

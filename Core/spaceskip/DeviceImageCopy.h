@@ -1,4 +1,5 @@
-// CUDA-GL interop: the engine's device image (Engine::deviceImage) into a mapped GL texture.
+// CUDA-GL interop: the engine's device image (Engine::deviceImage) into a mapped GL texture, or
+// blended straight into a mapped framebuffer texture.
 // No CUDA types here: the VTK module includes it without nvcc.
 #pragma once
 #include <memory>
@@ -20,6 +21,22 @@ class DeviceImageCopy {
   /// queued); without CUDA, 1 (cudaErrorInvalidValue).
   int copy(const void* image, int imageWidth, int imageHeight, void* array, int x0, int y0, int w, int h,
            bool eightBit, void* stream);
+
+  /// Queues on `stream` the blend of the pixels [x0, x0 + w) x [y0, y0 + h) of `image` (as in
+  /// copy()) over the pixels [x0 + dx, x0 + dx + w) x [y0 + dy, y0 + dy + h) of `array` (a
+  /// cudaArray_t of RGBA8 texels, `arrayWidth` x `arrayHeight`, usable as a surface: a mapped GL
+  /// framebuffer texture registered for surface load/store), as GL blends premultiplied colour
+  /// with (ONE, ONE_MINUS_SRC_ALPHA) into an 8-bit normalized buffer: per channel
+  /// d' = s + d (1 - s_alpha) rounded to the nearest 1/255, the source s rounded to 8 bits first
+  /// with `eightBit` (what the GL path's RGBA8 texture holds), else clamped to [0, 1]; pixels of
+  /// transparent black are left unwritten (d' = d). Returns the cudaError_t as an int (0: queued;
+  /// without CUDA, 1).
+  int blendOver(const void* image, int imageWidth, int imageHeight, void* array, int arrayWidth, int arrayHeight,
+                int x0, int y0, int w, int h, int dx, int dy, bool eightBit, void* stream);
+
+  /// Forgets the surface blendOver() made for its last array (waiting for the blends still
+  /// queued): call before that array's texture is unregistered or reallocated.
+  void releaseSurface();
 
  private:
   struct Impl;

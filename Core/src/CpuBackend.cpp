@@ -221,6 +221,10 @@ struct DeviceImageCopy::Impl {};
 DeviceImageCopy::DeviceImageCopy() = default;
 DeviceImageCopy::~DeviceImageCopy() = default;
 int DeviceImageCopy::copy(const void*, int, int, void*, int, int, int, int, bool, void*) { return 1; }
+int DeviceImageCopy::blendOver(const void*, int, int, void*, int, int, int, int, int, int, int, int, bool, void*) {
+  return 1;
+}
+void DeviceImageCopy::releaseSurface() {}
 #endif
 
 }  // namespace spaceskip

@@ -2,7 +2,7 @@
 // without waiting for the kernel, work queued on deviceImageStream() sees the finished frame (the
 // same bits as the host image), its kernel time is read when asked for, and DeviceImageCopy
 // writes a rectangle of it into a CUDA array as float4 or as RGBA8 rounded as the mapper's host
-// path rounds. Skipped without a CUDA device.
+// path rounds, or blends it over an RGBA8 surface as GL's blend would. Skipped without a CUDA device.
 #include "spaceskip/Backend.h"
 #include "spaceskip/DeviceImageCopy.h"
 #include "TestUtil.h"
@@ -14,6 +14,7 @@
 #endif
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -121,6 +122,57 @@ TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
     ASSERT_EQ(cudaMallocArray(&array, &desc, size_t(w), size_t(h)), cudaSuccess);
     EXPECT_NE(copy.copy(image, w, h, array, w - 10, 0, 11, 5, true, stream), 0);
     cudaFreeArray(array);
+
+    // Blended over an RGBA8 "framebuffer" larger than the image, at an offset (the viewport's
+    // origin): within the rectangle GL's (ONE, ONE_MINUS_SRC_ALPHA) over the background, rounded
+    // to the nearest 1/255 (here computed in double: at most 1/255 apart where float rounding
+    // lands on the other side of a half), elsewhere and under transparent pixels the background.
+    const int fw = w + 40, fh = h + 30, dx = 23, dy = 11;
+    std::vector<unsigned char> background(size_t(fw) * size_t(fh) * 4);
+    for (size_t i = 0; i < background.size(); ++i) background[i] = static_cast<unsigned char>((i * 7919u) >> 3);
+    for (bool eightBit : {true, false}) {
+      SCOPED_TRACE(eightBit ? "blend, 8-bit source" : "blend, float source");
+      cudaArray_t target = nullptr;
+      ASSERT_EQ(cudaMallocArray(&target, &desc, size_t(fw), size_t(fh), cudaArraySurfaceLoadStore), cudaSuccess);
+      ASSERT_EQ(cudaMemcpy2DToArray(target, 0, 0, background.data(), size_t(fw) * 4, size_t(fw) * 4, size_t(fh),
+                                    cudaMemcpyHostToDevice),
+                cudaSuccess);
+      EXPECT_EQ(copy.blendOver(image, w, h, target, fw, fh, x0, y0, rw, rh, dx, dy, eightBit, stream), 0);
+      ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);
+      std::vector<unsigned char> back(background.size());
+      ASSERT_EQ(cudaMemcpy2DFromArray(back.data(), size_t(fw) * 4, target, 0, 0, size_t(fw) * 4, size_t(fh),
+                                      cudaMemcpyDeviceToHost),
+                cudaSuccess);
+      int far = 0, near = 0, outside = 0, covered = 0;
+      for (int ty = 0; ty < fh; ++ty)
+        for (int tx = 0; tx < fw; ++tx) {
+          const size_t o = (size_t(ty) * size_t(fw) + size_t(tx)) * 4;
+          const int ix = tx - dx, iy = ty - dy;
+          if (ix < x0 || ix >= x0 + rw || iy < y0 || iy >= y0 + rh) {
+            outside += !std::equal(back.begin() + o, back.begin() + o + 4, background.begin() + o);
+            continue;
+          }
+          const vec4f& c = host.rgba[size_t(iy) * size_t(w) + size_t(ix)];
+          const float src[4] = {c.x, c.y, c.z, c.w};
+          double sv[4];
+          for (int i = 0; i < 4; ++i)
+            sv[i] = eightBit ? round8(src[i]) / 255.0 : std::min(std::max(double(src[i]), 0.0), 1.0);
+          covered += c.w > 0.f;
+          for (int i = 0; i < 4; ++i) {
+            const double want = std::min(1.0, sv[i] + background[o + i] / 255.0 * (1.0 - sv[3])) * 255.0 + 0.5;
+            const int diff = std::abs(int(back[o + i]) - int(std::floor(want)));
+            far += diff > 1;
+            near += diff == 1;
+          }
+        }
+      // A rectangle that does not fit the target is refused.
+      EXPECT_NE(copy.blendOver(image, w, h, target, fw, fh, 0, 0, 11, 5, fw - 10, 0, eightBit, stream), 0);
+      cudaFreeArray(target);
+      EXPECT_GT(covered, 100) << "the rectangle should hold part of the volume";
+      EXPECT_EQ(outside, 0) << "texels outside the rectangle were written";
+      EXPECT_EQ(far, 0) << "channels more than 1/255 from the blend";
+      EXPECT_LE(near, rw * rh / 50) << "channels 1/255 off: more than rounding ties explain";
+    }
   }
 }
 #endif

@@ -8,7 +8,7 @@
 // edit's frame with). Run by Testing/gpu/run-gpu-vtk.sh.
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
-//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:sync|:full|:float]]
+//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:sync|:full|:float|:glblend]]
 //       [--vtk-gpu]
 //       [--edits E (4)] [--edit-cut C (the edits move the ramp's zero between 10% and C of the
 //        range: 0.3 by default, which changes N-body's occupied cells; 0.2 does not, as its
@@ -24,7 +24,8 @@
 // SPACESKIP_SYNC_FRAME=1 for the item (the host waits for the kernel and copies on the default
 // stream, as before the asynchronous interop), :full SPACESKIP_COMPOSITE_FULL=1 (copy and blend
 // the whole window, not the volume's rectangle), :float the mapper's EightBitComposite off (a
-// float texture). Columns render_ms and finish_ms split the frame into the time in Render() and
+// float texture), :glblend SPACESKIP_CUDA_BLEND=0 (the image copied into a texture that GL
+// draws, instead of blended by CUDA into the window's framebuffer). Columns render_ms and finish_ms split the frame into the time in Render() and
 // the wait in glFinish() after it. stream_ms / stream_fps: the same orbit rendered back to back
 // with one glFinish() at the end (throughput; frame_ms is the latency of one waited-for frame).
 // edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
@@ -284,6 +285,7 @@ struct Item
   bool sync = false;  ///< SPACESKIP_SYNC_FRAME=1
   bool full = false;  ///< SPACESKIP_COMPOSITE_FULL=1
   bool floatComposite = false;
+  bool glBlend = false; ///< SPACESKIP_CUDA_BLEND=0
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -341,6 +343,10 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i] == "float")
     {
       it.floatComposite = true;
+    }
+    else if (parts[i] == "glblend")
+    {
+      it.glBlend = true;
     }
     else
     {
@@ -671,6 +677,10 @@ int main(int argc, char* argv[])
     };
     setSwitch("SPACESKIP_SYNC_FRAME", it.sync);
     setSwitch("SPACESKIP_COMPOSITE_FULL", it.full);
+    if (it.glBlend)
+      setenv("SPACESKIP_CUDA_BLEND", "0", 1);
+    else
+      unsetenv("SPACESKIP_CUDA_BLEND");
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
@@ -709,6 +719,7 @@ int main(int argc, char* argv[])
     const double k = 1e3 / frames;
     const double stream = StreamedRender(win, ren, b, frames);
     const std::string path = mapper->GetCompositePathUsed();
+    const std::string blendUsed = mapper->GetCompositeBlendUsed(); // the timed frames' (the check below draws through host memory)
     std::string check;
     if (path == "gpu")
     {
@@ -723,7 +734,10 @@ int main(int argc, char* argv[])
       check = ", gpu vs host image max diff " + std::to_string(MaxDiff(gpuShot, hostShot)) + "/255";
     }
     std::printf("  %s: image %s%s\n", it.label.c_str(),
-      path == "gpu" ? "on the GPU (CUDA-GL interop)" : "through host memory", check.c_str());
+      path == "gpu"
+        ? (std::string("on the GPU (CUDA-GL interop, blended by ") + blendUsed + ")").c_str()
+        : "through host memory",
+      check.c_str());
     if (!pngPrefix.empty())
     {
       std::string name = it.label;
