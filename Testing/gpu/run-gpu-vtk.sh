@@ -16,6 +16,8 @@
 #          window blended), :float (float interop texture), alone and all together, twice in one
 #          process: FRAME_ITEMS) interop-memcheck (compute-sanitizer memcheck on the window
 #          benchmark with the image kept on the GPU, 8-bit and float: memcheck.log)
+#          bench-floor (N-body FLOOR_N^3, default 128, in the 1024^2 window: the frame around a
+#          kernel of a few hundredths of a ms, CUDA blend against GL's: FLOOR_ITEMS)
 #          bench-ab (window benchmark processes alternating SPACESKIP_PART_RANGES: AB_RUNS,
 #          AB_ITEMS) nsys-frame (Nsight Systems timeline of the window benchmark, N-body 2048^3 Auto:hw and
 #          :sync:full:float, 8 frames and 2 edits each: CUDA API and GPU work per call, OpenGL
@@ -210,7 +212,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
 # vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -242,6 +244,11 @@ has bench-hw && ITEMS=${HW_ITEMS:-DistanceGrid,DistanceGrid:hw,Auto,Auto:hw} win
 # The frame around the kernel (issue 13): each change against the state before it, in one process.
 has bench-frame && ITEMS=${FRAME_ITEMS:-Auto:hw,Auto:hw:sync:full:float,Auto:hw:sync,Auto:hw:full,Auto:hw:float,Auto:hw,Auto:hw:sync:full:float} \
   window_bench nbody 2048 "${v2[@]}"
+# The window's floor (issue 13): the same frame around a kernel of a few hundredths of a
+# millisecond (N-body FLOOR_N^3, default 128, still drawn over the whole 1024^2 window): what
+# the window costs besides the kernel, with the CUDA blend and with GL's (:glblend).
+has bench-floor && ITEMS=${FLOOR_ITEMS:-Auto:hw,Auto:hw:glblend,Auto:hw,Auto:hw:glblend} \
+  window_bench nbody "${FLOOR_N:-128}" "${v2[@]}"
 # Part ranges off and on (SPACESKIP_PART_RANGES per process: the sub-brick masks on the edit's
 # path or on the frame after it), N-body 2048^3, alternated: AB_RUNS (e.g. "0 1 0 1"), AB_ITEMS.
 for r in ${AB_RUNS:-}; do
