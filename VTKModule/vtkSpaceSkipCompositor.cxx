@@ -44,6 +44,41 @@ bool EnvOn(const char* name)
   return v && v[0] == '1';
 }
 
+#ifdef SPACESKIP_HAVE_CUDA
+// Queues on the engine's `stream` (after its frame; with SPACESKIP_SYNC_FRAME=1, a measurement
+// switch, on the default stream, the engine having waited) the map of `resource`, `work` on its
+// array (returns a cudaError_t as an int) and the unmap: the map makes CUDA wait for GL's drawing
+// so far, the unmap GL's next drawing for `work`, both on the GPU. On failure `what` names the
+// step (`workName` for `work`).
+template <class Work>
+cudaError_t OnMappedArray(void* resource, void* stream, const char* workName, Work work, const char*& what)
+{
+  const cudaStream_t s = EnvOn("SPACESKIP_SYNC_FRAME") ? nullptr : static_cast<cudaStream_t>(stream);
+  cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(resource);
+  cudaError_t e = cudaGraphicsMapResources(1, &r, s);
+  if (e != cudaSuccess)
+  {
+    what = "cudaGraphicsMapResources";
+    return e;
+  }
+  cudaArray_t array = nullptr;
+  e = cudaGraphicsSubResourceGetMappedArray(&array, r, 0, 0);
+  what = "cudaGraphicsSubResourceGetMappedArray";
+  if (e == cudaSuccess)
+  {
+    e = static_cast<cudaError_t>(work(array, static_cast<void*>(s)));
+    what = workName;
+  }
+  const cudaError_t u = cudaGraphicsUnmapResources(1, &r, s);
+  if (e == cudaSuccess && u != cudaSuccess)
+  {
+    what = "cudaGraphicsUnmapResources";
+    return u;
+  }
+  return e;
+}
+#endif
+
 // The framebuffer pixels a blend of `rect` (VisibleRect: pixels of the viewport) may write, as x,
 // y, w, h: the rectangle moved to the viewport's origin `vp` and cut to the scissor box in force.
 // False when that leaves none.
@@ -249,6 +284,7 @@ void vtkSpaceSkipCompositor::VisibleRect(const spaceskip::Camera& camera, vtkIma
 bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image,
   void* stream, int width, int height, const int rect[4], bool eightBit)
 {
+#ifdef SPACESKIP_HAVE_CUDA
   if (this->BlendIntoFramebuffer(renWin, image, stream, width, height, rect, eightBit))
   {
     this->Direct = true;
@@ -256,6 +292,7 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, cons
     this->BlendPath = "cuda";
     return true;
   }
+#endif
   if (this->CopyToInteropTexture(renWin, image, stream, width, height, rect, eightBit))
   {
     this->Interop = true;
@@ -441,10 +478,10 @@ void vtkSpaceSkipCompositor::ReleaseTarget()
 // units more than the blend kernel costs its SMs. False (the texture path then draws this
 // frame) for any other target, with SPACESKIP_CUDA_BLEND=0 (a measurement switch), and from a
 // CUDA failure on (said once at INFO verbosity).
+#ifdef SPACESKIP_HAVE_CUDA
 bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
   const void* image, void* stream, int w, int h, const int rect[4], bool eightBit)
 {
-#ifdef SPACESKIP_HAVE_CUDA
   const char* off = std::getenv("SPACESKIP_CUDA_BLEND");
   if (this->TargetFailed || (off && off[0] == '0'))
   {
@@ -537,43 +574,16 @@ bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
   {
     this->ImageCopy.reset(new spaceskip::DeviceImageCopy);
   }
-  // As CopyToInteropTexture: on the engine's stream after its frame; the map waits (on the GPU)
-  // for GL's drawing so far, GL's next drawing for the unmap.
-  const cudaStream_t s = EnvOn("SPACESKIP_SYNC_FRAME") ? nullptr : static_cast<cudaStream_t>(stream);
-  cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(this->TargetResource);
-  cudaError_t e = cudaGraphicsMapResources(1, &r, s);
-  if (e != cudaSuccess)
-  {
-    return failed("cudaGraphicsMapResources", e);
-  }
-  cudaArray_t array = nullptr;
-  e = cudaGraphicsSubResourceGetMappedArray(&array, r, 0, 0);
-  if (e == cudaSuccess)
-  {
-    e = static_cast<cudaError_t>(this->ImageCopy->blendOver(image, w, h, array, tw, th, box[0] - vp[0],
-      box[1] - vp[1], box[2], box[3], vp[0], vp[1], eightBit, s));
-  }
-  const cudaError_t u = cudaGraphicsUnmapResources(1, &r, s);
-  if (e != cudaSuccess)
-  {
-    return failed("blend into the framebuffer texture", e);
-  }
-  if (u != cudaSuccess)
-  {
-    return failed("cudaGraphicsUnmapResources", u);
-  }
-  return true;
-#else
-  (void)renWin;
-  (void)image;
-  (void)stream;
-  (void)w;
-  (void)h;
-  (void)rect;
-  (void)eightBit;
-  return false;
-#endif
+  const char* what = "";
+  const cudaError_t e = OnMappedArray(this->TargetResource, stream, "blend into the framebuffer texture",
+    [&](cudaArray_t array, void* s) {
+      return this->ImageCopy->blendOver(image, w, h, array, tw, th, box[0] - vp[0], box[1] - vp[1],
+        box[2], box[3], vp[0], vp[1], eightBit, s);
+    },
+    what);
+  return e == cudaSuccess || failed(what, e);
 }
+#endif
 
 //------------------------------------------------------------------------------
 // Copies the engine's device image into InteropTexture; false (with the reason) on any failure.
@@ -636,32 +646,13 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(vtkOpenGLRenderWindow* renWin,
   {
     this->ImageCopy.reset(new spaceskip::DeviceImageCopy);
   }
-  // On the engine's stream, after its frame; GL's work after the unmap waits for the copy on
-  // the GPU. Measurement switch: the default stream, the engine having waited for its frame.
-  const cudaStream_t s = EnvOn("SPACESKIP_SYNC_FRAME") ? nullptr : static_cast<cudaStream_t>(stream);
-  cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(this->InteropResource);
-  cudaError_t e = cudaGraphicsMapResources(1, &r, s);
-  if (e != cudaSuccess)
-  {
-    return failed("cudaGraphicsMapResources", e);
-  }
-  cudaArray_t array = nullptr;
-  e = cudaGraphicsSubResourceGetMappedArray(&array, r, 0, 0);
-  if (e == cudaSuccess)
-  {
-    e = static_cast<cudaError_t>(
-      this->ImageCopy->copy(image, w, h, array, rect[0], rect[1], rect[2], rect[3], eightBit, s));
-  }
-  const cudaError_t u = cudaGraphicsUnmapResources(1, &r, s);
-  if (e != cudaSuccess)
-  {
-    return failed("copy into the GL texture", e);
-  }
-  if (u != cudaSuccess)
-  {
-    return failed("cudaGraphicsUnmapResources", u);
-  }
-  return true;
+  const char* what = "";
+  const cudaError_t e = OnMappedArray(this->InteropResource, stream, "copy into the GL texture",
+    [&](cudaArray_t array, void* s) {
+      return this->ImageCopy->copy(image, w, h, array, rect[0], rect[1], rect[2], rect[3], eightBit, s);
+    },
+    what);
+  return e == cudaSuccess || failed(what, e);
 #else
   (void)renWin;
   (void)image;

@@ -103,6 +103,7 @@ private:
   bool Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture, const int rect[4]);
   void ReleaseInterop();
   void ReleaseTarget();
+  // Defined with CUDA only.
   bool BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,
     int h, const int rect[4], bool eightBit);
   bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,

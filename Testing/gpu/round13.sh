@@ -5,7 +5,7 @@
 # Results: docs/results/round13-h100/NOTES.md. The column tool is not on the device: raw CSV.
 #
 #   Testing/gpu/round13.sh OUTDIR [phases]
-#   phases (default: blocks): tests blocks resident
+#   phases (default: blocks): tests blocks bricks resident
 #   env: DEADLINE (epoch s: no phase starts after), BLOCKS ("16x8 8x4 ..."), DATASETS, ITEMS
 set -uo pipefail
 out=${1:?usage: round13.sh OUTDIR [phases]}
@@ -31,6 +31,16 @@ if has blocks; then
     run "block$b-$n" SPACESKIP_CUDA_BLOCK=$b
   done
 fi
+# The brick size with the sub-brick masks (4^3 parts a brick: parts of 2, 3, 4, 8 voxels at
+# bricks 8, 12, 16, 32), ITEMS in one process, REPS processes (default 2) with --edits EDITS.
+if has bricks; then
+  for n in $(seq "${REPS:-2}"); do
+    late && break
+    env timeout 250 build-new/spaceskip bench --paper --datasets "$sets" --builders "$items" --frames 8 \
+      --edits "${EDITS:-8}" --csv "$out/bricks-$n.csv" > "$out/bricks-$n.log" 2>&1
+    log "bricks-$n rc=$?"
+  done
+fi
 # SPACESKIP_CUDA_RESIDENT=N: persistent blocks (N per SM) taking tiles from a counter.
 if has resident; then
   n=0
@@ -42,7 +52,7 @@ if has resident; then
 fi
 {
   for f in "$out"/*.csv; do
-    [ -f "$f" ] && { echo "== $f"; cut -d, -f1,6,7,17,18 "$f"; }
+    [ -f "$f" ] && { echo "== $f"; cut -d, -f1,6,7,13,14,17,18,26,33,34 "$f"; }
   done
 } > "$out/summary.txt" 2>&1
 cat "$out/summary.txt"
