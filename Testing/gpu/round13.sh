@@ -5,7 +5,7 @@
 # Results: docs/results/round13-h100/NOTES.md. The column tool is not on the device: raw CSV.
 #
 #   Testing/gpu/round13.sh OUTDIR [phases]
-#   phases (default: blocks): tests blocks bricks resident
+#   phases (default: blocks): tests blocks bricks order resident
 #   env: DEADLINE (epoch s: no phase starts after), BLOCKS ("16x8 8x4 ..."), DATASETS, ITEMS
 set -uo pipefail
 out=${1:?usage: round13.sh OUTDIR [phases]}
@@ -39,6 +39,17 @@ if has bricks; then
     env timeout 250 build-new/spaceskip bench --paper --datasets "$sets" --builders "$items" --frames 8 \
       --edits "${EDITS:-8}" --csv "$out/bricks-$n.csv" > "$out/bricks-$n.log" 2>&1
     log "bricks-$n rc=$?"
+  done
+fi
+# The persistent launch's tile order (SPACESKIP_TILE_ORDER=1: tiles nearest the image's centre
+# first), ORDERS: "BLOCK:RESIDENT:ORDER ..." one process each (resident 0: the plain launch).
+if has order; then
+  n=0
+  for spec in ${ORDERS:-16x8:0:0 16x8:8:1 8x4:32:1 16x8:0:0 16x8:8:0 8x4:32:0 16x8:8:1 8x4:32:1 16x8:0:0}; do
+    n=$((n + 1))
+    late && break
+    IFS=: read -r b r o <<< "$spec"
+    run "order-$b-$r-$o-$n" SPACESKIP_CUDA_BLOCK=$b SPACESKIP_CUDA_RESIDENT=$r SPACESKIP_TILE_ORDER=$o
   done
 fi
 # SPACESKIP_CUDA_RESIDENT=N: persistent blocks (N per SM) taking tiles from a counter.
