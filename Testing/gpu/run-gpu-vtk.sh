@@ -195,7 +195,9 @@ window_bench() {  # SHAPE N [--vtk-gpu] [--egl]
   SPACESKIP_BACKEND=cuda timeout 420 "$bench" --shape "$shape" --dims "$n" --frames "$frames" \
     --size 1024 --builders "${ITEMS:-$wb}" --csv "$out/bench.csv" --png "$work/frame" \
     ${EDIT_CUT:+--edit-cut "$EDIT_CUT"} "$@" >> "$work/bench.log" 2>&1
-  log "window bench rc=$?"
+  local rc=$?
+  log "window bench rc=$rc"
+  [ $rc -eq 0 ] || status=1  # 3: an item's GPU-path image differs from the host path's by > 1/255
   cp "$work/bench.log" "$out/bench.log"
   [ -n "${ITEMS:-}" ] && return  # a variant of a case benched above: no second CLI run
   log "CLI bench gen:$shape:$n"
