@@ -28,6 +28,7 @@ constexpr int kMaxRenderThreads = 256;
 // N-body 2048^3 789 kernel fps plain vs 730 persistent, in one process
 // (docs/results/round9-h100/before).
 constexpr size_t kLargeTextureBytes = size_t(2) << 30;
+constexpr int kRaySegments = 4;  // launch(): segments a ray of a segmentable frame is cut into
 constexpr int kLargeTextureResident = 6;
 template <class Sampler>
 struct RenderMinBlocks {
@@ -50,9 +51,13 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
     renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out,
                  unsigned* tileCounter) {
   const unsigned tilesX = (unsigned(f.width) + blockDim.x - 1) / blockDim.x;
+  // gridDim.z > 1: segment blockIdx.z of every ray into its own layer of `out` (RaySegments).
+  const int segment = int(blockIdx.z), segments = int(gridDim.z);
   auto tile = [&](unsigned tx, unsigned ty) {
     const int x = int(tx * blockDim.x + threadIdx.x), y = int(ty * blockDim.y + threadIdx.y);
-    if (x < f.width && y < f.height) out[int64_t(y) * f.width + x] = renderPixel<Sampler, Traversal, Plain>(f, s, x, y);
+    if (x < f.width && y < f.height)
+      out[(int64_t(segment) * f.height + y) * f.width + x] =
+          renderPixel<Sampler, Traversal, Plain>(f, s, x, y, segment, segments);
   };
   if (!tileCounter) {
     tile(blockIdx.x, blockIdx.y);
@@ -68,6 +73,19 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
     if (t >= numTiles) return;
     tile(t % tilesX, t / tilesX);
   }
+}
+
+// The layers of a segmented frame composited front to back into the image: one thread a pixel.
+__global__ void compositeSegmentsKernel(const vec4f* layers, int segments, int64_t pixels, vec4f* out) {
+  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i >= pixels) return;
+  vec4f c = layers[int64_t(segments - 1) * pixels + i];
+  for (int k = segments - 2; k >= 0; --k) {
+    const vec4f l = layers[int64_t(k) * pixels + i];
+    const float keep = 1.f - l.w;
+    c = vec4f{l.x + keep * c.x, l.y + keep * c.y, l.z + keep * c.z, l.w + keep * c.w};
+  }
+  out[i] = c;
 }
 
 template <class Sampler>
@@ -271,6 +289,24 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
   const int carveout = launch_.carveout >= 0 && launch_.carveout <= 100 ? launch_.carveout : env_.carveout;
   if (carveout >= 0) SS_CUDA_CHECK(cudaFuncSetAttribute(k, cudaFuncAttributePreferredSharedMemoryCarveout, carveout));
   if (residentBlocks <= 0) {
+    // Rays cut into kRaySegments segments marched by separate threads, composited front to back
+    // (segmentableFrame: composite plain frames without early ray termination). A frame takes as
+    // long as its slowest tiles, and at N-body 2048^3 those are tiles whose rays cross dense
+    // clusters: 0.6-0.9 ms while the median tile takes 1.3 us. Measured on the H100
+    // (docs/results/round13-h100/segments): 4 segments 1.07-1.18x kernel fps on five stand-ins
+    // (DistanceGrid, DistanceGrid:hw, Auto), 8 less. SPACESKIP_RAY_SEGMENTS (read per frame,
+    // 1..16; 1: whole rays) is the measurement switch.
+    const char* seg = std::getenv("SPACESKIP_RAY_SEGMENTS");
+    const int segments = seg ? std::max(1, std::min(16, std::atoi(seg))) : kRaySegments;
+    if (segments > 1 && segmentableFrame(f)) {
+      const int64_t pixels = int64_t(f.width) * f.height;
+      d_layers_.reserve(size_t(pixels) * size_t(segments));
+      k<<<dim3(grid.x, grid.y, unsigned(segments)), block, 0, stream>>>(f, s, d_layers_.get(), nullptr);
+      SS_CUDA_CHECK_LAUNCH(renderKernel);
+      compositeSegmentsKernel<<<unsigned((pixels + 255) / 256), 256, 0, stream>>>(d_layers_.get(), segments, pixels,
+                                                                                    d_image_.get());
+      return;
+    }
     k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr);
     return;
   }

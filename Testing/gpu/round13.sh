@@ -5,7 +5,7 @@
 # Results: docs/results/round13-h100/NOTES.md. The column tool is not on the device: raw CSV.
 #
 #   Testing/gpu/round13.sh OUTDIR [phases]
-#   phases (default: blocks): tests blocks bricks order resident
+#   phases (default: blocks): tests blocks bricks order segments resident
 #   env: DEADLINE (epoch s: no phase starts after), BLOCKS ("16x8 8x4 ..."), DATASETS, ITEMS
 set -uo pipefail
 out=${1:?usage: round13.sh OUTDIR [phases]}
@@ -50,6 +50,16 @@ if has order; then
     late && break
     IFS=: read -r b r o <<< "$spec"
     run "order-$b-$r-$o-$n" SPACESKIP_CUDA_BLOCK=$b SPACESKIP_CUDA_RESIDENT=$r SPACESKIP_TILE_ORDER=$o
+  done
+fi
+# Rays cut into K segments marched by separate threads (SPACESKIP_RAY_SEGMENTS=K, 1: whole
+# rays), SEGMENTS: one process per K, alternated.
+if has segments; then
+  n=0
+  for k in ${SEGMENTS:-1 4 8 1 4 8}; do
+    n=$((n + 1))
+    late && break
+    run "segments$k-$n" SPACESKIP_RAY_SEGMENTS=$k
   done
 fi
 # SPACESKIP_CUDA_RESIDENT=N: persistent blocks (N per SM) taking tiles from a counter.

@@ -387,12 +387,23 @@ struct IntervalMarcher {
   }
 };
 
+/// Whether a frame's rays may be cut into segments marched apart (renderPixel's `segment`):
+/// composite plain frames without early ray termination, a piece's incoming opacity or sample
+/// counts, where the segments' premultiplied colours composited front to back ("over") give the
+/// whole ray's colour (up to float rounding: the same samples, the sums associated differently).
+SS_FUNC bool segmentableFrame(const FrameView& f) {
+  return isPlainFrame(f) && !(f.ertThreshold <= 1.f) && !f.alphaIn && !f.sampleCount && !f.lattice.active;
+}
+
 /// Premultiplied RGBA of pixel (px, py); row 0 is the bottom row (OpenGL convention).
 /// `Traversal` >= 0 fixes the traversal at compile time (the CUDA kernels, one per traversal);
 /// -1 reads f.traversal.
 /// `Plain` (only for frames where isPlainFrame holds) compiles the composite path alone.
+/// With `segments` > 1 (segmentableFrame frames only) only segment `segment` of the ray's
+/// samples is marched: the lattice's samples split into `segments` runs of equal count, the
+/// shared boundaries computed alike on both sides, so each sample is taken by one segment.
 template <class Sampler, int Traversal = -1, bool Plain = false>
-SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) {
+SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py, int segment = 0, int segments = 1) {
   const PrimaryRay p = primaryRay(f, px, py);
   const Ray& r = p.r;
   const Ray rl = pieceRay(f, r);  // voxels, grid and tree (a piece's own index space; RayGen.h)
@@ -490,9 +501,16 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py) 
     } else if (f.firstSample > 0.f && !(a + lead < b)) {
       // Starting one or more steps in, the ray may leave the box before its first sample: that
       // sample is still taken (clamped to the box), as vtkGPUVolumeRayCastMapper does; every
-      // traversal alike.
+      // traversal alike. (A segmented ray: its first segment.)
       m.t0 = a + lead;
-      if (!f.lattice.active || ownsClampedSample(f, r.org + r.dir * m.t0)) m(m.t0, m.t0 + f.dt);
+      if (segment == 0 && (!f.lattice.active || ownsClampedSample(f, r.org + r.dir * m.t0))) m(m.t0, m.t0 + f.dt);
+    } else if (segments > 1) {
+      m.t0 = a + lead;
+      anchored = true;
+      const int64_t k0 = int64_t(ceilf((a - m.t0) / f.dt)), n = int64_t(ceilf((b - m.t0) / f.dt)) - k0;
+      const float sa = segment == 0 ? a : m.t0 + float(k0 + n * segment / segments) * f.dt;
+      const float sb = segment == segments - 1 ? b : m.t0 + float(k0 + n * (segment + 1) / segments) * f.dt;
+      if (sa < sb) march(sa, sb);
     } else {
       march(a, b);
     }
