@@ -824,8 +824,11 @@ TEST(CudaBackend, ErrorMidFrameFallsBackToTheCpuImage) {
 TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
   // LaunchParams::resident switches the render kernels to a persistent launch (blocks taking
   // tiles from a counter); every pixel must still be rendered once, with the same result. A
-  // 100x70 image leaves partial tiles, and 1 block per SM leaves each block many tiles.
+  // 100x70 image leaves partial tiles, and 1 block per SM leaves each block many tiles. Whole
+  // rays on both sides (the plain launch cuts them into segments by default, the persistent one
+  // does not: SegmentedRaysRenderTheSameImage compares those).
   REQUIRE_CUDA();
+  setenv("SPACESKIP_RAY_SEGMENTS", "1", 1);
   Volume v = generateVolume("nbody", vec3l{96, 96, 96});
   TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
   double b[6];
@@ -851,6 +854,7 @@ TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
       EXPECT_EQ(compareImages(img[0], img[1]).maxAbs, 0.f) << builderName(k);
     }
   }
+  unsetenv("SPACESKIP_RAY_SEGMENTS");
 }
 
 TEST(CudaBackend, SegmentedRaysRenderTheSameImage) {
