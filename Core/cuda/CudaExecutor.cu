@@ -4,6 +4,7 @@
 #include "spaceskip/Backend.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -126,6 +127,23 @@ RenderKernelPtr<Sampler> renderKernelFor(const FrameView& f) {
   else
     return isPlainFrame(f) ? renderKernelFor<Sampler, true>(f.traversal)
                            : renderKernelFor<Sampler, false>(f.traversal);
+}
+
+/// Segments for a frame's rays: one per kSamplesPerSegment samples along the volume's diagonal
+/// (its world length through the inverse of worldToIndex's linear part, over dt), at most
+/// kRaySegments; 1 (whole rays) below 2 x kSamplesPerSegment.
+constexpr double kSamplesPerSegment = 512;
+int raySegments(const FrameView& f) {
+  const float* m = f.worldToIndex;  // row-major 3x4: index = M world + c
+  const double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], g = m[6], h = m[8], i = m[9], j = m[10];
+  const double det = a * (e * j - g * i) - b * (d * j - g * h) + c * (d * i - e * h);
+  if (!(std::fabs(det) > 0) || !(f.dt > 0)) return 1;
+  const double x = f.boxHi.x, y = f.boxHi.y, z = f.boxHi.z;  // the box's diagonal in index space
+  const double wx = ((e * j - g * i) * x - (b * j - c * i) * y + (b * g - c * e) * z) / det;
+  const double wy = (-(d * j - g * h) * x + (a * j - c * h) * y - (a * g - c * d) * z) / det;
+  const double wz = ((d * i - e * h) * x - (a * i - b * h) * y + (a * e - b * d) * z) / det;
+  const double samples = std::sqrt(wx * wx + wy * wy + wz * wz) / double(f.dt);
+  return int(std::max(1.0, std::min(double(kRaySegments), std::floor(samples / kSamplesPerSegment))));
 }
 
 bool validBlock(const LaunchParams& p) {
@@ -294,10 +312,12 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
     // long as its slowest tiles, and at N-body 2048^3 those are tiles whose rays cross dense
     // clusters: 0.6-0.9 ms while the median tile takes 1.3 us. Measured on the H100
     // (docs/results/round13-h100/segments): 4 segments 1.07-1.18x kernel fps on five stand-ins
-    // (DistanceGrid, DistanceGrid:hw, Auto), 8 less. SPACESKIP_RAY_SEGMENTS (read per frame,
-    // 1..16; 1: whole rays) is the measurement switch.
+    // (DistanceGrid, DistanceGrid:hw, Auto), 8 less; short rays lose (N-body 128^3 in a 1024^2
+    // window: kernel 0.30 -> 0.35 ms), hence raySegments. SPACESKIP_RAY_SEGMENTS (read per
+    // frame; 1..16 fixed, 1: whole rays; 0 or unset: raySegments) is the measurement switch.
     const char* seg = std::getenv("SPACESKIP_RAY_SEGMENTS");
-    const int segments = seg ? std::max(1, std::min(16, std::atoi(seg))) : kRaySegments;
+    const int forced = seg ? std::max(0, std::min(16, std::atoi(seg))) : 0;
+    const int segments = forced > 0 ? forced : raySegments(f);
     if (segments > 1 && segmentableFrame(f)) {
       const int64_t pixels = int64_t(f.width) * f.height;
       d_layers_.reserve(size_t(pixels) * size_t(segments));
