@@ -79,6 +79,15 @@ cudaError_t OnMappedArray(void* resource, void* stream, const char* workName, Wo
 }
 #endif
 
+// The window's GL vendor, or nullptr when it is not NVIDIA's: only NVIDIA's GL can share with
+// CUDA, and another is not even asked (the failing call would show up as an API error in
+// compute-sanitizer).
+const char* NonNvidiaVendor()
+{
+  const char* vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
+  return vendor && std::strstr(vendor, "NVIDIA") ? nullptr : (vendor ? vendor : "unknown");
+}
+
 // The framebuffer pixels a blend of `rect` (VisibleRect: pixels of the viewport) may write, as x,
 // y, w, h: the rectangle moved to the viewport's origin `vp` and cut to the scissor box in force.
 // False when that leaves none.
@@ -119,6 +128,7 @@ vtkSpaceSkipCompositor::vtkSpaceSkipCompositor() = default;
 //------------------------------------------------------------------------------
 vtkSpaceSkipCompositor::~vtkSpaceSkipCompositor()
 {
+  this->ReleaseTarget();
   this->ReleaseInterop();
 }
 
@@ -140,6 +150,7 @@ void vtkSpaceSkipCompositor::ReleaseGraphicsResources(vtkWindow* win)
     this->Resolve->ReleaseGraphicsResources(win);
     this->Resolve = nullptr;
   }
+  this->ReleaseTarget();
   this->ReleaseInterop();
   if (this->InteropTexture)
   {
@@ -306,6 +317,7 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, cons
     "through host memory",
     this->InteropProblem.c_str());
   this->InteropFailed = true;
+  this->ReleaseTarget();
   this->ReleaseInterop();
   return false;
 }
@@ -447,7 +459,6 @@ void vtkSpaceSkipCompositor::ReleaseInterop()
 #endif
   this->InteropResource = nullptr;
   this->InteropSize[0] = this->InteropSize[1] = 0;
-  this->ReleaseTarget();
 }
 
 //------------------------------------------------------------------------------
@@ -499,30 +510,14 @@ bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
   {
     return false;
   }
-  auto attachment = [](GLenum what) {
-    GLint v = 0;
-    glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, what, &v);
-    return v;
-  };
+  // Per frame: the draw state (draw buffers, colour mask) the blend must honour.
   GLint buffer0 = 0, buffer1 = 0;
   glGetIntegerv(GL_DRAW_BUFFER0, &buffer0);
   glGetIntegerv(GL_DRAW_BUFFER1, &buffer1);
   GLboolean mask[4] = { GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE };
   glGetBooleanv(GL_COLOR_WRITEMASK, mask);
-  if (buffer0 != GL_COLOR_ATTACHMENT0 || buffer1 != GL_NONE || !(mask[0] && mask[1] && mask[2] && mask[3]) ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) != GL_TEXTURE ||
-    static_cast<unsigned>(attachment(GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME)) != tex->GetHandle() ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_TEXTURE_LEVEL) != 0 ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE) != GL_UNSIGNED_NORMALIZED ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING) != GL_LINEAR ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE) != 8 ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_GREEN_SIZE) != 8 ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_BLUE_SIZE) != 8 ||
-    attachment(GL_FRAMEBUFFER_ATTACHMENT_ALPHA_SIZE) != 8)
+  if (buffer0 != GL_COLOR_ATTACHMENT0 || buffer1 != GL_NONE || !(mask[0] && mask[1] && mask[2] && mask[3]))
   {
-    while (glGetError() != GL_NO_ERROR)
-    {
-    }
     return false;
   }
   int vp[4], box[4];
@@ -547,15 +542,36 @@ bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
       this->TargetProblem.c_str());
     return false;
   };
-  // A texture VTK reallocated (the window resized) or replaced: registered anew.
+  // A texture VTK reallocated (the window resized) or replaced: its format checked and the
+  // texture registered anew, once; one that does not fit stays unregistered until it changes.
   if (this->TargetTexture != tex || this->TargetHandle != tex->GetHandle() || this->TargetSize[0] != tw ||
     this->TargetSize[1] != th)
   {
     this->ReleaseTarget();
-    const char* vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
-    if (!vendor || !std::strstr(vendor, "NVIDIA"))
+    this->TargetTexture = tex;
+    this->TargetHandle = tex->GetHandle();
+    this->TargetSize[0] = tw;
+    this->TargetSize[1] = th;
+    auto attachment = [](GLenum what) {
+      GLint v = 0;
+      glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, what, &v);
+      return v;
+    };
+    const bool rgba8 = attachment(GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE) == GL_TEXTURE &&
+      static_cast<unsigned>(attachment(GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME)) == tex->GetHandle() &&
+      attachment(GL_FRAMEBUFFER_ATTACHMENT_TEXTURE_LEVEL) == 0 &&
+      attachment(GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE) == GL_UNSIGNED_NORMALIZED &&
+      attachment(GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING) == GL_LINEAR &&
+      attachment(GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE) == 8 &&
+      attachment(GL_FRAMEBUFFER_ATTACHMENT_GREEN_SIZE) == 8 &&
+      attachment(GL_FRAMEBUFFER_ATTACHMENT_BLUE_SIZE) == 8 &&
+      attachment(GL_FRAMEBUFFER_ATTACHMENT_ALPHA_SIZE) == 8;
+    while (glGetError() != GL_NO_ERROR)
     {
-      return false; // only NVIDIA's GL shares with CUDA (CopyToInteropTexture says so)
+    }
+    if (!rgba8 || NonNvidiaVendor())
+    {
+      return false;
     }
     cudaGraphicsResource_t r = nullptr;
     const cudaError_t e = cudaGraphicsGLRegisterImage(
@@ -565,10 +581,10 @@ bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
       return failed("cudaGraphicsGLRegisterImage", e);
     }
     this->TargetResource = r;
-    this->TargetTexture = tex;
-    this->TargetHandle = tex->GetHandle();
-    this->TargetSize[0] = tw;
-    this->TargetSize[1] = th;
+  }
+  if (!this->TargetResource)
+  {
+    return false; // this texture does not fit (checked when it appeared)
   }
   if (!this->ImageCopy)
   {
@@ -600,13 +616,9 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(vtkOpenGLRenderWindow* renWin,
     this->InteropEightBit != eightBit)
   {
     this->ReleaseInterop();
-    // Only NVIDIA's GL can share with CUDA: do not even ask another (the failing call would
-    // show up as an API error in compute-sanitizer).
-    const char* vendor = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
-    if (!vendor || !std::strstr(vendor, "NVIDIA"))
+    if (const char* other = NonNvidiaVendor())
     {
-      this->InteropProblem =
-        std::string("the window's OpenGL is ") + (vendor ? vendor : "unknown") + "'s, not NVIDIA's";
+      this->InteropProblem = std::string("the window's OpenGL is ") + other + "'s, not NVIDIA's";
       return false;
     }
     if (!this->InteropTexture)

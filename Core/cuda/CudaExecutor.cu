@@ -29,7 +29,6 @@ constexpr int kMaxRenderThreads = 256;
 // N-body 2048^3 789 kernel fps plain vs 730 persistent, in one process
 // (docs/results/round9-h100/before).
 constexpr size_t kLargeTextureBytes = size_t(2) << 30;
-constexpr int kRaySegments = 4;  // launch(): segments a ray of a segmentable frame is cut into
 constexpr int kLargeTextureResident = 6;
 template <class Sampler>
 struct RenderMinBlocks {
@@ -130,19 +129,21 @@ RenderKernelPtr<Sampler> renderKernelFor(const FrameView& f) {
 }
 
 /// Segments for a frame's rays: one per kSamplesPerSegment samples along the volume's diagonal
-/// (its world length through the inverse of worldToIndex's linear part, over dt), at most
-/// kRaySegments; 1 (whole rays) below 2 x kSamplesPerSegment.
+/// (its world length: the index box's corners through the inverse of worldToIndex, over dt), at
+/// most kRaySegments; 1 (whole rays) below 2 x kSamplesPerSegment.
+constexpr int kRaySegments = 4;
 constexpr double kSamplesPerSegment = 512;
 int raySegments(const FrameView& f) {
-  const float* m = f.worldToIndex;  // row-major 3x4: index = M world + c
-  const double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], g = m[6], h = m[8], i = m[9], j = m[10];
-  const double det = a * (e * j - g * i) - b * (d * j - g * h) + c * (d * i - e * h);
-  if (!(std::fabs(det) > 0) || !(f.dt > 0)) return 1;
-  const double x = f.boxHi.x, y = f.boxHi.y, z = f.boxHi.z;  // the box's diagonal in index space
-  const double wx = ((e * j - g * i) * x - (b * j - c * i) * y + (b * g - c * e) * z) / det;
-  const double wy = (-(d * j - g * h) * x + (a * j - c * h) * y - (a * g - c * d) * z) / det;
-  const double wz = ((d * i - e * h) * x - (a * i - b * h) * y + (a * e - b * d) * z) / det;
-  const double samples = std::sqrt(wx * wx + wy * wy + wz * wz) / double(f.dt);
+  mat4 w2i = identity4(), i2w;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) w2i.m[c * 4 + r] = f.worldToIndex[r * 4 + c];  // row-major 3x4
+  if (!invert(w2i, i2w) || !(f.dt > 0)) return 1;
+  const double lo[3] = {0, 0, 0}, hi[3] = {f.boxHi.x, f.boxHi.y, f.boxHi.z};
+  double a[3], b[3];
+  transformPoint(i2w, lo, a);
+  transformPoint(i2w, hi, b);
+  const double samples = std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                                   (b[2] - a[2]) * (b[2] - a[2])) / double(f.dt);
   return int(std::max(1.0, std::min(double(kRaySegments), std::floor(samples / kSamplesPerSegment))));
 }
 
@@ -322,7 +323,6 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
       const int64_t pixels = int64_t(f.width) * f.height;
       d_layers_.reserve(size_t(pixels) * size_t(segments));
       k<<<dim3(grid.x, grid.y, unsigned(segments)), block, 0, stream>>>(f, s, d_layers_.get(), nullptr);
-      SS_CUDA_CHECK_LAUNCH(renderKernel);
       compositeSegmentsKernel<<<unsigned((pixels + 255) / 256), 256, 0, stream>>>(d_layers_.get(), segments, pixels,
                                                                                     d_image_.get());
       return;
