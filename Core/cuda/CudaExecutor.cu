@@ -147,6 +147,15 @@ int raySegments(const FrameView& f) {
   return int(std::max(1.0, std::min(double(kRaySegments), std::floor(samples / kSamplesPerSegment))));
 }
 
+/// Samples a GPU march fetches together (FrameView::sampleBatch, IntervalMarcher::takeBatch):
+/// kMaxSampleBatch, or SPACESKIP_SAMPLE_BATCH (read per frame, 1..kMaxSampleBatch; 1: one
+/// sample at a time, as before round 14), a measurement switch.
+int sampleBatch() {
+  const char* e = std::getenv("SPACESKIP_SAMPLE_BATCH");
+  const int n = e ? std::atoi(e) : kMaxSampleBatch;
+  return std::max(1, std::min(kMaxSampleBatch, n));
+}
+
 bool validBlock(const LaunchParams& p) {
   return p.blockX > 0 && p.blockY > 0 && p.blockX * p.blockY >= 32 && p.blockX * p.blockY <= kMaxRenderThreads;
 }
@@ -209,6 +218,7 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   timingPending_ = false;  // the last frame's time, if nobody asked for it, is not kept
   lastDeviceSeconds_ = -1;
   f.tf = table_;
+  f.sampleBatch = sampleBatch();
   f.depth = nullptr;
   if (depth) {
     d_depth_.reserve(pixels);

@@ -3,12 +3,16 @@
 #pragma once
 #include "CudaCommon.cuh"
 #include "spaceskip/Volume.h"
+#include "spaceskip/render/FrameShared.h"
 
 namespace spaceskip::cuda {
 
 /// Hardware-filtered sampling: a 3-D texture with linear filtering. Integer types are read as
 /// normalized floats and scaled back to raw values so the TF mapping is the same as in exact mode.
 struct TextureSampler {
+  /// Samples a march fetches per step (SamplerBatch, Integrator.h): one texture instruction a
+  /// sample, so four in flight cost few registers.
+  static constexpr int kBatch = kMaxSampleBatch;
   cudaTextureObject_t tex;
   float scale;
   __device__ float sample(vec3f p) const { return tex3D<float>(tex, p.x + 0.5f, p.y + 0.5f, p.z + 0.5f) * scale; }

@@ -25,6 +25,23 @@ struct vec3l {
   SS_FUNC int64_t operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
 };
 
+/// v[i] = s for an axis i known at run time only, written as selects: no address is taken, so a
+/// GPU keeps v in registers (a run-time index into an array, or a reference to a member chosen
+/// at run time, puts the whole object in local memory).
+SS_FUNC void setAxis(vec3f& v, int i, float s) {
+  v.x = i == 0 ? s : v.x;
+  v.y = i == 1 ? s : v.y;
+  v.z = i == 2 ? s : v.z;
+}
+SS_FUNC void setAxis(vec3i& v, int i, int s) {
+  v.x = i == 0 ? s : v.x;
+  v.y = i == 1 ? s : v.y;
+  v.z = i == 2 ? s : v.z;
+}
+/// v[i] by value (selects, as setAxis).
+SS_FUNC float axisOf(const vec3f& v, int i) { return v[i]; }
+SS_FUNC int axisOf(const vec3i& v, int i) { return v[i]; }
+
 SS_FUNC vec3f make_vec3f(float x, float y, float z) { return vec3f{x, y, z}; }
 SS_FUNC vec3f operator+(vec3f a, vec3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 SS_FUNC vec3f operator-(vec3f a, vec3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }

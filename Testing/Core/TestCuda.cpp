@@ -857,6 +857,53 @@ TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
   unsetenv("SPACESKIP_RAY_SEGMENTS");
 }
 
+TEST(CudaBackend, BatchedSamplesRenderTheSameImage) {
+  // SPACESKIP_SAMPLE_BATCH=N (default kMaxSampleBatch) makes the GPU march of a plain frame
+  // fetch up to N samples of a run before compositing the first (IntervalMarcher::takeBatch):
+  // the same samples, colours and order of compositing as one at a time, so the image is the
+  // same bit for bit. Naive (whole runs), the grid walks (DistanceGrid: parts) and a tree; both
+  // filters; early ray termination (a batch fetches samples past the terminating one but must
+  // not composite them), with and without segments; a 100x70 image.
+  REQUIRE_CUDA();
+  Volume v = generateVolume("nbody", vec3l{96, 96, 96});
+  TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
+  double b[6];
+  v.worldBounds(b);
+  struct Mode {
+    double ert;
+    const char* segments;
+  };
+  const Mode modes[] = {{2.0, "1"}, {2.0, "3"}, {0.3, "1"}, {0.9, "1"}};
+  for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::KdTreeGPUFast}) {
+    for (FilterMode filter : {FilterMode::Exact, FilterMode::Hardware}) {
+      for (const Mode& m : modes) {
+        Image img[4];
+        const char* batches[4] = {"1", "2", "3", "4"};
+        for (int i = 0; i < 4; ++i) {
+          setenv("SPACESKIP_SAMPLE_BATCH", batches[i], 1);
+          setenv("SPACESKIP_RAY_SEGMENTS", m.segments, 1);
+          Engine e(BackendKind::CUDA);
+          e.setVolume(v);
+          e.setTransferFunction(tf);
+          e.setBuildParams(params(k));
+          RenderParams rp;
+          rp.filter = filter;
+          rp.ertThreshold = m.ert;
+          e.setRenderParams(rp);
+          e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
+          ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+        }
+        unsetenv("SPACESKIP_SAMPLE_BATCH");
+        unsetenv("SPACESKIP_RAY_SEGMENTS");
+        SCOPED_TRACE(std::string(builderName(k)) + (filter == FilterMode::Hardware ? " hw" : " exact") + " ert " +
+                     std::to_string(m.ert) + " segments " + m.segments);
+        ASSERT_GT(test::coverage(img[0]), 0.001);
+        for (int i = 1; i < 4; ++i) EXPECT_EQ(compareImages(img[0], img[i]).maxAbs, 0.f) << "batch " << batches[i];
+      }
+    }
+  }
+}
+
 TEST(CudaBackend, SegmentedRaysRenderTheSameImage) {
   // SPACESKIP_RAY_SEGMENTS=K (default 4) cuts each ray's samples into K runs marched by separate threads and
   // composites their colours front to back: the same samples, the sums associated differently,

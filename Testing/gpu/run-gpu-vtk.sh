@@ -19,7 +19,10 @@
 #          bench-floor (N-body FLOOR_N^3, default 128, in the 1024^2 window: the frame around a
 #          kernel of a few hundredths of a ms, CUDA blend against GL's: FLOOR_ITEMS)
 #          bench-ab (window benchmark processes alternating SPACESKIP_PART_RANGES: AB_RUNS,
-#          AB_ITEMS) nsys-frame (Nsight Systems timeline of the window benchmark, N-body 2048^3 Auto:hw and
+#          AB_ITEMS) bench-oldnew (window benchmark processes alternating this bundle's binaries
+#          and an older bundle's, OLD_VTK (a vtk.tar.xz, e.g. carried to the same machine in an
+#          earlier call): OLDNEW_RUNS (default "old new old new"), OLDNEW_ITEMS, at N-body
+#          OLDNEW_N^3 (2048)) nsys-frame (Nsight Systems timeline of the window benchmark, N-body 2048^3 Auto:hw and
 #          :sync:full:float, 8 frames and 2 edits each: CUDA API and GPU work per call, OpenGL
 #          calls, waits; summaries in nsys.log, the CUDA/GL traces as CSV in logs.tgz)
 #          bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
@@ -214,7 +217,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
 # vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor || has bench-oldnew; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -258,6 +261,23 @@ for r in ${AB_RUNS:-}; do
   echo "==== SPACESKIP_PART_RANGES=$r" >> "$work/bench.log"
   (export SPACESKIP_PART_RANGES=$r; ITEMS=${AB_ITEMS:-Auto,DistanceGrid,Auto:hw} window_bench nbody 2048 "${v2[@]}")
 done
+# This bundle against an older one (OLD_VTK), one window benchmark process each, alternated:
+# the same items, machine and window, the binaries (and their libvtkSpaceSkip) of two commits.
+if has bench-oldnew && [ -f "${OLD_VTK:-}" ]; then
+  mkdir -p "$B/old"
+  xz -dc "$OLD_VTK" | tar -C "$B/old" -xf - || log "cannot unpack $OLD_VTK"
+  log "old bundle: $(cat "$B/old/vtk/COMMIT" 2>/dev/null | head -1)"
+  for r in ${OLDNEW_RUNS:-old new old new}; do
+    echo "==== $r bundle: $([ "$r" = old ] && cat "$B/old/vtk/COMMIT" 2>/dev/null | head -1 || cat "$B/vtk/COMMIT" 2>/dev/null | head -1)" >> "$work/bench.log"
+    if [ "$r" = old ]; then
+      (bench=$B/old/vtk/bin/spaceskip_window_bench
+       export LD_LIBRARY_PATH=$B/old/vtk/lib${LD_LIBRARY_PATH#$B/vtk/lib}
+       ITEMS=${OLDNEW_ITEMS:-Auto:hw,Auto} window_bench nbody "${OLDNEW_N:-2048}" "${v2[@]}")
+    else
+      ITEMS=${OLDNEW_ITEMS:-Auto:hw,Auto} window_bench nbody "${OLDNEW_N:-2048}" "${v2[@]}"
+    fi
+  done
+fi
 # The interop path under compute-sanitizer (the mapper tests draw through host memory on Mesa).
 if has interop-memcheck && ! late; then
   log "interop memcheck"

@@ -54,6 +54,8 @@ struct LatticeView {
 
 /// Most iso values the isosurface blend mode takes (they travel in the FrameView).
 constexpr int kMaxIsoValues = 16;
+/// Most samples a GPU march fetches before compositing the first of them (FrameView::sampleBatch).
+constexpr int kMaxSampleBatch = 4;
 
 /// A light of the light list (RenderParams::lights) in the frame's origin-relative world space.
 struct LightView {
@@ -113,6 +115,11 @@ struct FrameView {
   float alphaLo, alphaScale;    ///< opacity channel -> table entry: (v - alphaLo) * alphaScale
   float rgbLo[3], rgbScale[3];  ///< 4 components: colour c = clamp((v_c - rgbLo[c]) * rgbScale[c], 0, 1)
   int gradientComponent;        ///< shading: the component whose gradient lights a sample
+  /// Samples of a run fetched together before any is composited in plain frames, with samplers
+  /// that ask for it (IntervalMarcher::takeBatch, SamplerBatch): 1..kMaxSampleBatch; <= 1: one
+  /// at a time. The CUDA executor sets it (the host's cores overlap the fetches of a loop on
+  /// their own); the image is the same either way.
+  int sampleBatch;
 };
 
 }  // namespace spaceskip

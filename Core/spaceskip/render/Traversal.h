@@ -25,17 +25,21 @@ enum class Step : int { Skip, Interval, Done };
 /// parts only (no memory reads beyond the mask).
 template <bool Parts>
 struct GridIterT {
+  // The DDA's per-axis state is vec3 (axisOf/setAxis, Math.h), never an array indexed by the
+  // axis the ray steps along: that index is known at run time only, and such an array would put
+  // the whole iterator in local memory on a GPU (152 bytes a thread, loaded and stored at every
+  // step of every ray: round 14).
   const GridView* g;
   vec3f org, dir, inv;
   float t, tmax, B;
-  int cell[3], step[3];
-  float tNext[3], tDelta[3];
+  vec3i cell, step;
+  vec3f tNext, tDelta;
   bool done;
   // The brick being walked part by part: its mask (0: none), the part, where the ray leaves
   // the part along each axis, the cursor and where the ray leaves the brick.
   uint64_t mask = 0;
-  int sc[3];
-  float sNext[3];
+  vec3i sc;
+  vec3f sNext;
   float ts, tsEnd;
 
   /// The next run of set parts of the brick being walked: [a, b). false: the brick is done.
@@ -43,9 +47,9 @@ struct GridIterT {
     const float S = B * (1.f / float(kSubPerAxis));
     bool have = false;
     while (ts < tsEnd) {
-      const int axis = sNext[0] < sNext[1] ? (sNext[0] < sNext[2] ? 0 : 2) : (sNext[1] < sNext[2] ? 1 : 2);
-      const bool set = (mask >> (sc[0] + kSubPerAxis * (sc[1] + kSubPerAxis * sc[2]))) & 1u;
-      const float te = ss_max(ts, ss_min(sNext[axis], tsEnd));
+      const int axis = sNext.x < sNext.y ? (sNext.x < sNext.z ? 0 : 2) : (sNext.y < sNext.z ? 1 : 2);
+      const bool set = (mask >> (sc.x + kSubPerAxis * (sc.y + kSubPerAxis * sc.z))) & 1u;
+      const float te = ss_max(ts, ss_min(axisOf(sNext, axis), tsEnd));
       if (set && !have) {
         a = ts;
         have = true;
@@ -53,9 +57,11 @@ struct GridIterT {
         break;  // the run ends where this part begins
       }
       ts = te;
-      sc[axis] += step[axis];
-      sNext[axis] += float(step[axis]) * S * inv[axis];
-      if (sc[axis] < 0 || sc[axis] >= kSubPerAxis) ts = tsEnd;  // left the brick
+      const int st = axisOf(step, axis);
+      const int c = axisOf(sc, axis) + st;
+      setAxis(sc, axis, c);
+      setAxis(sNext, axis, axisOf(sNext, axis) + float(st) * S * axisOf(inv, axis));
+      if (c < 0 || c >= kSubPerAxis) ts = tsEnd;  // left the brick
     }
     if (have) {
       b = ts;
@@ -66,24 +72,26 @@ struct GridIterT {
   }
 
   /// Starts walking the parts of brick `c` (mask `m`) from t0 to t1.
-  SS_FUNC void enterParts(const int c[3], uint64_t m, float t0, float t1) {
+  SS_FUNC void enterParts(vec3i c, uint64_t m, float t0, float t1) {
     const float S = B * (1.f / float(kSubPerAxis));
     mask = m;
     ts = t0;
     tsEnd = t1;
     const vec3f p = org + dir * t0;
     for (int a = 0; a < 3; ++a) {
-      const float base = float(c[a]) * B;
-      int k = int(floorf((p[a] - base) / S));
+      const float base = float(axisOf(c, a)) * B;
+      int k = int(floorf((axisOf(p, a) - base) / S));
       k = ss_maxi(0, ss_mini(k, kSubPerAxis - 1));
-      sc[a] = k;
-      sNext[a] = step[a] == 0 ? INFINITY : (base + float(step[a] > 0 ? k + 1 : k) * S - org[a]) * inv[a];
+      setAxis(sc, a, k);
+      const int st = axisOf(step, a);
+      setAxis(sNext, a, st == 0 ? INFINITY : (base + float(st > 0 ? k + 1 : k) * S - axisOf(org, a)) * axisOf(inv, a));
     }
   }
 
   /// Where the ray leaves cell c along axis a (the cell's far face in the step direction).
   SS_FUNC float exitOf(int a, int c) const {
-    return step[a] == 0 ? INFINITY : (float(step[a] > 0 ? c + 1 : c) * B - org[a]) * inv[a];
+    const int st = axisOf(step, a);
+    return st == 0 ? INFINITY : (float(st > 0 ? c + 1 : c) * B - axisOf(org, a)) * axisOf(inv, a);
   }
 
   SS_FUNC void init(const GridView& grid, const Ray& r, vec3f invDir, float tmin, float tEnd) {
@@ -99,13 +107,14 @@ struct GridIterT {
     if (done) return;
     const vec3f p = org + dir * tmin;
     for (int a = 0; a < 3; ++a) {
-      int c = int(floorf(p[a] / B));
-      c = ss_maxi(0, ss_mini(c, grid.dims[a] - 1));
-      cell[a] = c;
-      const float d = dir[a];
-      step[a] = d > 0.f ? 1 : d < 0.f ? -1 : 0;
-      tDelta[a] = step[a] == 0 ? INFINITY : float(step[a]) * B * inv[a];
-      tNext[a] = exitOf(a, c);
+      int c = int(floorf(axisOf(p, a) / B));
+      c = ss_maxi(0, ss_mini(c, axisOf(grid.dims, a) - 1));
+      setAxis(cell, a, c);
+      const float d = axisOf(dir, a);
+      const int st = d > 0.f ? 1 : d < 0.f ? -1 : 0;
+      setAxis(step, a, st);
+      setAxis(tDelta, a, st == 0 ? INFINITY : float(st) * B * axisOf(inv, a));
+      setAxis(tNext, a, exitOf(a, c));
     }
   }
 
@@ -116,7 +125,7 @@ struct GridIterT {
       done = true;
       return Step::Done;
     }
-    const int64_t idx = cell[0] + int64_t(g->dims.x) * (cell[1] + int64_t(g->dims.y) * cell[2]);
+    const int64_t idx = cell.x + int64_t(g->dims.x) * (cell.y + int64_t(g->dims.y) * cell.z);
     int dist;
     bool walkParts = false;
     if (g->vmin) {
@@ -133,7 +142,7 @@ struct GridIterT {
       float tJump = INFINITY;
       int ja = 0;
       for (int ax = 0; ax < 3; ++ax) {
-        const float ta = exitOf(ax, cell[ax] + step[ax] * rad);  // the cube's far face on axis ax
+        const float ta = exitOf(ax, axisOf(cell, ax) + axisOf(step, ax) * rad);  // the cube's far face on axis ax
         if (ta < tJump) {
           tJump = ta;
           ja = ax;
@@ -145,33 +154,35 @@ struct GridIterT {
       }
       const vec3f q = org + dir * tJump;
       for (int ax = 0; ax < 3; ++ax) {
+        const int ca = axisOf(cell, ax);
         int c;
         if (ax == ja) {
-          c = cell[ax] + step[ax] * (rad + 1);
+          c = ca + axisOf(step, ax) * (rad + 1);
         } else {  // still inside the cube's slab on this axis (clamped against rounding)
-          c = int(floorf(q[ax] / B));
-          c = ss_maxi(ss_maxi(cell[ax] - rad, 0), ss_mini(c, ss_mini(cell[ax] + rad, g->dims[ax] - 1)));
+          c = int(floorf(axisOf(q, ax) / B));
+          c = ss_maxi(ss_maxi(ca - rad, 0), ss_mini(c, ss_mini(ca + rad, axisOf(g->dims, ax) - 1)));
         }
-        if (c < 0 || c >= g->dims[ax]) {  // left the grid
+        if (c < 0 || c >= axisOf(g->dims, ax)) {  // left the grid
           done = true;
           return Step::Done;
         }
-        cell[ax] = c;
-        tNext[ax] = exitOf(ax, c);
+        setAxis(cell, ax, c);
+        setAxis(tNext, ax, exitOf(ax, c));
       }
       t = ss_max(t, tJump);
       return Step::Skip;
     }
-    const int axis = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
-    const float tExit = ss_max(t, ss_min(tNext[axis], tmax));
+    const int axis = tNext.x < tNext.y ? (tNext.x < tNext.z ? 0 : 2) : (tNext.y < tNext.z ? 1 : 2);
+    const float tExit = ss_max(t, ss_min(axisOf(tNext, axis), tmax));
     a = t;
     b = tExit;
     t = tExit;
     const uint64_t parts = Parts && dist == 0 && walkParts ? g->sub[idx] : ~uint64_t(0);
     if (Parts && parts != ~uint64_t(0)) enterParts(cell, parts, a, tExit);
-    cell[axis] += step[axis];
-    tNext[axis] += tDelta[axis];
-    if (cell[axis] < 0 || cell[axis] >= g->dims[axis]) done = true;
+    const int c = axisOf(cell, axis) + axisOf(step, axis);
+    setAxis(cell, axis, c);
+    setAxis(tNext, axis, axisOf(tNext, axis) + axisOf(tDelta, axis));
+    if (c < 0 || c >= axisOf(g->dims, axis)) done = true;
     if (dist != 0) return Step::Skip;
     if (!Parts || parts == ~uint64_t(0)) return Step::Interval;
     return mask && partRun(a, b) ? Step::Interval : Step::Skip;

@@ -8,7 +8,7 @@
 // edit's frame with). Run by Testing/gpu/run-gpu-vtk.sh.
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
-//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:sync|:full|:float|:glblend|:segN]]
+//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:sync|:full|:float|:glblend|:segN|:batchN]]
 //       [--vtk-gpu]
 //       [--edits E (4)] [--edit-cut C (the edits move the ramp's zero between 10% and C of the
 //        range: 0.3 by default, which changes N-body's occupied cells; 0.2 does not, as its
@@ -26,7 +26,8 @@
 // the whole window, not the volume's rectangle), :float the mapper's EightBitComposite off (a
 // float texture), :glblend SPACESKIP_CUDA_BLEND=0 (the image copied into a texture that GL
 // draws, instead of blended by CUDA into the window's framebuffer), :segN SPACESKIP_RAY_SEGMENTS=N
-// (rays cut into N segments; 1: whole rays). Columns render_ms and finish_ms split the frame into the time in Render() and
+// (rays cut into N segments; 1: whole rays), :batchN SPACESKIP_SAMPLE_BATCH=N (samples a GPU
+// march fetches together; 1: one at a time). Columns render_ms and finish_ms split the frame into the time in Render() and
 // the wait in glFinish() after it. stream_ms / stream_fps: the same orbit rendered back to back
 // with one glFinish() at the end (throughput; frame_ms is the latency of one waited-for frame).
 // edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
@@ -288,6 +289,7 @@ struct Item
   bool floatComposite = false;
   bool glBlend = false; ///< SPACESKIP_CUDA_BLEND=0
   int segments = 0;     ///< SPACESKIP_RAY_SEGMENTS (0: unset, the default)
+  int batch = 0;        ///< SPACESKIP_SAMPLE_BATCH (0: unset, the default)
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -353,6 +355,10 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i].rfind("seg", 0) == 0 && parts[i].size() > 3)
     {
       it.segments = std::atoi(parts[i].c_str() + 3);
+    }
+    else if (parts[i].rfind("batch", 0) == 0 && parts[i].size() > 5)
+    {
+      it.batch = std::atoi(parts[i].c_str() + 5);
     }
     else
     {
@@ -692,6 +698,10 @@ int main(int argc, char* argv[])
       setenv("SPACESKIP_RAY_SEGMENTS", std::to_string(it.segments).c_str(), 1);
     else
       unsetenv("SPACESKIP_RAY_SEGMENTS");
+    if (it.batch > 0)
+      setenv("SPACESKIP_SAMPLE_BATCH", std::to_string(it.batch).c_str(), 1);
+    else
+      unsetenv("SPACESKIP_SAMPLE_BATCH");
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
