@@ -71,9 +71,4 @@ if has resident; then
     run "resident$r-$n" SPACESKIP_CUDA_RESIDENT=$r
   done
 fi
-{
-  for f in "$out"/*.csv; do
-    [ -f "$f" ] && { echo "== $f"; cut -d, -f1,6,7,13,14,17,18,26,33,34 "$f"; }
-  done
-} > "$out/summary.txt" 2>&1
-cat "$out/summary.txt"
+summarize

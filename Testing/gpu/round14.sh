@@ -17,15 +17,8 @@ shift
 phases=${*:-tests batch}
 source "$(dirname "$0")/ab-common.sh"
 if has tests && ! late; then
-  cs=$(command -v compute-sanitizer || echo /usr/local/cuda/bin/compute-sanitizer)
-  timeout 240 "$cs" --tool memcheck --error-exitcode 3 ./build-new/spaceskip_core_tests \
-    --gtest_filter="${MEMCHECK_FILTER:-DeviceImage.*:CudaBackend.*}" > "$out/memcheck.log" 2>&1
-  log "memcheck rc=$?"
-  tail -3 "$out/memcheck.log"
-  timeout 120 "$cs" --tool racecheck --error-exitcode 3 ./build-new/spaceskip_core_tests \
-    --gtest_filter="${RACECHECK_FILTER:-CudaBackend.SegmentedRaysRenderTheSameImage}" > "$out/racecheck.log" 2>&1
-  log "racecheck rc=$?"
-  tail -3 "$out/racecheck.log"
+  sanitize memcheck "${MEMCHECK_FILTER:-DeviceImage.*:CudaBackend.*}"
+  sanitize racecheck "${RACECHECK_FILTER:-CudaBackend.SegmentedRaysRenderTheSameImage}" 120
 fi
 sets=${DATASETS:-nbody_2048,nbody_1024,menger_sponge,richtmyer_meshkov,kingsnake}
 items=${ITEMS:-naive,distance-grid,distance-grid:hw,auto}
@@ -46,9 +39,4 @@ if has batch; then
     log "$name rc=$? SPACESKIP_SAMPLE_BATCH=$b ${seg[*]}"
   done
 fi
-{
-  for f in "$out"/*.csv; do
-    [ -f "$f" ] && { echo "== $f"; cut -d, -f1,6,7,13,14,17,18,26,33,34 "$f"; }
-  done
-} > "$out/summary.txt" 2>&1
-cat "$out/summary.txt"
+summarize
