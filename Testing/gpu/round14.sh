@@ -32,11 +32,12 @@ if has batch; then
     [ "$spec" != "$b" ] && seg=(SPACESKIP_RAY_SEGMENTS="${spec#*:}")
     bin=build-new/spaceskip
     [ "$b" = old ] && bin=build-old/spaceskip
+    [[ "$b" =~ ^[0-9]+$ ]] && seg+=(SPACESKIP_SAMPLE_BATCH="$b")
     [ -x "$bin" ] || { log "$bin missing"; continue; }
     name="batch${spec/:/-seg}-$n"
-    env SPACESKIP_SAMPLE_BATCH="$b" "${seg[@]}" timeout 200 "$bin" bench --paper --datasets "$sets" \
+    env "${seg[@]}" timeout 200 "$bin" bench --paper --datasets "$sets" \
       --builders "$items" --frames "${FRAMES:-8}" --csv "$out/$name.csv" > "$out/$name.log" 2>&1
-    log "$name rc=$? SPACESKIP_SAMPLE_BATCH=$b ${seg[*]}"
+    log "$name rc=$? ${seg[*]}"
   done
 fi
 summarize
