@@ -18,8 +18,10 @@ namespace {
 // One kernel per traversal: a kernel holding every traversal is allocated the registers of the
 // tree traversal (64 per thread, half occupancy), which the naive and grid marches do not need.
 // SPACESKIP_CUDA_HW_MIN_BLOCKS > 1 asks the hardware-filtered kernels to fit that many blocks of
-// 256 threads per SM (a register cap). Measured on the H100 (round 3): 6 (40 registers) made
-// every ESS kernel 4-11% slower than no cap, so the default is 1 (no cap).
+// 256 threads per SM (a register cap). Measured on the H100: in round 3, 6 (40 registers) made
+// every ESS kernel 4-11% slower than no cap; in round 14, with batches of samples (102 registers
+// for the grid kernels), 3 (85 registers) made the hardware-filtered DistanceGrid 1.06-1.17x
+// faster on five stand-ins (docs/results/round14-h100), hence the default 3.
 constexpr int kMaxRenderThreads = 256;
 // Default launch of the hardware-filtered kernels: plain for volumes up to kLargeTextureBytes; a
 // persistent launch with kLargeTextureResident blocks of 128 threads per SM above, for Naive
@@ -35,7 +37,7 @@ struct RenderMinBlocks {
   static constexpr int value = 1;
 };
 #ifndef SPACESKIP_CUDA_HW_MIN_BLOCKS
-#define SPACESKIP_CUDA_HW_MIN_BLOCKS 1  // CMake: SPACESKIP_CUDA_HW_MIN_BLOCKS (1 = no register cap)
+#define SPACESKIP_CUDA_HW_MIN_BLOCKS 3  // CMake: SPACESKIP_CUDA_HW_MIN_BLOCKS (1 = no register cap)
 #endif
 template <>
 struct RenderMinBlocks<TextureSampler> {
