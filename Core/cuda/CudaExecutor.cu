@@ -48,24 +48,35 @@ struct RenderMinBlocks<TextureSampler> {
 // launch is persistent: a fixed number of resident blocks take tiles in row-major order from the
 // counter until none are left, which bounds the warps in flight (the volume's cache working set)
 // and balances blocks whose rays cost very different amounts.
+// Segmented frames (gridDim.z > 1: segment blockIdx.z of every ray into its own layer of `out`)
+// cover only the pixels of `rect` (x0, y0, x1, y1; boxPixelRect: the others render 0); with
+// `flags` a segment writes its layer only where it coloured the pixel and says so in flags
+// (SegmentLayers): most segments of a sparse volume colour nothing.
 template <class Sampler, int Traversal, bool Plain>
 __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::value)
     renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out,
-                 unsigned* tileCounter) {
-  const unsigned tilesX = (unsigned(f.width) + blockDim.x - 1) / blockDim.x;
-  // gridDim.z > 1: segment blockIdx.z of every ray into its own layer of `out` (RaySegments).
+                 unsigned* tileCounter, int4 rect, unsigned char* flags) {
+  const unsigned tilesX = (unsigned(rect.z - rect.x) + blockDim.x - 1) / blockDim.x;
   const int segment = int(blockIdx.z), segments = int(gridDim.z);
   auto tile = [&](unsigned tx, unsigned ty) {
-    const int x = int(tx * blockDim.x + threadIdx.x), y = int(ty * blockDim.y + threadIdx.y);
-    if (x < f.width && y < f.height)
-      out[(int64_t(segment) * f.height + y) * f.width + x] =
-          renderPixel<Sampler, Traversal, Plain>(f, s, x, y, segment, segments);
+    const int x = rect.x + int(tx * blockDim.x + threadIdx.x), y = rect.y + int(ty * blockDim.y + threadIdx.y);
+    if (x < rect.z && y < rect.w) {
+      const int64_t i = (int64_t(segment) * f.height + y) * f.width + x;
+      const vec4f c = renderPixel<Sampler, Traversal, Plain>(f, s, x, y, segment, segments);
+      if (!flags) {
+        out[i] = c;
+      } else {
+        const bool coloured = c.x != 0.f || c.y != 0.f || c.z != 0.f || c.w != 0.f;
+        flags[i] = coloured;
+        if (coloured) out[i] = c;
+      }
+    }
   };
   if (!tileCounter) {
     tile(blockIdx.x, blockIdx.y);
     return;
   }
-  const unsigned numTiles = tilesX * ((unsigned(f.height) + blockDim.y - 1) / blockDim.y);
+  const unsigned numTiles = tilesX * ((unsigned(rect.w - rect.y) + blockDim.y - 1) / blockDim.y);
   __shared__ unsigned next;
   for (;;) {
     if (threadIdx.x == 0 && threadIdx.y == 0) next = atomicAdd(tileCounter, 1u);
@@ -78,14 +89,29 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
 }
 
 // The layers of a segmented frame composited front to back into the image: one thread a pixel.
-__global__ void compositeSegmentsKernel(const vec4f* layers, int segments, int64_t pixels, vec4f* out) {
+// Outside `rect` no ray met the box: 0. With `flags` only the layers a segment coloured are
+// read; "over" with a (0, 0, 0, 0) layer leaves the colour bit for bit as it was, so skipping
+// them gives the same image as compositing every layer.
+__global__ void compositeSegmentsKernel(const vec4f* layers, const unsigned char* flags, int segments, int width,
+                                        int height, int4 rect, vec4f* out) {
+  const int64_t pixels = int64_t(width) * height;
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i >= pixels) return;
-  vec4f c = layers[int64_t(segments - 1) * pixels + i];
-  for (int k = segments - 2; k >= 0; --k) {
-    const vec4f l = layers[int64_t(k) * pixels + i];
-    const float keep = 1.f - l.w;
-    c = vec4f{l.x + keep * c.x, l.y + keep * c.y, l.z + keep * c.z, l.w + keep * c.w};
+  const int x = int(i % width), y = int(i / width);
+  vec4f c{0, 0, 0, 0};
+  if (x >= rect.x && x < rect.z && y >= rect.y && y < rect.w) {
+    int k = segments - 1;
+    if (flags)
+      while (k >= 0 && !flags[int64_t(k) * pixels + i]) --k;
+    if (k >= 0) {
+      c = layers[int64_t(k) * pixels + i];
+      for (--k; k >= 0; --k) {
+        if (flags && !flags[int64_t(k) * pixels + i]) continue;
+        const vec4f l = layers[int64_t(k) * pixels + i];
+        const float keep = 1.f - l.w;
+        c = vec4f{l.x + keep * c.x, l.y + keep * c.y, l.z + keep * c.z, l.w + keep * c.w};
+      }
+    }
   }
   out[i] = c;
 }
@@ -96,7 +122,7 @@ template <class T>
 struct IsPoolSampler<PoolSampler<T>> : std::true_type {};
 
 template <class Sampler>
-using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*);
+using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*, int4, unsigned char*);
 
 template <class Sampler, bool Plain>
 RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
@@ -156,6 +182,15 @@ int sampleBatch() {
   const char* e = std::getenv("SPACESKIP_SAMPLE_BATCH");
   const int n = e ? std::atoi(e) : kMaxSampleBatch;
   return std::max(1, std::min(kMaxSampleBatch, n));
+}
+
+/// How a segmented frame's layers are laid out (CudaExecutor::launch): SPACESKIP_SEGMENT_LAYERS.
+enum class SegmentLayers { Dense, Flags, Rect };
+SegmentLayers segmentLayers() {
+  const char* e = std::getenv("SPACESKIP_SEGMENT_LAYERS");
+  if (e && std::strcmp(e, "dense") == 0) return SegmentLayers::Dense;
+  if (e && std::strcmp(e, "flags") == 0) return SegmentLayers::Flags;
+  return SegmentLayers::Rect;
 }
 
 bool validBlock(const LaunchParams& p) {
@@ -332,21 +367,42 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
     const int forced = seg ? std::max(0, std::min(16, std::atoi(seg))) : 0;
     const int segments = forced > 0 ? forced : raySegments(f);
     if (segments > 1 && segmentableFrame(f)) {
+      // The layers cover the pixels whose rays can meet the box (boxPixelRect), and a segment
+      // writes its layer only where it coloured the pixel (flags): at N-body 2048^3 in a 1024^2
+      // window about half the pixels miss the box and most segments colour nothing, which spared
+      // the layers' traffic (4 x 16 MB written and read a frame). SPACESKIP_SEGMENT_LAYERS (read
+      // per frame), a measurement switch: "dense" every pixel and layer (round 13's layout),
+      // "flags" every pixel with flags, else (the default) the rectangle with flags.
+      const SegmentLayers layout = segmentLayers();
       const int64_t pixels = int64_t(f.width) * f.height;
+      int rect[4] = {0, 0, f.width, f.height};
+      if (layout == SegmentLayers::Rect) boxPixelRect(f, rect);
+      const int4 r = make_int4(rect[0], rect[1], rect[2], rect[3]);
       d_layers_.reserve(size_t(pixels) * size_t(segments));
-      k<<<dim3(grid.x, grid.y, unsigned(segments)), block, 0, stream>>>(f, s, d_layers_.get(), nullptr);
-      compositeSegmentsKernel<<<unsigned((pixels + 255) / 256), 256, 0, stream>>>(d_layers_.get(), segments, pixels,
+      unsigned char* flags = nullptr;
+      if (layout != SegmentLayers::Dense) {
+        d_layerFlags_.reserve(size_t(pixels) * size_t(segments));
+        flags = d_layerFlags_.get();
+      }
+      if (r.z > r.x && r.w > r.y) {
+        const dim3 rectGrid(unsigned((r.z - r.x + int(block.x) - 1) / int(block.x)),
+                            unsigned((r.w - r.y + int(block.y) - 1) / int(block.y)), unsigned(segments));
+        k<<<rectGrid, block, 0, stream>>>(f, s, d_layers_.get(), nullptr, r, flags);
+      }
+      compositeSegmentsKernel<<<unsigned((pixels + 255) / 256), 256, 0, stream>>>(d_layers_.get(), flags, segments,
+                                                                                    f.width, f.height, r,
                                                                                     d_image_.get());
       return;
     }
-    k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr);
+    k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr, make_int4(0, 0, f.width, f.height), nullptr);
     return;
   }
   d_tileCounter_.reserve(1);
   SS_CUDA_CHECK(cudaMemsetAsync(d_tileCounter_.get(), 0, sizeof(unsigned), stream));
   const unsigned tiles = grid.x * grid.y;
   const unsigned blocks = std::min(tiles, unsigned(residentBlocks) * unsigned(numSMs_));
-  k<<<blocks, block, 0, stream>>>(f, s, d_image_.get(), d_tileCounter_.get());
+  k<<<blocks, block, 0, stream>>>(f, s, d_image_.get(), d_tileCounter_.get(), make_int4(0, 0, f.width, f.height),
+                                  nullptr);
 }
 
 }  // namespace spaceskip::cuda

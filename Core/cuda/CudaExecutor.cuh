@@ -56,6 +56,7 @@ class CudaExecutor {
   DeviceBuffer<vec4f> d_image_;
   DeviceBuffer<unsigned> d_tileCounter_;
   DeviceBuffer<vec4f> d_layers_;  ///< a segmented frame's layers (SPACESKIP_RAY_SEGMENTS)
+  DeviceBuffer<unsigned char> d_layerFlags_;  ///< which layers a segment coloured (1) or left empty (0)
   PinnedBuffer h_stage_;           ///< pinned copy of the last frame's image on its way to the caller
   bool imageOnDevice_ = false;     ///< setImageOnDevice(): leave the image in d_image_
   bool deviceImageValid_ = false;  ///< the last render() left its image in d_image_

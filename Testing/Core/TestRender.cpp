@@ -1,7 +1,11 @@
 // Lossless skipping: the grid image equals the naive image on several volumes and cameras.
 #include "TestUtil.h"
+#include "spaceskip/Camera.h"
+#include "spaceskip/render/RayGen.h"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 using namespace spaceskip;
 
@@ -92,4 +96,86 @@ TEST(Render, DepthBufferClipsTheVolume) {
   e.render(cam, 32, 32, half, depth.data());
   EXPECT_GT(test::coverage(half), 0.0);
   EXPECT_LT(test::coverage(half), test::coverage(all));
+}
+
+namespace {
+// A frame as Engine::render sets it up for a volume at the origin: the camera's inverse, and
+// index space given by `spacing` and a rotation of 30 degrees about z (a direction matrix).
+FrameView rectFrame(const Camera& cam, int w, int h, vec3f boxHi, const double spacing[3], bool rotated) {
+  FrameView f{};
+  mat4 vp = multiply(cam.proj, cam.view), ivp;
+  EXPECT_TRUE(invert(vp, ivp));
+  for (int i = 0; i < 16; ++i) f.invViewProj[i] = float(ivp.m[i]);
+  const double a = rotated ? 30.0 * M_PI / 180.0 : 0.0;
+  mat4 i2w = identity4();
+  const double R[3][3] = {{std::cos(a), -std::sin(a), 0}, {std::sin(a), std::cos(a), 0}, {0, 0, 1}};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) i2w.m[c * 4 + r] = R[r][c] * spacing[c];
+  mat4 w2i;
+  EXPECT_TRUE(invert(i2w, w2i));
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) f.worldToIndex[r * 4 + c] = float(w2i.m[c * 4 + r]);
+  f.width = w;
+  f.height = h;
+  f.boxHi = boxHi;
+  return f;
+}
+}  // namespace
+
+TEST(BoxPixelRect, NoRayOutsideMeetsTheBox) {
+  // The CUDA executor marches a segmented frame's rays only inside boxPixelRect and writes 0
+  // elsewhere: no pixel outside may have a ray that meets the box (primaryRay, the rays both
+  // backends march). Orthographic orbits (the paper's protocol), perspective ones, a zoom that
+  // puts part of the box off screen, anisotropic spacing, a rotated volume, and a camera inside
+  // the box (the whole frame); the rect must also leave pixels out where the box is small.
+  const vec3f boxHi{63, 40, 95};
+  const double unit[3] = {1, 1, 1}, aniso[3] = {0.5, 2.0, 1.25};
+  int cameras = 0, smaller = 0;
+  for (const double* sp : {unit, aniso}) {
+    for (bool rotated : {false, true}) {
+      const double b[6] = {-40, 100, -40, 100, -40, 130};
+      for (bool persp : {false, true}) {
+        for (double zoom : {0.6, 1.0, 2.5}) {
+          for (double az : {0.0, 33.0, 120.0, 250.0}) {
+            const int w = 160, h = 120;
+            const Camera cam = orbitCamera(b, az, 20, zoom, persp, double(w) / h);
+            const FrameView f = rectFrame(cam, w, h, boxHi, sp, rotated);
+            int rect[4];
+            boxPixelRect(f, rect);
+            ASSERT_LE(0, rect[0]);
+            ASSERT_LE(rect[2], w);
+            ASSERT_LE(rect[0], rect[2]);
+            ASSERT_LE(0, rect[1]);
+            ASSERT_LE(rect[3], h);
+            ASSERT_LE(rect[1], rect[3]);
+            int hits = 0;
+            for (int y = 0; y < h; ++y)
+              for (int x = 0; x < w; ++x) {
+                const PrimaryRay p = primaryRay(f, x, y);
+                const bool meets = p.tEnter < p.tExit;
+                hits += meets;
+                const bool inside = x >= rect[0] && x < rect[2] && y >= rect[1] && y < rect[3];
+                if (meets && !inside)
+                  FAIL() << "pixel " << x << "," << y << " meets the box outside rect " << rect[0] << ","
+                         << rect[1] << "-" << rect[2] << "," << rect[3] << " az " << az << " zoom " << zoom
+                         << " persp " << persp;
+              }
+            ++cameras;
+            if ((rect[2] - rect[0]) * (rect[3] - rect[1]) < w * h) ++smaller;
+            EXPECT_GT(hits, 0);
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GE(smaller, cameras / 3);  // the zoom-0.6 and 1.0 views leave margins
+  // Inside the box: corners behind the eye, the whole frame.
+  const double eye[3] = {30, 20, 40}, centre[3] = {30, 20, 90}, up[3] = {0, 1, 0};
+  const FrameView f = rectFrame(lookAtCamera(eye, centre, up, true, 60, 1.0, 0.1, 500), 64, 64, boxHi, unit, false);
+  int rect[4];
+  boxPixelRect(f, rect);
+  EXPECT_EQ(rect[0], 0);
+  EXPECT_EQ(rect[1], 0);
+  EXPECT_EQ(rect[2], 64);
+  EXPECT_EQ(rect[3], 64);
 }

@@ -3,6 +3,9 @@
 #pragma once
 #include "FrameShared.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace spaceskip {
 
 /// A pixel's ray in index space over [tEnter, tExit) (empty when !(tEnter < tExit)), with the
@@ -59,6 +62,45 @@ SS_FUNC PrimaryRay primaryRay(const FrameView& f, int px, int py) {
   p.tEnter = ss_max(p.tEnter, 0.f);
   p.tExit = ss_min(p.tExit, tLimit);
   return p;
+}
+
+/// The pixels whose rays can meet the index-space box [0, boxHi] (host only): rect = {x0, y0,
+/// x1, y1}, half-open, within the frame. A ray meets the box only where its pixel's centre lies
+/// in the box's projection, the hull of its 8 projected corners: their NDC bounds, widened by 2
+/// pixels against rounding. The whole frame when a matrix does not invert, a corner is not in
+/// front of the eye (w <= 0) or not finite. Every pixel outside the rect renders (0, 0, 0, 0).
+inline void boxPixelRect(const FrameView& f, int rect[4]) {
+  rect[0] = rect[1] = 0;
+  rect[2] = f.width;
+  rect[3] = f.height;
+  mat4 invVp{}, vp{}, w2i = identity4(), i2w{};
+  for (int i = 0; i < 16; ++i) invVp.m[i] = f.invViewProj[i];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) w2i.m[c * 4 + r] = f.worldToIndex[r * 4 + c];  // row-major 3x4
+  if (!invert(invVp, vp) || !invert(w2i, i2w)) return;
+  const mat4 m = multiply(vp, i2w);  // index -> clip
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (int corner = 0; corner < 8; ++corner) {
+    const double p[3] = {(corner & 1) ? double(f.boxHi.x) : 0.0, (corner & 2) ? double(f.boxHi.y) : 0.0,
+                         (corner & 4) ? double(f.boxHi.z) : 0.0};
+    double clip[4];
+    for (int r = 0; r < 4; ++r) clip[r] = m.m[r] * p[0] + m.m[4 + r] * p[1] + m.m[8 + r] * p[2] + m.m[12 + r];
+    if (!(clip[3] > 0.0) || !std::isfinite(clip[0] / clip[3]) || !std::isfinite(clip[1] / clip[3])) return;
+    for (int a = 0; a < 2; ++a) {
+      lo[a] = std::min(lo[a], clip[a] / clip[3]);
+      hi[a] = std::max(hi[a], clip[a] / clip[3]);
+    }
+  }
+  // Pixel p's centre is at NDC (p + 0.5) / n * 2 - 1 (primaryRay).
+  const int n[2] = {f.width, f.height};
+  for (int a = 0; a < 2; ++a) {
+    const double first = std::floor((lo[a] + 1) * 0.5 * n[a] - 0.5) - 2;
+    const double last = std::ceil((hi[a] + 1) * 0.5 * n[a] - 0.5) + 2;
+    const int x0 = int(std::max(0.0, std::min(first, double(n[a]))));
+    const int x1 = int(std::max(0.0, std::min(last + 1, double(n[a]))));
+    rect[a] = x0;
+    rect[2 + a] = std::max(x0, x1);
+  }
 }
 
 // -- Rendering one piece of a larger volume (FrameView::lattice, MPI) -------------------------

@@ -27,7 +27,9 @@
 // float texture), :glblend SPACESKIP_CUDA_BLEND=0 (the image copied into a texture that GL
 // draws, instead of blended by CUDA into the window's framebuffer), :segN SPACESKIP_RAY_SEGMENTS=N
 // (rays cut into N segments; 1: whole rays), :batchN SPACESKIP_SAMPLE_BATCH=N (samples a GPU
-// march fetches together; 1: one at a time). Columns render_ms and finish_ms split the frame into the time in Render() and
+// march fetches together; 1: one at a time), :layersdense / :layersflags
+// SPACESKIP_SEGMENT_LAYERS=dense / flags (a segmented frame's layers over every pixel, each
+// written (round 13), or over every pixel with flags; default: the box's pixel rectangle with flags). Columns render_ms and finish_ms split the frame into the time in Render() and
 // the wait in glFinish() after it. stream_ms / stream_fps: the same orbit rendered back to back
 // with one glFinish() at the end (throughput; frame_ms is the latency of one waited-for frame).
 // edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
@@ -290,6 +292,7 @@ struct Item
   bool glBlend = false; ///< SPACESKIP_CUDA_BLEND=0
   int segments = 0;     ///< SPACESKIP_RAY_SEGMENTS (0: unset, the default)
   int batch = 0;        ///< SPACESKIP_SAMPLE_BATCH (0: unset, the default)
+  std::string layers;   ///< SPACESKIP_SEGMENT_LAYERS (empty: unset, the default)
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -359,6 +362,10 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i].rfind("batch", 0) == 0 && parts[i].size() > 5)
     {
       it.batch = std::atoi(parts[i].c_str() + 5);
+    }
+    else if (parts[i] == "layersdense" || parts[i] == "layersflags")
+    {
+      it.layers = parts[i].substr(6);
     }
     else
     {
@@ -702,6 +709,10 @@ int main(int argc, char* argv[])
       setenv("SPACESKIP_SAMPLE_BATCH", std::to_string(it.batch).c_str(), 1);
     else
       unsetenv("SPACESKIP_SAMPLE_BATCH");
+    if (!it.layers.empty())
+      setenv("SPACESKIP_SEGMENT_LAYERS", it.layers.c_str(), 1);
+    else
+      unsetenv("SPACESKIP_SEGMENT_LAYERS");
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
