@@ -292,7 +292,8 @@ void vtkSpaceSkipCompositor::VisibleRect(const spaceskip::Camera& camera, vtkIma
 }
 
 //------------------------------------------------------------------------------
-bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image,
+bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin,
+  const spaceskip::DeviceImageView& image, const std::function<const void*()>& flatImage,
   void* stream, int width, int height, const int rect[4], bool eightBit)
 {
 #ifdef SPACESKIP_HAVE_CUDA
@@ -304,7 +305,8 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin, cons
     return true;
   }
 #endif
-  if (this->CopyToInteropTexture(renWin, image, stream, width, height, rect, eightBit))
+  const void* flat = flatImage ? flatImage() : image.image;
+  if (flat && this->CopyToInteropTexture(renWin, flat, stream, width, height, rect, eightBit))
   {
     this->Interop = true;
     this->CompositePath = "gpu";
@@ -491,7 +493,8 @@ void vtkSpaceSkipCompositor::ReleaseTarget()
 // CUDA failure on (said once at INFO verbosity).
 #ifdef SPACESKIP_HAVE_CUDA
 bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
-  const void* image, void* stream, int w, int h, const int rect[4], bool eightBit)
+  const spaceskip::DeviceImageView& image, void* stream, int w, int h, const int rect[4],
+  bool eightBit)
 {
   const char* off = std::getenv("SPACESKIP_CUDA_BLEND");
   if (this->TargetFailed || (off && off[0] == '0'))

@@ -6,7 +6,8 @@
 
 #include "vtkSmartPointer.h" // For the textures and the framebuffer
 
-#include <memory> // For Quad
+#include <functional> // For the flat image's getter
+#include <memory>     // For Quad
 #include <string> // For the problem and path texts
 #include <vector> // For the buffers
 
@@ -21,6 +22,7 @@ namespace spaceskip
 {
 class DeviceImageCopy;
 struct Camera;
+struct DeviceImageView;
 struct Image;
 }
 
@@ -60,10 +62,12 @@ public:
     int height, int rect[4]);
 
   /**
-   * Blends `rect` (VisibleRect) of the engine's device image (float4 RGBA) by CUDA straight into
+   * Blends `rect` (VisibleRect) of the engine's device image (Engine::deviceImageView: the
+   * float4 RGBA image, or a segmented frame's layers composited as they are blended) by CUDA straight into
    * the colour texture of the window's render framebuffer when that is the target being drawn
    * (single-sample RGBA8, draw buffer 0, all channels written), as GL's blend would (Draw() then
-   * has nothing left to do); otherwise copies it into a GL texture
+   * has nothing left to do); otherwise copies the flat image (`flatImage()`:
+   * Engine::deviceImage, which composites pending layers) into a GL texture
    * registered with CUDA, the one Draw() then blends: float texels, or with `eightBit` RGBA8
    * rounded as the host path rounds (a quarter of the bytes for the blend to read). The map,
    * copy and unmap are queued on `stream` (the engine's, Engine::deviceImageStream()) after the
@@ -72,8 +76,9 @@ public:
    * any failure (not NVIDIA's GL, another device, a CUDA error): said once at INFO verbosity,
    * and the host path is used from then on.
    */
-  bool CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int width,
-    int height, const int rect[4], bool eightBit);
+  bool CopyDeviceImage(vtkOpenGLRenderWindow* renWin, const spaceskip::DeviceImageView& image,
+    const std::function<const void*()>& flatImage, void* stream, int width, int height,
+    const int rect[4], bool eightBit);
 
   /**
    * Blends the image over what is drawn as premultiplied RGBA (ONE, ONE_MINUS_SRC_ALPHA), within
@@ -104,8 +109,8 @@ private:
   void ReleaseInterop();
   void ReleaseTarget();
   // Defined with CUDA only.
-  bool BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,
-    int h, const int rect[4], bool eightBit);
+  bool BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin, const spaceskip::DeviceImageView& image,
+    void* stream, int w, int h, const int rect[4], bool eightBit);
   bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,
     int h, const int rect[4], bool eightBit);
 

@@ -410,10 +410,13 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::Composite(vtkOpenGLRenderWindow
     2.0 + engine.sampleDistance() / std::max(minSpacing, 1e-300), width, height, rect);
   std::copy(rect, rect + 4, this->CompositeRect);
   const bool eightBit = this->Self->EightBitComposite != 0;
-  if (const void* deviceImage = engine.deviceImage())
+  const spaceskip::DeviceImageView deviceImage = engine.deviceImageView();
+  if (deviceImage.image)
   {
-    if (!this->Compositor.CopyDeviceImage(
-          renWin, deviceImage, engine.deviceImageStream(), width, height, rect, eightBit))
+    // The flat image only if the CUDA blend cannot read the layers (the texture path).
+    if (!this->Compositor.CopyDeviceImage(renWin, deviceImage,
+          [&engine]() { return engine.deviceImage(); }, engine.deviceImageStream(), width, height,
+          rect, eightBit))
     {
       engine.setImageOnDevice(false);
       engine.render(camera, width, height, this->Image, this->FrameDepth);
@@ -505,7 +508,7 @@ double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
   }
   // With the image kept on the GPU the engine returns once the kernel is launched: the pass is
   // the kernel's time (this waits for it).
-  if (engine->deviceImage())
+  if (engine->deviceImageStream())
   {
     const spaceskip::FrameStats& f = engine->frameStats();
     return f.deviceSeconds > 0 ? f.deviceSeconds : f.seconds;

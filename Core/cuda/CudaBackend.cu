@@ -181,8 +181,9 @@ class CudaBackend final : public Backend {
 
   bool setImageOnDevice(bool on) override { return exec_.setImageOnDevice(on); }
   const void* deviceImage() const override { return exec_.deviceImage(); }
+  DeviceImageView deviceImageView() const override { return exec_.deviceImageView(); }
   void* deviceImageStream() const override {
-    return exec_.deviceImage() ? static_cast<void*>(static_cast<cudaStream_t>(stream_)) : nullptr;
+    return exec_.hasDeviceImage() ? static_cast<void*>(static_cast<cudaStream_t>(stream_)) : nullptr;
   }
   void setLaunchParams(const LaunchParams& p) override { exec_.setLaunchParams(p); }
   double lastFrameDeviceSeconds() const override { return exec_.lastFrameDeviceSeconds(); }

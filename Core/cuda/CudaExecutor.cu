@@ -88,32 +88,12 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
   }
 }
 
-// The layers of a segmented frame composited front to back into the image: one thread a pixel.
-// Outside `rect` no ray met the box: 0. With `flags` only the layers a segment coloured are
-// read; "over" with a (0, 0, 0, 0) layer leaves the colour bit for bit as it was, so skipping
-// them gives the same image as compositing every layer.
-__global__ void compositeSegmentsKernel(const vec4f* layers, const unsigned char* flags, int segments, int width,
-                                        int height, int4 rect, vec4f* out) {
-  const int64_t pixels = int64_t(width) * height;
+// The layers of a segmented frame composited front to back into the image (compositeLayers,
+// SegmentLayers.h): one thread a pixel.
+__global__ void compositeSegmentsKernel(const SegmentLayersView v, vec4f* out) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i >= pixels) return;
-  const int x = int(i % width), y = int(i / width);
-  vec4f c{0, 0, 0, 0};
-  if (x >= rect.x && x < rect.z && y >= rect.y && y < rect.w) {
-    int k = segments - 1;
-    if (flags)
-      while (k >= 0 && !flags[int64_t(k) * pixels + i]) --k;
-    if (k >= 0) {
-      c = layers[int64_t(k) * pixels + i];
-      for (--k; k >= 0; --k) {
-        if (flags && !flags[int64_t(k) * pixels + i]) continue;
-        const vec4f l = layers[int64_t(k) * pixels + i];
-        const float keep = 1.f - l.w;
-        c = vec4f{l.x + keep * c.x, l.y + keep * c.y, l.z + keep * c.z, l.w + keep * c.w};
-      }
-    }
-  }
-  out[i] = c;
+  if (i >= int64_t(v.width) * v.height) return;
+  out[i] = compositeLayers(v, int(i % v.width), int(i / v.width));
 }
 
 template <class Sampler>
@@ -256,6 +236,8 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   lastDeviceSeconds_ = -1;
   f.tf = table_;
   f.sampleBatch = sampleBatch();
+  layers_ = SegmentLayersView{};  // launch() sets it for a segmented frame
+  deviceImageValid_ = false;
   f.depth = nullptr;
   if (depth) {
     d_depth_.reserve(pixels);
@@ -302,6 +284,16 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   }
   SS_CUDA_CHECK_LAUNCH(renderKernel);
   SS_CUDA_CHECK(injectedRenderError());
+  const char* sync = std::getenv("SPACESKIP_SYNC_FRAME");
+  const bool wait = sync && sync[0] == '1';
+  // A segmented frame's layers (launch) are composited into d_image_ here, or, when the image
+  // stays on the device, when someone asks for d_image_ (deviceImage()): the CUDA blend into a
+  // window reads the layers themselves (deviceImageView()), which spares writing and reading the
+  // flat image. SPACESKIP_FUSED_BLEND=0 (read per frame, a measurement switch) composites here.
+  const char* fuse = std::getenv("SPACESKIP_FUSED_BLEND");
+  stream_ = stream;
+  if (layers_.layers && !(imageOnDevice_ && !hostCounts && !wait && !(fuse && fuse[0] == '0')))
+    compositeLayers();
   SS_CUDA_CHECK(cudaEventRecord(ev1_, stream));
   out.width = f.width;
   out.height = f.height;
@@ -311,8 +303,7 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
     // download, and no wait here, so that the host's work for the frame overlaps the kernel.
     // SPACESKIP_SYNC_FRAME=1 (read per frame, a measurement switch) waits as before this change.
     out.rgba.clear();
-    const char* sync = std::getenv("SPACESKIP_SYNC_FRAME");
-    if (!(sync && sync[0] == '1')) {
+    if (!wait) {
       timingPending_ = true;
       deviceImageValid_ = true;
       return;
@@ -338,6 +329,28 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   if (staged) parallelCopy(out.rgba.data(), h_stage_.get(), imageBytes);
   SS_CUDA_CHECK(cudaEventElapsedTime(&ms, ev0_, ev1_));
   lastDeviceSeconds_ = double(ms) * 1e-3;
+}
+
+void CudaExecutor::compositeLayers() const {
+  if (!layers_.layers) return;
+  const int64_t pixels = int64_t(layers_.width) * layers_.height;
+  compositeSegmentsKernel<<<unsigned((pixels + 255) / 256), 256, 0, stream_>>>(layers_, d_image_.get());
+  SS_CUDA_CHECK_LAUNCH(compositeSegmentsKernel);
+  layers_ = SegmentLayersView{};
+}
+
+const void* CudaExecutor::deviceImage() const {
+  if (!deviceImageValid_) return nullptr;
+  compositeLayers();  // a segmented frame whose layers are still pending
+  return d_image_.get();
+}
+
+DeviceImageView CudaExecutor::deviceImageView() const {
+  DeviceImageView v;
+  if (!deviceImageValid_) return v;
+  v.image = d_image_.get();
+  v.layers = layers_;
+  return v;
 }
 
 template <class Sampler>
@@ -376,7 +389,13 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
       const SegmentLayers layout = segmentLayers();
       const int64_t pixels = int64_t(f.width) * f.height;
       int rect[4] = {0, 0, f.width, f.height};
-      if (layout == SegmentLayers::Rect) boxPixelRect(f, rect);
+      if (layout == SegmentLayers::Rect) {
+        boxPixelRect(f, rect);
+        // Whole tiles of the full frame's launch: the same pixels share a block as without the
+        // rect (measured: a rect cutting tiles made Menger's frame 1 % slower).
+        rect[0] -= rect[0] % int(block.x);
+        rect[1] -= rect[1] % int(block.y);
+      }
       const int4 r = make_int4(rect[0], rect[1], rect[2], rect[3]);
       d_layers_.reserve(size_t(pixels) * size_t(segments));
       unsigned char* flags = nullptr;
@@ -389,9 +408,12 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
                             unsigned((r.w - r.y + int(block.y) - 1) / int(block.y)), unsigned(segments));
         k<<<rectGrid, block, 0, stream>>>(f, s, d_layers_.get(), nullptr, r, flags);
       }
-      compositeSegmentsKernel<<<unsigned((pixels + 255) / 256), 256, 0, stream>>>(d_layers_.get(), flags, segments,
-                                                                                    f.width, f.height, r,
-                                                                                    d_image_.get());
+      layers_.layers = d_layers_.get();
+      layers_.flags = flags;
+      layers_.segments = segments;
+      layers_.width = f.width;
+      layers_.height = f.height;
+      std::copy(rect, rect + 4, layers_.rect);
       return;
     }
     k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr, make_int4(0, 0, f.width, f.height), nullptr);

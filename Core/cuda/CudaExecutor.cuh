@@ -4,6 +4,7 @@
 #pragma once
 #include "DeviceVolume.cuh"
 #include "spaceskip/BrickPool.h"
+#include "spaceskip/DeviceImageCopy.h"
 #include "spaceskip/LaunchParams.h"
 #include "spaceskip/Types.h"
 #include "spaceskip/render/Integrator.h"
@@ -32,12 +33,20 @@ class CudaExecutor {
     deviceImageValid_ = false;
     return true;
   }
-  const void* deviceImage() const { return deviceImageValid_ ? d_image_.get() : nullptr; }
+  /// The last frame's image in device memory (setImageOnDevice), or nullptr. A segmented frame's
+  /// layers still pending are composited into it first (queued on the frame's stream).
+  const void* deviceImage() const;
+  /// The same frame as deviceImage(), but a segmented frame's layers are not composited: the
+  /// view holds them instead (a reader that composites as it reads: DeviceImageCopy::blendOver).
+  DeviceImageView deviceImageView() const;
+  bool hasDeviceImage() const { return deviceImageValid_; }
   /// The last frame's kernel time (CUDA events). A frame left on the device is not waited for by
   /// render(): this waits for it, the first time it is asked.
   double lastFrameDeviceSeconds() const;
 
  private:
+  /// Queues the composite of layers_ (a segmented frame's, when set) into d_image_ on stream_.
+  void compositeLayers() const;
   template <class Sampler>
   void launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes, cudaStream_t stream);
 
@@ -57,6 +66,8 @@ class CudaExecutor {
   DeviceBuffer<unsigned> d_tileCounter_;
   DeviceBuffer<vec4f> d_layers_;  ///< a segmented frame's layers (SPACESKIP_RAY_SEGMENTS)
   DeviceBuffer<unsigned char> d_layerFlags_;  ///< which layers a segment coloured (1) or left empty (0)
+  mutable SegmentLayersView layers_;  ///< the last frame's layers while not yet composited into d_image_
+  cudaStream_t stream_ = nullptr;     ///< the last frame's stream
   PinnedBuffer h_stage_;           ///< pinned copy of the last frame's image on its way to the caller
   bool imageOnDevice_ = false;     ///< setImageOnDevice(): leave the image in d_image_
   bool deviceImageValid_ = false;  ///< the last render() left its image in d_image_

@@ -26,11 +26,14 @@ __global__ void roundToRgba8Kernel(const float4* image, int imageWidth, int x0, 
 
 // Premultiplied "over" into RGBA8 surface texels at (x0 + x + dx, y0 + y + dy): what GL's blend
 // (ONE, ONE_MINUS_SRC_ALPHA) writes into an 8-bit normalized colour buffer.
-__global__ void blendOverKernel(const float4* image, int imageWidth, int x0, int y0, int w, int h, int dx, int dy,
-                                bool eightBit, cudaSurfaceObject_t target) {
+// With the view's layers (a segmented frame not composited into the flat image), each pixel is
+// composited from them here (compositeLayers): the same colour, no flat image written or read.
+__global__ void blendOverKernel(const DeviceImageView src, int imageWidth, int x0, int y0, int w, int h, int dx,
+                                int dy, bool eightBit, cudaSurfaceObject_t target) {
   const int x = int(blockIdx.x * blockDim.x + threadIdx.x), y = int(blockIdx.y * blockDim.y + threadIdx.y);
   if (x >= w || y >= h) return;
-  const float4 c = image[int64_t(y0 + y) * imageWidth + (x0 + x)];
+  const vec4f c = src.layers.layers ? compositeLayers(src.layers, x0 + x, y0 + y)
+                                    : static_cast<const vec4f*>(src.image)[int64_t(y0 + y) * imageWidth + (x0 + x)];
   if (c.x == 0.f && c.y == 0.f && c.z == 0.f && c.w == 0.f) return;  // d' = d
   auto source = [eightBit](float v) {
     return eightBit ? float(roundTo8(v)) * (1.f / 255.f) : fminf(fmaxf(v, 0.f), 1.f);
@@ -109,7 +112,17 @@ int DeviceImageCopy::copy(const void* image, int imageWidth, int imageHeight, vo
 int DeviceImageCopy::blendOver(const void* image, int imageWidth, int imageHeight, void* array, int arrayWidth,
                                int arrayHeight, int x0, int y0, int w, int h, int dx, int dy, bool eightBit,
                                void* stream) {
-  if (!image || !array || x0 < 0 || y0 < 0 || w <= 0 || h <= 0 || x0 + w > imageWidth || y0 + h > imageHeight ||
+  DeviceImageView v;
+  v.image = image;
+  return blendOver(v, imageWidth, imageHeight, array, arrayWidth, arrayHeight, x0, y0, w, h, dx, dy, eightBit, stream);
+}
+
+int DeviceImageCopy::blendOver(const DeviceImageView& image, int imageWidth, int imageHeight, void* array,
+                               int arrayWidth, int arrayHeight, int x0, int y0, int w, int h, int dx, int dy,
+                               bool eightBit, void* stream) {
+  const bool layered = image.layers.layers != nullptr;
+  if ((!image.image && !layered) ||
+      (layered && (image.layers.width != imageWidth || image.layers.height != imageHeight)) || !array || x0 < 0 || y0 < 0 || w <= 0 || h <= 0 || x0 + w > imageWidth || y0 + h > imageHeight ||
       x0 + dx < 0 || y0 + dy < 0 || x0 + dx + w > arrayWidth || y0 + dy + h > arrayHeight)
     return int(cudaErrorInvalidValue);
   Impl& d = *impl_;
@@ -126,8 +139,7 @@ int DeviceImageCopy::blendOver(const void* image, int imageWidth, int imageHeigh
   }
   const dim3 block(32, 8);
   const dim3 grid(unsigned((w + 31) / 32), unsigned((h + 7) / 8));
-  blendOverKernel<<<grid, block, 0, s>>>(static_cast<const float4*>(image), imageWidth, x0, y0, w, h, dx, dy, eightBit,
-                                         d.surface);
+  blendOverKernel<<<grid, block, 0, s>>>(image, imageWidth, x0, y0, w, h, dx, dy, eightBit, d.surface);
   return int(cudaPeekAtLastError());
 }
 

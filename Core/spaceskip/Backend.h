@@ -2,6 +2,7 @@
 // Internal to Core (the VTK module only sees Engine).
 #pragma once
 #include "Classification.h"
+#include "DeviceImageCopy.h"
 #include "LaunchParams.h"
 #include "Tree.h"
 #include "Types.h"
@@ -41,6 +42,8 @@ class Backend {
   /// The last frame's premultiplied RGBA (one float4 per pixel, row 0 at the bottom) in device
   /// memory while setImageOnDevice(true) is in effect, else nullptr.
   virtual const void* deviceImage() const { return nullptr; }
+  /// The same frame, a segmented frame's layers not composited (DeviceImageView).
+  virtual DeviceImageView deviceImageView() const { return DeviceImageView{}; }
   /// The CUDA stream (a cudaStream_t) deviceImage() is written on, or nullptr. render() does not
   /// wait for a frame it leaves on the device: work the caller queues on this stream after
   /// render() sees the finished image, and the next render() overwrites it only after that work.

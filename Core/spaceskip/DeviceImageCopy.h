@@ -2,9 +2,19 @@
 // blended straight into a mapped framebuffer texture.
 // No CUDA types here: the VTK module includes it without nvcc.
 #pragma once
+#include "render/SegmentLayers.h"
+
 #include <memory>
 
 namespace spaceskip {
+
+/// A frame's image in device memory (Engine::deviceImageView): the flat image (float4
+/// premultiplied RGBA), or, while a segmented frame's layers are not yet composited into it,
+/// those layers (`layers.layers` set; `image` then holds no valid pixels).
+struct DeviceImageView {
+  const void* image = nullptr;
+  SegmentLayersView layers;
+};
 
 class DeviceImageCopy {
  public:
@@ -33,6 +43,10 @@ class DeviceImageCopy {
   /// without CUDA, 1).
   int blendOver(const void* image, int imageWidth, int imageHeight, void* array, int arrayWidth, int arrayHeight,
                 int x0, int y0, int w, int h, int dx, int dy, bool eightBit, void* stream);
+  /// The same from a view: with layers, each pixel composited from them as it is blended
+  /// (compositeLayers: the same colour as the flat image), so the flat image is never written.
+  int blendOver(const DeviceImageView& image, int imageWidth, int imageHeight, void* array, int arrayWidth,
+                int arrayHeight, int x0, int y0, int w, int h, int dx, int dy, bool eightBit, void* stream);
 
   /// Forgets the surface blendOver() made for its last array (waiting for the blends still
   /// queued): call before that array's texture is unregistered or reallocated.

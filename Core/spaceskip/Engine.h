@@ -5,6 +5,7 @@
 #pragma once
 #include "Camera.h"
 #include "Classification.h"
+#include "DeviceImageCopy.h"
 #include "Tree.h"
 #include "TransferFunction.h"
 #include "Types.h"
@@ -78,6 +79,10 @@ class Engine {
   /// The last frame's premultiplied RGBA, float4 per pixel, row 0 at the bottom, in device memory
   /// (valid until the next render), or nullptr when the image went to the host.
   const void* deviceImage() const;
+  /// The same frame without compositing a segmented frame's layers into the flat image: the
+  /// view holds the layers then (DeviceImageCopy::blendOver composites them as it blends).
+  /// Empty (no image, no layers) when the image went to the host.
+  DeviceImageView deviceImageView() const;
   /// The CUDA stream (a cudaStream_t) deviceImage() is written on, nullptr without a device
   /// image. render() does not wait for a frame it leaves on the device: work queued on this
   /// stream after render() sees the finished image (e.g. the CUDA-GL interop copy), and the next

@@ -983,6 +983,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
 
 bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }
 const void* Engine::deviceImage() const { return impl_->backend->deviceImage(); }
+DeviceImageView Engine::deviceImageView() const { return impl_->backend->deviceImageView(); }
 void* Engine::deviceImageStream() const { return impl_->backend->deviceImageStream(); }
 void Engine::setLaunchParams(const LaunchParams& p) { impl_->backend->setLaunchParams(p); }
 void Engine::setMemoryBudget(int64_t bytes, int poolBrick) {

@@ -175,4 +175,76 @@ TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
     }
   }
 }
+
+TEST(DeviceImage, LayersBlendLikeTheFlatImage) {
+  // A segmented frame left on the device keeps its layers (Engine::deviceImageView) until the
+  // flat image is asked for (Engine::deviceImage composites them then); the CUDA blend composites
+  // the layers as it reads them. Both blends must write the same texels bit for bit, and the
+  // flat image must equal the host image. 4 segments forced (rays this short are whole by
+  // default), the box's rectangle with flags and every layer written (SPACESKIP_SEGMENT_LAYERS).
+  std::string why;
+  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  Scene s;
+  const int w = 120, h = 90;
+  setenv("SPACESKIP_RAY_SEGMENTS", "4", 1);
+  const cudaChannelFormatDesc desc = cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned);
+  for (const char* layout : {"rect", "dense"}) {
+    setenv("SPACESKIP_SEGMENT_LAYERS", layout, 1);
+    for (bool eightBit : {true, false}) {
+      SCOPED_TRACE(std::string(layout) + (eightBit ? " 8-bit" : " float"));
+      Engine e(BackendKind::CUDA);
+      test::load(e, s.v, s.tf, test::builder(BuilderKind::DistanceGrid));
+      Image host;
+      e.render(s.cam, w, h, host);
+      ASSERT_TRUE(e.setImageOnDevice(true));
+      Image sized;
+      e.render(s.cam, w, h, sized);
+      const DeviceImageView view = e.deviceImageView();
+      ASSERT_NE(view.image, nullptr);
+      ASSERT_NE(view.layers.layers, nullptr) << "the layers were composited before anyone asked";
+      EXPECT_EQ(view.layers.segments, 4);
+      void* stream = e.deviceImageStream();
+      ASSERT_NE(stream, nullptr);
+      std::vector<unsigned char> background(size_t(w) * size_t(h) * 4);
+      for (size_t i = 0; i < background.size(); ++i) background[i] = static_cast<unsigned char>((i * 7919u) >> 3);
+      std::vector<unsigned char> back[2];
+      DeviceImageCopy copy;
+      for (int pass = 0; pass < 2; ++pass) {
+        cudaArray_t target = nullptr;
+        ASSERT_EQ(cudaMallocArray(&target, &desc, size_t(w), size_t(h), cudaArraySurfaceLoadStore), cudaSuccess);
+        ASSERT_EQ(cudaMemcpy2DToArray(target, 0, 0, background.data(), size_t(w) * 4, size_t(w) * 4, size_t(h),
+                                      cudaMemcpyHostToDevice),
+                  cudaSuccess);
+        if (pass == 0) {
+          EXPECT_EQ(copy.blendOver(view, w, h, target, w, h, 3, 2, w - 5, h - 4, 0, 0, eightBit, stream), 0);
+        } else {
+          const void* flat = e.deviceImage();  // composites the layers now
+          ASSERT_NE(flat, nullptr);
+          EXPECT_EQ(e.deviceImageView().layers.layers, nullptr) << "the layers are composited once";
+          EXPECT_EQ(copy.blendOver(flat, w, h, target, w, h, 3, 2, w - 5, h - 4, 0, 0, eightBit, stream), 0);
+          std::vector<vec4f> down(size_t(w) * size_t(h));
+          ASSERT_EQ(cudaMemcpyAsync(down.data(), flat, down.size() * sizeof(vec4f), cudaMemcpyDeviceToHost,
+                                    static_cast<cudaStream_t>(stream)),
+                    cudaSuccess);
+          ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);
+          Image dev;
+          dev.width = w;
+          dev.height = h;
+          dev.rgba = down;
+          EXPECT_EQ(compareImages(host, dev).maxAbs, 0.f) << "the composited layers differ from the host image";
+        }
+        ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);
+        back[pass].resize(background.size());
+        ASSERT_EQ(cudaMemcpy2DFromArray(back[pass].data(), size_t(w) * 4, target, 0, 0, size_t(w) * 4, size_t(h),
+                                        cudaMemcpyDeviceToHost),
+                  cudaSuccess);
+        cudaFreeArray(target);
+      }
+      EXPECT_NE(back[0], background) << "the blend should colour some texels";
+      EXPECT_EQ(back[0], back[1]) << "the blend from the layers differs from the blend of the flat image";
+    }
+  }
+  unsetenv("SPACESKIP_SEGMENT_LAYERS");
+  unsetenv("SPACESKIP_RAY_SEGMENTS");
+}
 #endif

@@ -29,7 +29,9 @@
 // (rays cut into N segments; 1: whole rays), :batchN SPACESKIP_SAMPLE_BATCH=N (samples a GPU
 // march fetches together; 1: one at a time), :layersdense / :layersflags
 // SPACESKIP_SEGMENT_LAYERS=dense / flags (a segmented frame's layers over every pixel, each
-// written (round 13), or over every pixel with flags; default: the box's pixel rectangle with flags). Columns render_ms and finish_ms split the frame into the time in Render() and
+// written (round 13), or over every pixel with flags; default: the box's pixel rectangle with flags),
+// :nofuse SPACESKIP_FUSED_BLEND=0 (a segmented frame's layers composited into the flat image
+// before the CUDA blend reads it, instead of by the blend itself). Columns render_ms and finish_ms split the frame into the time in Render() and
 // the wait in glFinish() after it. stream_ms / stream_fps: the same orbit rendered back to back
 // with one glFinish() at the end (throughput; frame_ms is the latency of one waited-for frame).
 // edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
@@ -293,6 +295,7 @@ struct Item
   int segments = 0;     ///< SPACESKIP_RAY_SEGMENTS (0: unset, the default)
   int batch = 0;        ///< SPACESKIP_SAMPLE_BATCH (0: unset, the default)
   std::string layers;   ///< SPACESKIP_SEGMENT_LAYERS (empty: unset, the default)
+  bool noFuse = false;  ///< SPACESKIP_FUSED_BLEND=0
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -366,6 +369,10 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i] == "layersdense" || parts[i] == "layersflags")
     {
       it.layers = parts[i].substr(6);
+    }
+    else if (parts[i] == "nofuse")
+    {
+      it.noFuse = true;
     }
     else
     {
@@ -713,6 +720,10 @@ int main(int argc, char* argv[])
       setenv("SPACESKIP_SEGMENT_LAYERS", it.layers.c_str(), 1);
     else
       unsetenv("SPACESKIP_SEGMENT_LAYERS");
+    if (it.noFuse)
+      setenv("SPACESKIP_FUSED_BLEND", "0", 1);
+    else
+      unsetenv("SPACESKIP_FUSED_BLEND");
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
