@@ -62,6 +62,27 @@ SS_FUNC int ss_mini(int a, int b) { return a < b ? a : b; }
 SS_FUNC int ss_maxi(int a, int b) { return a > b ? a : b; }
 SS_FUNC float ss_clamp(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
+/// *p, for data that stays constant while a kernel runs (the volume, the grids, the transfer
+/// function): on a GPU through the read-only data path (__ldg), on the host a plain load.
+template <class T>
+SS_FUNC T ss_ldg(const T* p) {
+#ifdef __CUDA_ARCH__
+  return __ldg(p);
+#else
+  return *p;
+#endif
+}
+/// Entry i of a table of vec4f in device memory (cudaMalloc'd, so 16-byte aligned): one 16-byte
+/// read-only load on a GPU instead of four 4-byte ones; on the host a plain copy.
+SS_FUNC vec4f ss_ldg4(const vec4f* t, int64_t i) {
+#ifdef __CUDA_ARCH__
+  const float4 v = __ldg(reinterpret_cast<const float4*>(t) + i);
+  return vec4f{v.x, v.y, v.z, v.w};
+#else
+  return t[i];
+#endif
+}
+
 /// Integer box in cell coordinates, half-open: [lo, hi).
 struct box3i {
   vec3i lo, hi;

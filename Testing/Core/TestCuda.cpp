@@ -821,6 +821,21 @@ TEST(CudaBackend, ErrorMidFrameFallsBackToTheCpuImage) {
   }
 }
 
+namespace {
+/// `e` set up for one frame path: the volume, the transfer function, builder `k`, the filter and
+/// early ray termination at `ert` (> 1: off).
+void loadFrame(Engine& e, const Volume& v, const TransferFunction& tf, BuilderKind k, FilterMode filter,
+               double ert = 2.0) {
+  e.setVolume(v);
+  e.setTransferFunction(tf);
+  e.setBuildParams(params(k));
+  RenderParams rp;
+  rp.filter = filter;
+  rp.ertThreshold = ert;
+  e.setRenderParams(rp);
+}
+}  // namespace
+
 TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
   // LaunchParams::resident switches the render kernels to a persistent launch (blocks taking
   // tiles from a counter); every pixel must still be rendered once, with the same result. A
@@ -841,12 +856,7 @@ TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
         LaunchParams lp;
         lp.resident = i == 1 ? 1 : 0;  // plain launch vs 1 resident block per SM
         e.setLaunchParams(lp);
-        e.setVolume(v);
-        e.setTransferFunction(tf);
-        e.setBuildParams(params(k));
-        RenderParams rp;
-        rp.filter = filter;
-        e.setRenderParams(rp);
+        loadFrame(e, v, tf, k, filter);
         e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
         ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
       }
@@ -883,13 +893,7 @@ TEST(CudaBackend, BatchedSamplesRenderTheSameImage) {
           setenv("SPACESKIP_SAMPLE_BATCH", batches[i], 1);
           setenv("SPACESKIP_RAY_SEGMENTS", m.segments, 1);
           Engine e(BackendKind::CUDA);
-          e.setVolume(v);
-          e.setTransferFunction(tf);
-          e.setBuildParams(params(k));
-          RenderParams rp;
-          rp.filter = filter;
-          rp.ertThreshold = m.ert;
-          e.setRenderParams(rp);
+          loadFrame(e, v, tf, k, filter, m.ert);
           e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
           ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
         }
@@ -928,12 +932,7 @@ TEST(CudaBackend, SegmentLayersRenderTheSameImage) {
           for (int i = 0; i < 3; ++i) {
             setenv("SPACESKIP_SEGMENT_LAYERS", layouts[i], 1);
             Engine e(BackendKind::CUDA);
-            e.setVolume(v);
-            e.setTransferFunction(tf);
-            e.setBuildParams(params(k));
-            RenderParams rp;
-            rp.filter = filter;
-            e.setRenderParams(rp);
+            loadFrame(e, v, tf, k, filter);
             e.render(cam, 101, 73, img[i]);
             // Three frames, the last at `cam`: it is drawn over layers and flags another view
             // wrote, so anything stale that the composite read would show.
@@ -979,13 +978,7 @@ TEST(CudaBackend, SegmentedRaysRenderTheSameImage) {
           for (int i = 0; i < 3; ++i) {
             setenv("SPACESKIP_RAY_SEGMENTS", counts[i], 1);
             Engine e(BackendKind::CUDA);
-            e.setVolume(c.v);
-            e.setTransferFunction(c.tf);
-            e.setBuildParams(params(k));
-            RenderParams rp;
-            rp.filter = filter;
-            rp.ertThreshold = ert;
-            e.setRenderParams(rp);
+            loadFrame(e, c.v, c.tf, k, filter, ert);
             e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
             ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
           }

@@ -31,6 +31,17 @@ unsigned char round8(float s) {
   return static_cast<unsigned char>(v * 255.f + 0.5f);
 }
 
+// The device image `image` (w x h float4) as an Image, copied on `stream` behind what is queued.
+bool download(const void* image, void* stream, int w, int h, Image& out) {
+  out.width = w;
+  out.height = h;
+  out.rgba.resize(size_t(w) * size_t(h));
+  const cudaStream_t s = static_cast<cudaStream_t>(stream);
+  return cudaMemcpyAsync(out.rgba.data(), image, out.rgba.size() * sizeof(vec4f), cudaMemcpyDeviceToHost, s) ==
+             cudaSuccess &&
+         cudaStreamSynchronize(s) == cudaSuccess;
+}
+
 struct Scene {
   Volume v = generateVolume("nbody", vec3l{64, 64, 64}, 4);
   TransferFunction tf;
@@ -73,15 +84,8 @@ TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
       EXPECT_EQ(e.frameStats(false).deviceSeconds, -1.0) << "render() waited for the kernel";
     }
     // Queued behind the kernel on the engine's stream: the finished frame.
-    std::vector<vec4f> down(size_t(w) * size_t(h));
-    ASSERT_EQ(cudaMemcpyAsync(down.data(), image, down.size() * sizeof(vec4f), cudaMemcpyDeviceToHost,
-                              static_cast<cudaStream_t>(stream)),
-              cudaSuccess);
-    ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);
     Image dev;
-    dev.width = w;
-    dev.height = h;
-    dev.rgba = down;
+    ASSERT_TRUE(download(image, stream, w, h, dev));
     EXPECT_EQ(compareImages(host, dev).maxAbs, 0.f) << "the device image differs from the host image";
     EXPECT_GT(e.frameStats().deviceSeconds, 0.0) << "the kernel time, read on demand";
 
@@ -222,15 +226,8 @@ TEST(DeviceImage, LayersBlendLikeTheFlatImage) {
           ASSERT_NE(flat, nullptr);
           EXPECT_EQ(e.deviceImageView().layers.layers, nullptr) << "the layers are composited once";
           EXPECT_EQ(copy.blendOver(flat, w, h, target, w, h, 3, 2, w - 5, h - 4, 0, 0, eightBit, stream), 0);
-          std::vector<vec4f> down(size_t(w) * size_t(h));
-          ASSERT_EQ(cudaMemcpyAsync(down.data(), flat, down.size() * sizeof(vec4f), cudaMemcpyDeviceToHost,
-                                    static_cast<cudaStream_t>(stream)),
-                    cudaSuccess);
-          ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);
           Image dev;
-          dev.width = w;
-          dev.height = h;
-          dev.rgba = down;
+          ASSERT_TRUE(download(flat, stream, w, h, dev));
           EXPECT_EQ(compareImages(host, dev).maxAbs, 0.f) << "the composited layers differ from the host image";
         }
         ASSERT_EQ(cudaStreamSynchronize(static_cast<cudaStream_t>(stream)), cudaSuccess);

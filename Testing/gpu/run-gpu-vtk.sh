@@ -359,7 +359,8 @@ fi
 # --- Kernel fps (CLI, the paper's protocol) with settings alternated per process ----------------
 # CLI_AB_RUNS: one process each, a comma-separated list of VAR=VALUE (e.g. the layers of
 # segmented frames: SPACESKIP_SEGMENT_LAYERS=dense against the default rect); CLI_AB_DATASETS,
-# CLI_AB_ITEMS. Key columns of every run into cli-ab.txt.
+# CLI_AB_ITEMS; a run "old" (or "old,VAR=VALUE...") uses the older bundle's CLI (OLD_VTK, with
+# bench-oldnew). Key columns of every run into cli-ab.txt.
 if has cli-ab; then
   n=0
   for spec in ${CLI_AB_RUNS:-SPACESKIP_SEGMENT_LAYERS=dense SPACESKIP_SEGMENT_LAYERS=rect SPACESKIP_SEGMENT_LAYERS=dense SPACESKIP_SEGMENT_LAYERS=rect}; do
@@ -367,7 +368,14 @@ if has cli-ab; then
     n=$((n + 1))
     log "CLI A/B run $n: $spec"
     echo "==== run $n: $spec" >> "$work/cli-ab.log"
-    env ${spec//,/ } timeout 300 "$cli" bench --paper \
+    # "old" (alone or first in the list): the CLI of the older bundle (OLD_VTK, unpacked by bench-oldnew).
+    runcli=$cli
+    runenv=${spec//,/ }
+    if [ "${spec%%,*}" = old ]; then
+      runcli=$B/old/vtk/bin/spaceskip
+      runenv="LD_LIBRARY_PATH=$B/old/vtk/lib${LD_LIBRARY_PATH#$B/vtk/lib} ${runenv#old}"
+    fi
+    env $runenv timeout 300 "$runcli" bench --paper \
       --datasets "${CLI_AB_DATASETS:-nbody_2048,nbody_1024,menger_sponge,kingsnake}" \
       --builders "${CLI_AB_ITEMS:-distance-grid,distance-grid:hw,auto}" --frames "${CLI_AB_FRAMES:-8}" \
       --csv "$work/cli-ab-$n.csv" >> "$work/cli-ab.log" 2>&1
