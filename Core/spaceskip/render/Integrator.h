@@ -38,7 +38,7 @@ struct ArraySampler {
   int64_t nx, ny, nz;
 
   SS_FUNC float fetch(int64_t i, int64_t j, int64_t k) const {
-    return voxelValue(ss_ldg(data + (i + nx * (j + ny * k))));
+    return voxelValue(data[i + nx * (j + ny * k)]);
   }
   SS_FUNC static void axis(float p, int64_t n, int64_t& i0, int64_t& i1, float& f) {
     float x = ss_clamp(p, 0.f, float(n - 1));

@@ -129,10 +129,10 @@ struct GridIterT {
     int dist;
     bool walkParts = false;
     if (g->vmin) {
-      dist = m.active(ss_ldg(g->vmin + idx), ss_ldg(g->vmax + idx)) ? 0 : 1;
+      dist = m.active(g->vmin[idx], g->vmax[idx]) ? 0 : 1;
     } else {
       // DistanceGrid's field or the brick states: bit 7 says "walk the parts" (subBrickState).
-      const int raw = ss_ldg(g->dist ? g->dist + idx : g->occ + idx);
+      const int raw = g->dist ? g->dist[idx] : g->occ[idx];
       walkParts = Parts && (raw & kBrickPartsBit) != 0 && g->sub != nullptr;
       dist = g->dist ? (raw & 0x7f) : (raw != 0 ? 0 : 1);
     }
@@ -177,7 +177,7 @@ struct GridIterT {
     a = t;
     b = tExit;
     t = tExit;
-    const uint64_t parts = Parts && dist == 0 && walkParts ? ss_ldg(g->sub + idx) : ~uint64_t(0);
+    const uint64_t parts = Parts && dist == 0 && walkParts ? g->sub[idx] : ~uint64_t(0);
     if (Parts && parts != ~uint64_t(0)) enterParts(cell, parts, a, tExit);
     const int c = axisOf(cell, axis) + axisOf(step, axis);
     setAxis(cell, axis, c);
