@@ -62,20 +62,6 @@ SS_FUNC int ss_mini(int a, int b) { return a < b ? a : b; }
 SS_FUNC int ss_maxi(int a, int b) { return a > b ? a : b; }
 SS_FUNC float ss_clamp(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
-/// Entry i of a table of vec4f in device memory (cudaMalloc'd, so 16-byte aligned) that stays
-/// constant while a kernel runs (the transfer function): one 16-byte read-only load on a GPU
-/// instead of four 4-byte ones; on the host a plain copy. Measured on the H100 (round 15): the
-/// same read-only path for the grids' bytes and the exact sampler's voxels made N-body 0.87x
-/// (exact) and 0.98x (hardware filter), so those stay plain loads.
-SS_FUNC vec4f ss_ldg4(const vec4f* t, int64_t i) {
-#ifdef __CUDA_ARCH__
-  const float4 v = __ldg(reinterpret_cast<const float4*>(t) + i);
-  return vec4f{v.x, v.y, v.z, v.w};
-#else
-  return t[i];
-#endif
-}
-
 /// Integer box in cell coordinates, half-open: [lo, hi).
 struct box3i {
   vec3i lo, hi;

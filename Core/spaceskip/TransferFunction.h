@@ -83,7 +83,7 @@ SS_FUNC vec4f lookup(const TransferFunctionView& tf, float v) {
   int i0 = int(x);
   int i1 = i0 + 1 < tf.size ? i0 + 1 : i0;
   float f = x - float(i0);
-  const vec4f a = ss_ldg4(tf.table, i0), b = ss_ldg4(tf.table, i1);
+  vec4f a = tf.table[i0], b = tf.table[i1];
   return vec4f{a.x + (b.x - a.x) * f, a.y + (b.y - a.y) * f, a.z + (b.z - a.z) * f,
                a.w + (b.w - a.w) * f};
 }

@@ -335,7 +335,8 @@ if has bench-modes; then
 fi
 
 # --- Core's tests (CUDA included) and compute-sanitizer on its CUDA tests ------------------------
-coretests=$B/vtk/bin/spaceskip_core_tests
+# CORE_TESTS: Core's test binary carried apart (e.g. xz'd beside a bundle built with BUNDLE_NO_CORE_TESTS=1).
+coretests=${CORE_TESTS:-$B/vtk/bin/spaceskip_core_tests}
 if has core && ! late && [ -x "$coretests" ]; then
   log "Core tests"
   timeout 400 "$coretests" > "$work/core-tests.log" 2>&1
