@@ -302,12 +302,6 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin,
     this->Direct = true;
     this->CompositePath = "gpu";
     this->BlendPath = "cuda";
-    // SPACESKIP_WAIT_BLEND=1 (a measurement switch): the host waits for the blend, so that GL's
-    // next work (VTK's blits) reaches the GPU only once CUDA's frame is done.
-    if (EnvOn("SPACESKIP_WAIT_BLEND"))
-    {
-      cudaStreamSynchronize(static_cast<cudaStream_t>(stream));
-    }
     return true;
   }
 #endif

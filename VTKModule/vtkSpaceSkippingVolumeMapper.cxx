@@ -361,15 +361,6 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWind
     this->Compositor.CanUseDeviceImage(this->Self->GPUComposite != 0) &&
     engine.backendKind() == spaceskip::BackendKind::CUDA);
   t0 = std::chrono::steady_clock::now();
-  // SPACESKIP_GL_FLUSH=1 (a measurement switch): GL's work so far (the window's clear) goes to
-  // the GPU before the frame's kernel is queued.
-  if (const char* flush = std::getenv("SPACESKIP_GL_FLUSH"))
-  {
-    if (flush[0] == '1')
-    {
-      glFlush();
-    }
-  }
   engine.render(camera, width, height, this->Image, this->FrameDepth,
     this->Self->DeferDraw ? this->Self->IncomingAlpha : nullptr);
   this->EngineSeconds = SecondsSince(t0);

@@ -122,8 +122,8 @@ int DeviceImageCopy::blendOver(const DeviceImageView& image, int imageWidth, int
                                bool eightBit, void* stream) {
   const bool layered = image.layers.layers != nullptr;
   if ((!image.image && !layered) ||
-      (layered && (image.layers.width != imageWidth || image.layers.height != imageHeight)) || !array || x0 < 0 || y0 < 0 || w <= 0 || h <= 0 || x0 + w > imageWidth || y0 + h > imageHeight ||
-      x0 + dx < 0 || y0 + dy < 0 || x0 + dx + w > arrayWidth || y0 + dy + h > arrayHeight)
+      (layered && (image.layers.width != imageWidth || image.layers.height != imageHeight)) || !array || x0 < 0 ||
+      y0 < 0 || w <= 0 || h <= 0 || x0 + w > imageWidth || y0 + h > imageHeight || x0 + dx < 0 || y0 + dy < 0 || x0 + dx + w > arrayWidth || y0 + dy + h > arrayHeight)
     return int(cudaErrorInvalidValue);
   Impl& d = *impl_;
   const cudaStream_t s = static_cast<cudaStream_t>(stream);

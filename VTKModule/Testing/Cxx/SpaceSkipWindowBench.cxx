@@ -31,9 +31,7 @@
 // SPACESKIP_SEGMENT_LAYERS=dense / flags (a segmented frame's layers over every pixel, each
 // written (round 13), or over every pixel with flags; default: the box's pixel rectangle with flags),
 // :nofuse SPACESKIP_FUSED_BLEND=0 (a segmented frame's layers composited into the flat image
-// before the CUDA blend reads it, instead of by the blend itself), :waitblend SPACESKIP_WAIT_BLEND=1
-// (the host waits for the CUDA blend before VTK's blits are issued), :glflush SPACESKIP_GL_FLUSH=1
-// (GL flushed before the frame's kernel is queued). Columns render_ms and finish_ms split the frame into the time in Render() and
+// before the CUDA blend reads it, instead of by the blend itself). Columns render_ms and finish_ms split the frame into the time in Render() and
 // the wait in glFinish() after it. stream_ms / stream_fps: the same orbit rendered back to back
 // with one glFinish() at the end (throughput; frame_ms is the latency of one waited-for frame).
 // edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
@@ -298,8 +296,6 @@ struct Item
   int batch = 0;        ///< SPACESKIP_SAMPLE_BATCH (0: unset, the default)
   std::string layers;   ///< SPACESKIP_SEGMENT_LAYERS (empty: unset, the default)
   bool noFuse = false;  ///< SPACESKIP_FUSED_BLEND=0
-  bool waitBlend = false; ///< SPACESKIP_WAIT_BLEND=1
-  bool glFlush = false;   ///< SPACESKIP_GL_FLUSH=1
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -377,14 +373,6 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i] == "nofuse")
     {
       it.noFuse = true;
-    }
-    else if (parts[i] == "waitblend")
-    {
-      it.waitBlend = true;
-    }
-    else if (parts[i] == "glflush")
-    {
-      it.glFlush = true;
     }
     else
     {
@@ -716,8 +704,6 @@ int main(int argc, char* argv[])
     };
     setSwitch("SPACESKIP_SYNC_FRAME", it.sync);
     setSwitch("SPACESKIP_COMPOSITE_FULL", it.full);
-    setSwitch("SPACESKIP_WAIT_BLEND", it.waitBlend);
-    setSwitch("SPACESKIP_GL_FLUSH", it.glFlush);
     if (it.glBlend)
       setenv("SPACESKIP_CUDA_BLEND", "0", 1);
     else
@@ -872,8 +858,6 @@ int main(int argc, char* argv[])
 
   unsetenv("SPACESKIP_SYNC_FRAME");
   unsetenv("SPACESKIP_COMPOSITE_FULL");
-  unsetenv("SPACESKIP_WAIT_BLEND");
-  unsetenv("SPACESKIP_GL_FLUSH");
   if (vtkGpu)
   {
     // VTK's own GPU ray caster in the same window: same property, sample distance half a voxel
