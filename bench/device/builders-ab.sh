@@ -4,13 +4,13 @@
 # (A B A B ... so clock and thermal drift hit both alike) and the ratio after/before of the kernel
 # fps and of the build time is printed per case.
 #
-#   Testing/gpu/bench-compare.sh OUTDIR BEFORE_CLI AFTER_CLI
+#   bench/device/builders-ab.sh OUTDIR BEFORE_CLI AFTER_CLI
 #   env: ROUNDS (3), FRAMES (16), VOLUMES ("gen:nbody:1024 gen:menger:1024"), BUILDERS (below),
 #        EXTRA (more bench options, e.g. "--build-reps 20": the fastest of 20 rebuilds),
-#        TBB_DIR/LD_LIBRARY_PATH as for run-gpu.sh (set from ./.deps when present)
+#        TBB_DIR/LD_LIBRARY_PATH as for run-core.sh (set from ./.deps when present)
 # Writes OUTDIR/compare.csv (every run), OUTDIR/compare.txt (medians and ratios), OUTDIR/env.txt.
 set -uo pipefail
-out=${1:?usage: bench-compare.sh OUTDIR BEFORE_CLI AFTER_CLI}
+out=${1:?usage: builders-ab.sh OUTDIR BEFORE_CLI AFTER_CLI}
 before=${2:?} after=${3:?}
 src=$(cd "$(dirname "$0")/../.." && pwd)
 mkdir -p "$out"

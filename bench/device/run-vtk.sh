@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# On a GPU machine without VTK, X or GL loaders (DEVICE.md): unpacks the bundle made by
-# Testing/gpu/bundle-vtk.sh, starts its Xvfb, picks NVIDIA's GL for the clients
+# On a GPU machine without VTK, X or GL loaders (docs/gpu.md): unpacks the bundle made by
+# bench/device/bundle-vtk.sh, starts its Xvfb, picks NVIDIA's GL for the clients
 # (__GLX_VENDOR_LIBRARY_NAME=nvidia; falls back to Mesa and says so), runs every VTK mapper test
 # with the CUDA backend forced (SPACESKIP_BACKEND=cuda) against the CPU baselines and thresholds
 # (then once more as written: Auto/CPU per test, as CI runs them),
 # compute-sanitizer memcheck on mapper tests, and the window benchmark beside the CLI's kernel
 # timings for the same cases. Writes everything into OUTDIR.
 #
-#   Testing/gpu/run-gpu-vtk.sh OUTDIR [PHASE...]
+#   bench/device/run-vtk.sh OUTDIR [PHASE...]
 #   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
 #          bench-ert bench-hw (N-body 2048^3, the mapper's FilterMode Hardware (texture unit)
 #          against Exact: HW_ITEMS, default DistanceGrid,DistanceGrid:hw,Auto,Auto:hw)
@@ -39,12 +39,12 @@
 #          vtkGPUVolumeRayCastMapper in the 1024^3 benchmarks), REQUIRE_NVIDIA_GL (set: stop
 #          when only Mesa works), BENCH_N (every benchmark at this size instead: quick checks),
 #          EDIT_CUT (the window benchmark's --edit-cut: 0.3 by default, changing N-body's occupied
-#          cells; 0.2 changes none, the edit of round 7 and before)
+#          cells; 0.2 changes none, the older edit path)
 #
 # OUTDIR receives at most 8 files (the device tool's limit): env.txt, tests.log, memcheck.log,
 # bench.log, bench.csv, cli-bench.log, cli-bench.csv, logs.tgz (everything).
 set -uo pipefail
-out=${1:?usage: run-gpu-vtk.sh OUTDIR [PHASE...]}
+out=${1:?usage: run-vtk.sh OUTDIR [PHASE...]}
 shift
 phases=${*:-tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024 bench-host bench-float bench-ert}
 src=$(cd "$(dirname "$0")/../.." && pwd)

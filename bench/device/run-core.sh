@@ -1,22 +1,22 @@
 #!/usr/bin/env bash
 # Builds Core with CUDA on a GPU machine, runs the tests, compute-sanitizer (memcheck, racecheck)
-# on the CUDA tests, and the benchmarks; writes everything into OUTDIR (see DEVICE.md).
+# on the CUDA tests, and the benchmarks; writes everything into OUTDIR (see docs/gpu.md).
 #
-#   Testing/gpu/run-gpu.sh OUTDIR [PHASE...]
-#   PHASE: build test sanitize bench-small bench-large bench-round2 bench-round3 bench-sweep regcap
-#          resident bench-final3 bench-menger3 profile2048 blocks ncu
+#   bench/device/run-core.sh OUTDIR [PHASE...]
+#   PHASE: build test sanitize bench-small bench-large bench-nbody-builders bench-distance-grid bench-sweep regcap
+#          resident bench-launch bench-menger profile2048 blocks ncu
 #          (default: build test sanitize bench-small)
 #          bench-sweep: KdTreeCPU vs KdTreeGPUFast with bins 0 (the same trees) at 256^3..2048^3
 #   env:   BUILD_DIR (default ./build-gpu), TBB_DIR/LD_LIBRARY_PATH (set from ../.deps or ./.deps
 #          when present), BENCH_FRAMES (8), SANITIZE_FILTER (gtest filter for the sanitizer runs),
 #          SANITIZE_TOOLS ("memcheck racecheck"), SANITIZE_TIMEOUT (240 s per tool), SANITIZE_DEADLINE
-#          (epoch seconds; shortens that timeout), BENCH_ROUND2_KDGPU (the one KdTreeGPU deep variant
-#          of bench-round2, "kdtree-gpu:deep:mls32:cold"; empty for none)
+#          (epoch seconds; shortens that timeout), BENCH_NBODY_KDGPU (the one KdTreeGPU deep variant
+#          of bench-nbody-builders, "kdtree-gpu:deep:mls32:cold"; empty for none)
 #
 # OUTDIR receives at most 8 files (the device tool's limit): env.txt, build.log, ctest.log,
 # sanitize.log, bench.log, bench.csv, bench.json, and logs.tgz (everything).
 set -uo pipefail
-out=${1:?usage: run-gpu.sh OUTDIR [PHASE...]}
+out=${1:?usage: run-core.sh OUTDIR [PHASE...]}
 shift
 phases=${*:-build test sanitize bench-small}
 src=$(cd "$(dirname "$0")/../.." && pwd)
@@ -130,18 +130,18 @@ if has bench-large; then
   cpucold="lbvh-cpu:cold,kdtree-cpu:shallow:cold,kdtree-cpu:deep:mls32:cold,kdtree-cpu:deep:mls128:cold,hybrid:cold"
   bench nbody2048 gen:nbody:2048 "naive,grid,lbvh,$kdfast,$hw,$cpucold,${BENCH_2048_KDGPU:-$kdcold}"
 fi
-if has bench-round2; then
-  # Round 2 (the resolution-independent N-body particle set): the GPU builders at 256^3..2048^3,
+if has bench-nbody-builders; then
+  # The resolution-independent N-body particle set: the GPU builders at 256^3..2048^3,
   # then naive at one-voxel steps (the paper does not state its step; ours defaults to half a voxel).
-  kd1=${BENCH_ROUND2_KDGPU-kdtree-gpu:deep:mls32:cold}
+  kd1=${BENCH_NBODY_KDGPU-kdtree-gpu:deep:mls32:cold}
   r2="naive,naive:hw,grid,grid:hw,lbvh,lbvh:hw,kdtree-gpu-fast:shallow,kdtree-gpu-fast:deep:mls32,kdtree-gpu-fast:deep:mls32:hw,kdtree-gpu-fast:deep:mls128,kdtree-gpu-fast:deep:mls128:hw"
   for n in 256 512 1024; do bench r2-nbody$n gen:nbody:$n "$r2,kdtree-gpu:shallow,hybrid${kd1:+,$kd1}"; done
   bench r2-nbody2048 gen:nbody:2048 "$r2,kdtree-gpu:shallow:cold,hybrid:cold${kd1:+,$kd1}"
   bench r2-nbody2048-step1 gen:nbody:2048 "naive,naive:hw,grid:hw,lbvh:hw" --sample-distance 1
 fi
-if has bench-round3; then
-  # Round 3: DistanceGrid (the grid DDA leaping with a distance field) beside the best builders
-  # of round 2, 256^3..2048^3 N-body and the 1024^3 Menger sponge; then one-voxel steps at 2048^3.
+if has bench-distance-grid; then
+  # DistanceGrid (the grid DDA leaping with a distance field) beside the best builders
+  # of bench-nbody-builders, 256^3..2048^3 N-body and the 1024^3 Menger sponge; then one-voxel steps at 2048^3.
   r3="naive:hw,grid,grid:hw,distance-grid,distance-grid:hw,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw"
   r3="$r3,grid:brick16:hw,distance-grid:brick16:hw,distance-grid:brick4:hw"
   for n in 256 512 1024 2048; do bench r3-nbody$n gen:nbody:$n "$r3"; done
@@ -173,10 +173,10 @@ if has resident; then
   rs="$rs,distance-grid:brick4:hw,distance-grid:brick4:hw:res8,distance-grid:brick4:hw:res16"
   for n in 1024 2048; do bench res-nbody$n gen:nbody:$n "$rs"; done
 fi
-if has bench-final3; then
-  # Round 3 final table: the default launch (persistent, 6 blocks/SM, for hardware-filtered
+if has bench-launch; then
+  # The launch table: the default launch (persistent, 6 blocks/SM, for hardware-filtered
   # textures over 2 GiB) beside the plain one (:res0), DistanceGrid at bricks 8 and 4, and the
-  # round-2 best builders; then naive:hw at 2048^3 repeated (plain vs default vs 5/7 blocks/SM).
+  # best builders of bench-nbody-builders; then naive:hw at 2048^3 repeated (plain vs default vs 5/7 blocks/SM).
   f3="naive,naive:hw:res0,naive:hw,grid:hw,distance-grid,distance-grid:hw,distance-grid:brick4,distance-grid:brick4:hw"
   f3="$f3,lbvh:hw,kdtree-gpu-fast:deep:mls32:hw"
   for n in 256 512 1024 2048; do bench f3-nbody$n gen:nbody:$n "$f3"; done
@@ -187,7 +187,7 @@ if has bench-final3; then
     "naive:hw:res0,naive:hw,naive:hw:res0,naive:hw,naive:hw:res5,naive:hw:res7,naive:hw:res0,naive:hw"
   frames=$frames0
 fi
-if has bench-menger3; then
+if has bench-menger; then
   # The Menger sponge (40.7% occupied): which structure is fastest when little space is empty.
   bench m3-menger1024 gen:menger:1024 \
     "naive:hw,kdtree-gpu-fast:shallow:hw,kdtree-cpu:shallow:hw,grid:hw,grid:brick16:hw,distance-grid:brick16:hw,kdtree-gpu-fast:deep:mls128:hw,kdtree-gpu-fast:deep:mls32:hw,hybrid:hw"

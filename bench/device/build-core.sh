@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds only the CLI and the Core tests with CUDA (sm_90) on the GPU machine into ${BUILD_DIR:-build-gpu},
-# for a before/after measurement in the same device call. usage: quick-build.sh LOG
+# for a before/after measurement in the same device call. usage: build-core.sh LOG
 set -uo pipefail
 src=$(cd "$(dirname "$0")/../.." && pwd)
 build=${BUILD_DIR:-$src/build-gpu}

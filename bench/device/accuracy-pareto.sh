@@ -2,11 +2,11 @@
 # Speed/accuracy trade per data set (issue 13): `spaceskip accuracy` (sample distance 0.25-4 voxels
 # x filter x ERT x jitter vs PSNR/SSIM to a 1/8-voxel reference) on each shape, one CSV per
 # backend, then the Pareto plots when matplotlib is there (scripts/plot_pareto.py).
-#   Testing/gpu/pareto.sh OUTDIR CLI
+#   bench/device/accuracy-pareto.sh OUTDIR CLI
 #   env: SHAPES (default the paper's stand-ins), N (volume edge, 256), SIZE (512x512),
 #        BACKENDS ("cuda cpu"), CPU_N (edge for the CPU backend, 128), BUILDER (auto)
 set -uo pipefail
-out=${1:?usage: pareto.sh OUTDIR CLI} cli=${2:?}
+out=${1:?usage: accuracy-pareto.sh OUTDIR CLI} cli=${2:?}
 mkdir -p "$out"
 shapes=${SHAPES:-aneurism xmas_tree magnetic stag_beetle kingsnake menger richtmyer_meshkov nbody}
 for be in ${BACKENDS:-cuda cpu}; do

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Build time vs oneTBB threads with interleaved repeats (robust against other load on a shared
 # machine): REPS runs per thread count, alternating, each the fastest of 5 rebuilds.
-# usage: Testing/scripts/cpu-builders-threads.sh OUT_DIR [SPACESKIP_BINARY]   (THREADS="1 2", REPS=5)
+# usage: bench/cpu/builders-threads.sh OUT_DIR [SPACESKIP_BINARY]   (THREADS="1 2", REPS=5)
 set -euo pipefail
 out=${1:?usage: $0 OUT_DIR [SPACESKIP_BINARY]}
 bin=${2:-build/Core/spaceskip}

@@ -4,7 +4,7 @@
 # with a time limit so the run ends inside the device tool's 10 minutes per command; then, when
 # matplotlib is there, the figures (scripts/plot-paper-bench.py; else draw them afterwards).
 #
-#   Testing/gpu/paper-bench.sh OUTDIR
+#   bench/device/paper-bench.sh OUTDIR
 #   env: BUILD_DIR (default ./build-gpu; built when it has no spaceskip), SCALE (1), FRAMES (8),
 #        TIME_LIMIT (420 s: no new item starts after it), DATASETS / BUILDERS (subsets, comma
 #        separated; default all), BACKEND (cuda), EXTRA (more bench options)

@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# One device call with carried binaries (see DEVICE.md): the Core tests (CUDA twins included),
+# One device call with carried binaries (see docs/gpu.md): the Core tests (CUDA twins included),
 # compute-sanitizer memcheck on a filter, then the paper's protocol (paper-bench.sh) on data sets.
 #
-#   Testing/gpu/cli-and-tests.sh OUTDIR
+#   bench/device/tests-and-paper-bench.sh OUTDIR
 #   expects: build-bench/both.tar.xz (stripped spaceskip + spaceskip_core_tests, one solid xz:
 #            they share most of their code, so both fit the carry limit), build-bench/lib
 #            (libpng16), .deps/tbb
 #   env:     MEMCHECK_FILTER (gtest filter, default the CUDA distance field and Auto),
 #            RUNS ("run2:DATASETS run1:DATASETS", space separated), BUILDERS, TIME_LIMIT, FRAMES
 set -uo pipefail
-out=${1:?usage: cli-and-tests.sh OUTDIR}
+out=${1:?usage: tests-and-paper-bench.sh OUTDIR}
 mkdir -p "$out"
 src=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$src"
@@ -33,7 +33,7 @@ tail -3 "$out/memcheck.log"
 for run in ${RUNS:-}; do
   name=${run%%:*}
   BUILD_DIR=$src/build-y DATASETS=${run#*:} BUILDERS=${BUILDERS:-naive,grid,distance_grid,kdtree_gpu_fast,kdtree_empty,auto} \
-    TIME_LIMIT=${TIME_LIMIT:-200} FRAMES=${FRAMES:-8} bash Testing/gpu/paper-bench.sh "$out/$name" > "$out/$name.out" 2>&1
+    TIME_LIMIT=${TIME_LIMIT:-200} FRAMES=${FRAMES:-8} bash bench/device/paper-bench.sh "$out/$name" > "$out/$name.out" 2>&1
   echo "$name rc=$?" | tee -a "$out/env.txt"
   grep -h "^Auto:" "$out/$name/bench.log" | head -20
 done

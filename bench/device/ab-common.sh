@@ -1,4 +1,4 @@
-# Shared by the old-vs-new device scripts (refill-dg.sh, round11.sh): sourced after `out` and
+# Shared by the old-vs-new device scripts (paper-ab.sh): sourced after `out` and
 # `phases` are set. Unpacks build-bench/both.tar.xz (new) and old.tar.xz (old, when carried)
 # into build-new/ and build-old/, sets the library path (build-bench/lib, .deps/tbb), writes
 # OUT/env.txt (GPU, driver, commit), defines has/late/log/sanitize/summarize, and runs the

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Packs, on the development machine (Debian 12 + ParaView 5.11), what the VTK mapper tests and the
-# window benchmark need on a GPU machine that has no VTK, X server or GL loader (DEVICE.md):
+# window benchmark need on a GPU machine that has no VTK, X server or GL loader (docs/gpu.md):
 #   .vtkbundle/vtk.tar.xz  bin/: vtkSpaceSkipCxxTests, spaceskip_window_bench, spaceskip (CLI),
 #                          spaceskip_core_tests (Core's GoogleTest binary, when built);
 #                          lib/: libvtkSpaceSkip.so (built with CUDA), libEGL (glvnd) + the closure of shared
@@ -12,10 +12,10 @@
 # Trimmed to fit one device run (64 MiB with the working tree): libz3 (LLVM's SMT solver, used by
 # clang's analyzer only) and libicuuc/libicudata (libxml2's encoding conversion) are replaced by
 # stubs that define the symbols their users link against and abort if ever called; Mesa never
-# calls them (checked by running Xvfb and a Mesa client on the stubs, see run-gpu-vtk.sh).
+# calls them (checked by running Xvfb and a Mesa client on the stubs, see run-vtk.sh).
 #
-#   Testing/gpu/bundle-vtk.sh [BUILD_DIR]     (default ./build; configure it with CUDA on)
-# Then on the GPU machine: Testing/gpu/run-gpu-vtk.sh OUTDIR (the device tool: carry .vtkbundle).
+#   bench/device/bundle-vtk.sh [BUILD_DIR]     (default ./build; configure it with CUDA on)
+# Then on the GPU machine: bench/device/run-vtk.sh OUTDIR (the device tool: carry .vtkbundle).
 # x.tar.xz is kept when it exists (it takes ~2 minutes to compress): delete it to repack.
 set -euo pipefail
 src=$(cd "$(dirname "$0")/../.." && pwd)

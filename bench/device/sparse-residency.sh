@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Sparse residency on the GPU machine (issue "Larger than GPU memory"), from a CLI and core-test
-# build carried over (SS_CLI, SS_TESTS; LD_LIBRARY_PATH for oneTBB and libpng as for run-gpu.sh).
+# build carried over (SS_CLI, SS_TESTS; LD_LIBRARY_PATH for oneTBB and libpng as for run-core.sh).
 #
-#   Testing/gpu/sparse.sh OUTDIR [tests] [memcheck] [compare] [beyond]
+#   bench/device/sparse-residency.sh OUTDIR [tests] [memcheck] [compare] [beyond]
 #   tests:    the core tests BrickPool.* (CUDA sparse == in core for every builder and mode)
 #             and the CUDA suites that touch the backend (CudaTrees, Cuda*, Slice, CropClip)
 #   memcheck: compute-sanitizer memcheck on BrickPool.Cuda* and a small sparse CLI run
@@ -14,7 +14,7 @@
 #             device's free memory less the rest)
 # Each phase writes OUTDIR/<phase>.log; OUTDIR/env.txt has the GPU, date and binaries.
 set -uo pipefail
-out=${1:?usage: sparse.sh OUTDIR [tests] [memcheck] [compare] [beyond]}
+out=${1:?usage: sparse-residency.sh OUTDIR [tests] [memcheck] [compare] [beyond]}
 shift
 mkdir -p "$out"
 cli=${SS_CLI:-build/Core/spaceskip}

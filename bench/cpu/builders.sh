@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Reruns the CPU-builder measurements quoted in docs/results/cpu-builders-256.md.
-# usage: Testing/scripts/cpu-builders-bench.sh OUT_DIR [SPACESKIP_BINARY]
+# usage: bench/cpu/builders.sh OUT_DIR [SPACESKIP_BINARY]
 #   THREADS="1 2" (default) oneTBB thread counts for the build-time sweep; BRICKS="8 4 2 1".
 set -euo pipefail
 out=${1:?usage: $0 OUT_DIR [SPACESKIP_BINARY]}

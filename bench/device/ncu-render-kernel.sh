@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Nsight Compute profile of the render kernel per builder on one volume (issue 13: why skipping
-# loses to naive on dense data). usage: profile-dense.sh OUT BIN [VOLUME] [BUILDERS]
+# loses to naive on dense data). usage: ncu-render-kernel.sh OUT BIN [VOLUME] [BUILDERS]
 #   BIN: a spaceskip CLI built with CUDA; VOLUME default gen:menger:1024;
 #   BUILDERS default naive,grid,kdtree-gpu-fast:deep:mls128,lbvh; env EXTRA: more bench options.
 set -uo pipefail
