@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Reruns the CPU-builder measurements quoted in docs/results/cpu-builders-256.md.
+# Reruns the CPU-builder measurements quoted in docs/results/cpu-builders/NOTES.md.
 # usage: bench/cpu/builders.sh OUT_DIR [SPACESKIP_BINARY]
 #   THREADS="1 2" (default) oneTBB thread counts for the build-time sweep; BRICKS="8 4 2 1".
 set -euo pipefail
