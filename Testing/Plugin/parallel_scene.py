@@ -65,7 +65,7 @@ if stock:
     disp.SetRepresentationType("Volume")
 else:
     # Early ray termination stops a ray at opacity 0.99 inside one piece; the pieces behind it
-    # still add their (at most 1 %) share: off for the exact comparison (README, Parallel).
+    # still add their (at most 1 %) share: off for the exact comparison (docs/paraview.md, Parallel (MPI)).
     disp.EarlyRayTermination = 1 if os.environ.get("SPACESKIP_PARALLEL_ERT") else 0
     # Float compositing of the ranks' pieces (on by default); "0": ParaView's 8-bit compositing.
     disp.FloatCompositing = int(os.environ.get("SPACESKIP_FLOAT_COMPOSITING", "1"))

@@ -170,7 +170,7 @@ try:
         disp.BlendMode = "Composite"
         disp.Builder = "Grid"
         # The 8-bit path's own differences off: FXAA smooths each rank's image apart, early ray
-        # termination stops a ray in the front piece only (README, Parallel).
+        # termination stops a ray in the front piece only (docs/paraview.md, Parallel (MPI)).
         view.UseFXAA = 0
         disp.EarlyRayTermination = 0
         n = servermanager.ActiveConnection.GetNumberOfDataPartitions()

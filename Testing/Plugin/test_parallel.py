@@ -10,7 +10,7 @@ head with a translucent transfer function, seen obliquely, so the planes where t
 Each rank's piece is exact (Testing/Core/TestPieces.cpp composites pieces in float: within
 1e-3 of the whole volume's image); what remains is IceT's compositing in 8 bits per channel,
 front + floor(back * (255 - alpha) / 255), after each piece was rounded to 8 bits: a blend of n
-pieces can be off by up to about n/255 in rare pixels (README, Parallel: ParaView 5.11's IceT
+pieces can be off by up to about n/255 in rare pixels (docs/paraview.md, Parallel (MPI): ParaView 5.11's IceT
 composites RGBA in 8 bits only). Checked, tightened to what the 2-core development machine
 measured on 2026-11-24 (Grid and KdTreeCPU alike: 58.87 / 57.34 dB, max 2/255 / 3/255, 0.011 % /
 0.473 % of the pixels off by more than 1/255): max |diff| <= n/255, PSNR >= 58.5 / 57.0 dB, and
