@@ -96,17 +96,33 @@ struct OpacityRangeMaxView {
   const float* levels;                   ///< level k at levels + offset[k]: size - 2^k + 1 entries
   int offset[kMaxLevels];
   int size;         ///< table entries (level 0)
-  double lo, scale; ///< entry x = (v - lo) * scale
+  float lo, scale;  ///< the samplers' own mapping (tableMapping): entry x = (v - lo) * scale
+
+  /// Relative widening of a value range before it is mapped: a trilinear sample of voxels in
+  /// [vmin, vmax], computed in float (or by the texture unit), can round a few ulps outside it.
+  static constexpr float kRoundingPad = 1e-5f;
 
   /// Max opacity any sample with value in [vmin, vmax] can get (0 for an empty/NaN range).
+  /// Exact where it matters for skipping: the entries are the ones lookup() can blend for such a
+  /// value, mapped in float exactly as the samplers map it (float subtraction and multiplication
+  /// are monotonic, so every sample's position lies in [x(vmin), x(vmax)]). A position that is a
+  /// whole entry reads that entry alone (lookup's weight of the next one is 0), so a brick whose
+  /// voxels all sit at a value of opacity 0 (ParaView's default ramp at its lower end, exact-zero
+  /// backgrounds) is empty.
   SS_FUNC float query(double vmin, double vmax) const {
     if (!(vmin <= vmax)) return 0.f;  // empty or NaN range
-    // A sample's value lies in [vmin, vmax]; the lookup blends entries floor(x) and floor(x)+1.
-    double x0 = (vmin - lo) * scale, x1 = (vmax - lo) * scale;
-    x0 = fmin(fmax(x0, 0.0), double(size - 1));
-    x1 = fmin(fmax(x1, 0.0), double(size - 1));
-    // One extra entry on each side absorbs float-vs-double rounding of the integrator's lookup.
-    int i0 = int(floor(x0)) - 1, i1 = int(ceil(x1)) + 1;
+    float a = float(vmin), b = float(vmax);
+    const float pad = fmaxf(fabsf(a), fabsf(b)) * kRoundingPad;  // 0 for an all-zero brick
+    a -= pad;
+    b += pad;
+    float x0 = (a - lo) * scale, x1 = (b - lo) * scale;
+    const float top = float(size - 1);
+    x0 = fminf(fmaxf(x0, 0.f), top);  // fmax/fmin: NaN (inf - inf) becomes the bound
+    x1 = fminf(fmaxf(x1, 0.f), top);
+    if (!(x0 <= x1)) x0 = 0.f, x1 = top;  // cannot happen for ordered finite input; stay safe
+    int i0 = int(floorf(x0));
+    int i1 = int(floorf(x1));
+    if (float(i1) < x1) ++i1;  // a fractional position blends the next entry too
     i0 = i0 < 0 ? 0 : (i0 > size - 1 ? size - 1 : i0);
     i1 = i1 < i0 ? i0 : (i1 > size - 1 ? size - 1 : i1);
     const int len = i1 - i0 + 1;

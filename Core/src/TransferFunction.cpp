@@ -111,10 +111,12 @@ OpacityRangeMax::OpacityRangeMax(const TransferFunction& tf) {
   if (tf.table.empty()) throw std::invalid_argument("empty transfer-function table");
   const int size = int(tf.table.size());
   view_.size = size;
-  // Over the alpha entries' own range (dependent components: the opacity channel's).
-  const double lo = tf.alphaMin(), hi = tf.alphaMax();
-  view_.lo = lo;
-  view_.scale = hi > lo ? double(size - 1) / (hi - lo) : 0.0;
+  // Over the alpha entries' own range (dependent components: the opacity channel's), mapped as
+  // the samplers map it (Engine's fillComponents and setTransferTable use tableMapping too).
+  TransferFunction alpha;
+  alpha.rangeMin = tf.alphaMin();
+  alpha.rangeMax = tf.alphaMax();
+  tableMapping(alpha, size, view_.lo, view_.scale);
   // Level k (entries i..i+2^k-1) at offset[k]: the max of two entries of level k-1.
   size_t total = 0;
   int levels = 0;

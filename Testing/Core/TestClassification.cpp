@@ -107,6 +107,41 @@ TEST(Classification, OpacityZeroEverywhereAndOne) {
   EXPECT_EQ(classify(g, TransferFunction::preset("opaque", 0, 255)).occupied, g.size());
 }
 
+TEST(Classification, ExactZerosUnderParaViewsDefaultRampAreEmpty) {
+  // ParaView's default opacity map is a ramp from (data min, 0) to (data max, 1). A brick whose
+  // voxels (with the halo) are all exactly the data minimum can only sample that value, which
+  // maps onto table entry 0 exactly: opacity 0, so the brick is empty. Bricks touching a
+  // non-zero voxel stay occupied, and every builder still draws the naive image.
+  const int n = 48;
+  Volume v;
+  v.allocate(vec3l{n, n, n}, VoxelType::UInt8);
+  uint8_t* d = v.mutableData();
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const double r = std::sqrt(double((x - 20) * (x - 20) + (y - 24) * (y - 24) + (z - 26) * (z - 26)));
+        d[x + n * (y + n * z)] = r < 7 ? uint8_t(255 - r * 30) : 0;  // a ball in exact zeros
+      }
+  const auto tf = TransferFunction::fromPoints({{0, 0.23f, 0.3f, 0.75f, 0.f}, {255, 0.7f, 0.02f, 0.15f, 1.f}}, 0,
+                                               255, 1024);
+  RangeGrid g = computeRangeGrid(v, 8);
+  OccupancyGrid o = classify(g, tf);
+  for (int64_t i = 0; i < g.size(); ++i)
+    EXPECT_EQ(o.occ[size_t(i)] != 0, g.vmax[size_t(i)] > 0.f) << "brick " << i;
+  EXPECT_LT(o.occupancy(), 0.2);
+  EXPECT_GT(o.occupied, 0);
+  // A value just above zero is not skipped: the table's entry 1 is > 0 and blends in.
+  EXPECT_GT(OpacityRangeMax(tf).query(0.0, 1e-3), 0.f);
+  EXPECT_EQ(OpacityRangeMax(tf).query(0.0, 0.0), 0.f);
+  const Image naive = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 30, 20);
+  EXPECT_GT(test::coverage(naive), 0.005);
+  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::LBVHCPU, BuilderKind::KdTreeCPU, BuilderKind::Hybrid,
+                        BuilderKind::DistanceGrid}) {
+    const Image img = test::renderWith(v, tf, test::builder(k), 30, 20);
+    EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f) << "builder " << int(k);
+  }
+}
+
 TEST(Engine, ColourEditUpdatesTableOnlyOpacityEditReclassifies) {
   Volume v = generateVolume("shell", vec3l{32, 32, 32});
   Engine e(BackendKind::CPU);
@@ -239,7 +274,7 @@ TEST(SubMasks, AVoxelSetsThePartsWhoseSamplesCanReadIt) {
   EXPECT_EQ(computeSubMasks(v, o, tf).mask[0], uint64_t(1));
   // Bricks without four parts of >= 2 cells have no masks.
   EXPECT_TRUE(computeSubMasks(v, classify(computeRangeGrid(v, 4), tf), tf).mask.empty());
-  // A brick with more set parts than subMaskMaxSet() is marched whole.
+  // A brick with more set parts than Tuning::subMaskMaxSet is marched whole.
   std::fill(d, d + 17 * 17 * 17, uint8_t(200));
   o = classify(computeRangeGrid(v, 8), tf);
   const SubMasks full = computeSubMasks(v, o, tf);
@@ -265,9 +300,9 @@ TEST(SubMasks, FewerSamplesAndTheSameImage) {
     const Image naive = test::renderCounting(v, tf, BuilderKind::Naive, c, 96, naiveSamples);
     for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid}) {
       int64_t with = 0, without = 0;
-      setenv("SPACESKIP_SUB_MASKS", "0", 1);
-      const Image whole = test::renderCounting(v, tf, k, c, 96, without);
-      unsetenv("SPACESKIP_SUB_MASKS");
+      Tuning noMasks;
+      noMasks.subMasks = false;
+      const Image whole = test::renderCounting(v, tf, k, c, 96, without, RenderParams{}, noMasks);
       const Image parts = test::renderCounting(v, tf, k, c, 96, with);
       EXPECT_EQ(compareImages(whole, parts).maxAbs, 0.f) << builderName(k);
       EXPECT_LE(compareImages(naive, parts).maxAbs, 1.f / 255.f) << builderName(k);
