@@ -1,13 +1,18 @@
 // The server-manager proxy of "Space Skipping Volume": its statistics come from the render server.
 #include "vtkSMSpaceSkipRepresentationProxy.h"
 
+#include "vtkCommand.h"
+#include "vtkDataObject.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPVSession.h"
 #include "vtkPVXMLElement.h"
+#include "vtkSMArrayListDomain.h"
+#include "vtkSMPVRepresentationProxy.h"
 #include "vtkSMProperty.h"
 #include "vtkSMPropertyGroup.h"
 #include "vtkSMPropertyHelper.h"
+#include "vtkSMSessionProxyManager.h"
 #include "vtkSpaceSkipStatisticsInformation.h"
 
 #include <cstring>
@@ -18,7 +23,17 @@ vtkStandardNewMacro(vtkSMSpaceSkipRepresentationProxy);
 vtkSMSpaceSkipRepresentationProxy::vtkSMSpaceSkipRepresentationProxy() = default;
 
 //------------------------------------------------------------------------------
-vtkSMSpaceSkipRepresentationProxy::~vtkSMSpaceSkipRepresentationProxy() = default;
+vtkSMSpaceSkipRepresentationProxy::~vtkSMSpaceSkipRepresentationProxy()
+{
+  if (this->RepresentationProperty && this->RepresentationObserver)
+  {
+    this->RepresentationProperty->RemoveObserver(this->RepresentationObserver);
+  }
+  if (this->ObservedView && this->RenderObserver)
+  {
+    this->ObservedView->RemoveObserver(this->RenderObserver);
+  }
+}
 
 //------------------------------------------------------------------------------
 void vtkSMSpaceSkipRepresentationProxy::UpdatePropertyInformationInternal(vtkSMProperty* prop)
@@ -131,6 +146,12 @@ void vtkSMSpaceSkipRepresentationProxy::CreateVTKObjects()
   {
     return;
   }
+  if (vtkSMProperty* representation = display->GetProperty("Representation"))
+  {
+    this->RepresentationProperty = representation;
+    this->RepresentationObserver = representation->AddObserver(
+      vtkCommand::ModifiedEvent, this, &vtkSMSpaceSkipRepresentationProxy::OnRepresentationModified);
+  }
   for (size_t i = 0; i < display->GetNumberOfPropertyGroups(); ++i)
   {
     vtkSMPropertyGroup* group = display->GetPropertyGroup(i);
@@ -141,6 +162,84 @@ void vtkSMSpaceSkipRepresentationProxy::CreateVTKObjects()
       AddRepresentationToOr(group->GetHints());
     }
   }
+}
+
+//------------------------------------------------------------------------------
+void vtkSMSpaceSkipRepresentationProxy::OnRepresentationModified()
+{
+  auto* display = vtkSMPVRepresentationProxy::SafeDownCast(this->GetParentProxy());
+  if (!display || this->PickingColorArray || !this->RepresentationProperty)
+  {
+    return;
+  }
+  const char* type = vtkSMPropertyHelper(this->RepresentationProperty).GetAsString();
+  if (!type || strcmp(type, kRepresentationName) != 0 || display->GetUsingScalarColoring())
+  {
+    return;
+  }
+  vtkSMSessionProxyManager* pxm = display->GetSessionProxyManager();
+  if (pxm && pxm->GetInLoadXMLState())
+  {
+    return;
+  }
+  vtkSMProperty* colorArrayName = display->GetProperty("ColorArrayName");
+  auto* arrays = colorArrayName ? colorArrayName->FindDomain<vtkSMArrayListDomain>() : nullptr;
+  if (!arrays || arrays->GetNumberOfStrings() == 0)
+  {
+    return;
+  }
+  unsigned int index = 0;
+  for (unsigned int i = 0; i < arrays->GetNumberOfStrings(); ++i)
+  {
+    if (arrays->GetFieldAssociation(i) == vtkDataObject::POINT)
+    {
+      index = i;
+      break;
+    }
+  }
+  this->PickingColorArray = true;
+  if (display->SetScalarColoring(arrays->GetString(index), arrays->GetFieldAssociation(index)))
+  {
+    display->RescaleTransferFunctionToDataRange(true);
+  }
+  this->PickingColorArray = false;
+}
+
+//------------------------------------------------------------------------------
+void vtkSMSpaceSkipRepresentationProxy::ViewUpdated(vtkSMProxy* view)
+{
+  this->Superclass::ViewUpdated(view);
+  if (!view || view == this->ObservedView)
+  {
+    return;
+  }
+  if (this->ObservedView && this->RenderObserver)
+  {
+    this->ObservedView->RemoveObserver(this->RenderObserver);
+  }
+  this->ObservedView = view;
+  this->RenderObserver =
+    view->AddObserver(vtkCommand::EndEvent, this, &vtkSMSpaceSkipRepresentationProxy::OnRenderEnd);
+}
+
+//------------------------------------------------------------------------------
+void vtkSMSpaceSkipRepresentationProxy::OnRenderEnd(vtkObject*, unsigned long, void* calldata)
+{
+  // vtkSMViewProxy: calldata points to 0 after StillRender, 1 after InteractiveRender. Only
+  // still renders (a gather from the render server each), and only while this one is shown.
+  const int interactive = calldata ? *static_cast<int*>(calldata) : 0;
+  vtkSMProxy* display = this->GetParentProxy();
+  if (interactive || !this->ObjectsCreated || !display || !this->RepresentationProperty)
+  {
+    return;
+  }
+  const char* type = vtkSMPropertyHelper(this->RepresentationProperty).GetAsString();
+  if (!type || strcmp(type, kRepresentationName) != 0 ||
+    !vtkSMPropertyHelper(display, "Visibility").GetAsInt())
+  {
+    return;
+  }
+  this->UpdatePropertyInformation();
 }
 
 //------------------------------------------------------------------------------

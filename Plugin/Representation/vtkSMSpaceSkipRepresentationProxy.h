@@ -20,6 +20,7 @@
 
 #include "vtkSMRepresentationProxy.h"
 #include "vtkSpaceSkipRepresentationModule.h" // for export macro
+#include "vtkWeakPointer.h"                   // for vtkWeakPointer
 
 class VTKSPACESKIPREPRESENTATION_EXPORT vtkSMSpaceSkipRepresentationProxy
   : public vtkSMRepresentationProxy
@@ -44,7 +45,27 @@ protected:
   /// in the parent display's group hints (once: the hints belong to the shared definition).
   void CreateVTKObjects() override;
 
+  /// After the view updated: follows that view's still renders (see OnRenderEnd).
+  void ViewUpdated(vtkSMProxy* view) override;
+
+  /// A colour array when the display switches to "Space Skipping Volume" without one, picked
+  /// as vtkSMPVRepresentationProxy::SetRepresentationType does for ParaView's own "Volume" (the
+  /// first point array, else the first array; its transfer functions rescaled to the data
+  /// range), so the volume draws at once. Not while a state file loads (it sets its own).
+  void OnRepresentationModified();
+
+  /// After a still render of the view: the statistics properties read again, so the Properties
+  /// panel shows the frame just drawn (ParaView pulls information properties only on request).
+  void OnRenderEnd(vtkObject* caller, unsigned long event, void* calldata);
+
 private:
+  vtkWeakPointer<vtkSMProperty> RepresentationProperty;
+  unsigned long RepresentationObserver = 0;
+  vtkWeakPointer<vtkSMProxy> ObservedView;
+  unsigned long RenderObserver = 0;
+  bool PickingColorArray = false;
+
+
   vtkSMSpaceSkipRepresentationProxy(const vtkSMSpaceSkipRepresentationProxy&) = delete;
   void operator=(const vtkSMSpaceSkipRepresentationProxy&) = delete;
 };
