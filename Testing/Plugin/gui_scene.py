@@ -12,6 +12,24 @@ import ssptest
 out = os.environ["SPACESKIP_TEMP"]
 try:
     import paraview.simple
+    # First contact, as a new user meets it: a data set shown with ParaView's defaults, then
+    # "Space Skipping Volume" chosen in the representation menu (SetRepresentationType, what the
+    # menu calls): no colour array, transfer function or builder picked by hand. The statistics
+    # are read as the Properties panel reads them, without asking for an update.
+    first_view = GetActiveViewOrCreate("RenderView")  # the view in the GUI's layout
+    first = ssptest.open_data()
+    RenameSource("first contact", first)
+    first_disp = Show(first, first_view)
+    first_disp.SetRepresentationType("Space Skipping Volume")
+    first_view.ResetCamera()
+    Render(first_view)
+    SaveScreenshot(os.path.join(out, "gui_first.png"), first_view, ImageResolution=list(ssptest.IMAGE_SIZE),
+                   TransparentBackground=0)
+    first_result = {
+        "color_array": list(first_disp.ColorArrayName),
+        "stats": {n: first_disp.GetPropertyValue(n) for n in
+                  ("BuilderUsed", "BackendUsed", "LastRenderSeconds", "Occupancy", "FrameCount", "BuilderChoice")}}
+    Delete(first)
     paraview.simple._DisableFirstRenderCameraReset()  # keep the scene's camera
     reader = ssptest.open_data()
     RenameSource("shell_64x64x64_uint8.raw", reader)
@@ -25,7 +43,8 @@ try:
                    TransparentBackground=0)
     result = {"representation": disp.SMProxy.GetProperty("Representation").GetElement(0),
               "stats": ssptest.stats(disp),
-              "groups_shown": ssptest.groups_shown_for(disp)}
+              "groups_shown": ssptest.groups_shown_for(disp),
+              "first": first_result}
 except Exception as e:  # report to the driver instead of leaving it waiting
     import traceback
     result = {"error": traceback.format_exc()}

@@ -14,7 +14,7 @@ ok = ssptest.Checker()
 here = os.path.dirname(os.path.abspath(__file__))
 out = os.path.dirname(ssptest.temp_path("x"))
 done = os.path.join(out, "gui_done.txt")
-for name in ("gui_done.txt", "gui_view.png", "gui_window.png"):
+for name in ("gui_done.txt", "gui_view.png", "gui_window.png", "gui_first.png"):
     if os.path.exists(os.path.join(out, name)):
         os.remove(os.path.join(out, name))
 
@@ -66,6 +66,24 @@ stats = result.get("stats", {})
 ok.check(stats.get("FrameCount", 0) >= 1 and stats.get("BuildCount", 0) >= 1,
          "the mapper drew in the GUI (%s frames, %s builds)" % (stats.get("FrameCount"),
                                                                 stats.get("BuildCount")))
+# First contact: the representation chosen on a fresh display draws at once (the colour array
+# picked as for ParaView's Volume) and the statistics panel is filled after the first render.
+first = result.get("first", {})
+fstats = first.get("stats", {})
+ok.check(first.get("color_array", ["", ""])[1] == ssptest.ARRAY,
+         "choosing the representation picks the colour array (%s)" % first.get("color_array"))
+ok.check(fstats.get("FrameCount", 0) >= 1 and fstats.get("BuilderUsed") not in (None, "", "none")
+         and fstats.get("LastRenderSeconds", 0) > 0 and 0 < fstats.get("Occupancy", 0) <= 1,
+         "the statistics panel is filled after the first render, without asking (%s)" % fstats)
+first_png = os.path.join(out, "gui_first.png")
+if os.path.exists(first_png):
+    a = ssptest.read_png(first_png)
+    # ParaView's default background (not black here): pixels that differ from the corner's.
+    lit = float((abs(a - a[0, 0]).max(axis=2) > 8).mean())
+    ok.check(lit > 0.02, "the view is not empty right after choosing the representation (%.1f%% lit)"
+             % (100 * lit))
+else:
+    ok.check(False, "the GUI saved no first-contact screenshot")
 view_png = os.path.join(out, "gui_view.png")
 if os.path.exists(view_png):
     a = ssptest.read_png(view_png)
