@@ -36,33 +36,6 @@ ok = ssptest.Checker()
 N = args.size
 
 
-def write_sparse_vti(path):
-    """N^3 uint8: a few balls and tubes with a smooth profile in a background of exact zeros
-    (about 5 % of the voxels non-zero), written as .vti as a user's data set would be."""
-    import numpy
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    z, y, x = numpy.mgrid[0:N, 0:N, 0:N].astype(numpy.float32) / N
-    v = numpy.zeros((N, N, N), numpy.float32)
-    for cx, cy, cz, r in ((0.3, 0.35, 0.4, 0.18), (0.7, 0.6, 0.55, 0.15), (0.5, 0.75, 0.3, 0.12)):
-        d = numpy.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2) / r
-        v = numpy.maximum(v, numpy.clip(1.0 - d, 0.0, 1.0))
-    tube = numpy.sqrt((y - 0.5) ** 2 + (z - 0.65) ** 2) / 0.05  # a tube along x
-    v = numpy.maximum(v, numpy.clip(1.0 - tube, 0.0, 1.0) * 0.8)
-    data = numpy.round(v * 255.0).astype(numpy.uint8)
-    img = vtkImageData()
-    img.SetDimensions(N, N, N)
-    arr = numpy_to_vtk(data.ravel(), deep=1)
-    arr.SetName("density")
-    img.GetPointData().SetScalars(arr)
-    w = vtkXMLImageDataWriter()
-    w.SetFileName(path)
-    w.SetInputData(img)
-    w.Write()
-    return float((data > 0).mean())
-
-
 def shown(source, view, representation):
     """A fresh display of `source` switched to `representation` the way the GUI's menu does."""
     disp = Show(source, view)
@@ -138,7 +111,8 @@ def images(views, name):
 rows = []
 # -- sparse: exact-zero background -------------------------------------------------------------
 path = ssptest.temp_path("first_hour_sparse_%d.vti" % N)
-nonzero = write_sparse_vti(path)
+nonzero = ssptest.write_sparse_vti(path, N, balls=((0.3, 0.35, 0.4, 0.18), (0.7, 0.6, 0.55, 0.15), (0.5, 0.75, 0.3, 0.12)),
+                                   tube_radius=0.05)
 sparse = XMLImageDataReader(FileName=[path])
 views, ours = scene(sparse, "sparse")
 t_ours, t_stock = measure(views)
