@@ -26,6 +26,7 @@
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 
+#include "spaceskip/Tuning.h"
 #include "spaceskip/Types.h"
 
 #include <tbb/blocked_range.h>
@@ -61,6 +62,7 @@ void CopySettings(vtkSpaceSkippingVolumeMapper* from, vtkSpaceSkippingVolumeMapp
   to->SetGPUComposite(from->GetGPUComposite());
   to->SetUseJittering(from->GetUseJittering());
   to->SetDeviceMemoryBudget(from->GetDeviceMemoryBudget());
+  to->SetTuning(from->GetTuning());
   to->SetVectorMode(from->GetVectorMode());
   to->SetVectorComponent(from->GetVectorComponent());
   to->SetBlendModeOverride(from->GetBlendModeOverride());
@@ -118,12 +120,6 @@ vtkDataArray* SelectedScalars(vtkSpaceSkippingVolumeMapper* parent, vtkImageData
   vtkDataArray* scalars = vtkAbstractMapper::GetScalars(image, parent->GetScalarMode(),
     parent->GetArrayAccessMode(), parent->GetArrayId(), parent->GetArrayName(), cellFlag);
   return scalars && cellFlag == 0 ? scalars : nullptr;
-}
-
-// [lo, hi] per axis of two boxes (points or cells, inclusive) overlap on axis a.
-bool Overlap(const int* a, const int* b, int axis)
-{
-  return a[2 * axis] <= b[2 * axis + 1] && b[2 * axis] <= a[2 * axis + 1];
 }
 
 // The cells of an image block that no ghost array marks as duplicates, [lo, hi) per axis in
@@ -540,9 +536,8 @@ bool vtkSpaceSkipBlockRenderer::Render(vtkSpaceSkippingVolumeMapper* parent,
   {
     // Under MPI IceT blends the ranks' images in 8 bits and truncates: where a ray goes on into
     // another rank's blocks, this rank's colour is raised by half a unit, as a single piece's is
-    // (VolumePiece::followBias; SPACESKIP_PIECE_BIAS in 1/255 overrides).
-    const char* env = std::getenv("SPACESKIP_PIECE_BIAS");
-    const float bias = static_cast<float>((env ? std::atof(env) : 0.5) / 255.0);
+    // (VolumePiece::followBias; Tuning::pieceBias, in 1/255).
+    const float bias = static_cast<float>(parent->GetTuning().pieceBias / 255.0);
     if (bias != 0.f)
     {
       this->AddFollowBias(ren, vol, bias);

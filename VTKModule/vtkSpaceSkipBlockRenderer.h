@@ -91,8 +91,6 @@ public:
   bool IsActive() const { return this->Active; }
   /// Forgets the blocks (the input is no longer composite).
   void Clear();
-  /// Whether the last Render() laid the blocks on one lattice (else each sampled on its own).
-  bool IsOnLattice() const { return this->Active && this->OnLattice; }
 
   ///@{
   /// Statistics over the block mappers of the last frame (see vtkSpaceSkippingVolumeMapper):
@@ -127,7 +125,6 @@ public:
   double MinSampleDistance() const;
   /// Frames drawn through the blocks (one per Render() that drew at least one block).
   int GetFrameCount() const { return this->Frames; }
-  int GetNumberOfBlocks() const { return static_cast<int>(this->Blocks.size()); }
   ///@}
 
 private:

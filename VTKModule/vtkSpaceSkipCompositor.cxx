@@ -37,23 +37,15 @@
 
 namespace
 {
-// A measurement switch (read per frame), "1": on.
-bool EnvOn(const char* name)
-{
-  const char* v = std::getenv(name);
-  return v && v[0] == '1';
-}
-
 #ifdef SPACESKIP_HAVE_CUDA
-// Queues on the engine's `stream` (after its frame; with SPACESKIP_SYNC_FRAME=1, a measurement
-// switch, on the default stream, the engine having waited) the map of `resource`, `work` on its
+// Queues on the engine's `stream` (after its frame) the map of `resource`, `work` on its
 // array (returns a cudaError_t as an int) and the unmap: the map makes CUDA wait for GL's drawing
 // so far, the unmap GL's next drawing for `work`, both on the GPU. On failure `what` names the
 // step (`workName` for `work`).
 template <class Work>
 cudaError_t OnMappedArray(void* resource, void* stream, const char* workName, Work work, const char*& what)
 {
-  const cudaStream_t s = EnvOn("SPACESKIP_SYNC_FRAME") ? nullptr : static_cast<cudaStream_t>(stream);
+  const cudaStream_t s = static_cast<cudaStream_t>(stream);
   cudaGraphicsResource_t r = static_cast<cudaGraphicsResource_t>(resource);
   cudaError_t e = cudaGraphicsMapResources(1, &r, s);
   if (e != cudaSuccess)
@@ -241,7 +233,7 @@ void vtkSpaceSkipCompositor::VisibleRect(const spaceskip::Camera& camera, vtkIma
   rect[0] = rect[1] = 0;
   rect[2] = width;
   rect[3] = height;
-  if (!input || EnvOn("SPACESKIP_COMPOSITE_FULL"))
+  if (!input)
   {
     return;
   }
@@ -489,15 +481,14 @@ void vtkSpaceSkipCompositor::ReleaseTarget()
 // RGBA8 texture written through draw buffer 0 with every channel enabled (VTK's default). No
 // texture copy and no GL draw: a draw over the whole window costs the H100's few graphics
 // units more than the blend kernel costs its SMs. False (the texture path then draws this
-// frame) for any other target, with SPACESKIP_CUDA_BLEND=0 (a measurement switch), and from a
+// frame) for any other target, with SetCudaBlend(false) (Tuning::cudaBlend), and from a
 // CUDA failure on (said once at INFO verbosity).
 #ifdef SPACESKIP_HAVE_CUDA
 bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
   const spaceskip::DeviceImageView& image, void* stream, int w, int h, const int rect[4],
   bool eightBit)
 {
-  const char* off = std::getenv("SPACESKIP_CUDA_BLEND");
-  if (this->TargetFailed || (off && off[0] == '0'))
+  if (this->TargetFailed || !this->CudaBlend)
   {
     return false;
   }

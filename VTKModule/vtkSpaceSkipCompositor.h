@@ -48,6 +48,10 @@ public:
    */
   static bool SceneHasDepth(vtkRenderer* ren);
 
+  /// Whether CopyDeviceImage may blend into the framebuffer's texture by CUDA (Tuning::cudaBlend;
+  /// default on); off: the texture path (a measurement switch of the window benchmark).
+  void SetCudaBlend(bool on) { this->CudaBlend = on; }
+
   /// Whether the image may stay on the device for CUDA-GL interop (GPUComposite on, not failed).
   bool CanUseDeviceImage(bool gpuComposite) const { return gpuComposite && !this->InteropFailed; }
 
@@ -55,8 +59,8 @@ public:
    * The pixels of a `width` x `height` frame its rays can colour, as x, y, w, h (w or h 0: none):
    * the projection of `input`'s box grown by `pad` cells on each side, plus 2 pixels; a ray
    * through a pixel centre outside it misses the box, and its pixel is transparent black, which
-   * the blend leaves unchanged. The whole frame when a corner lies behind the eye, or with
-   * SPACESKIP_COMPOSITE_FULL=1 (a measurement switch).
+   * the blend leaves unchanged. The whole frame when a corner lies behind the eye or `input` is
+   * null (the mapper's Tuning::compositeFull).
    */
   static void VisibleRect(const spaceskip::Camera& camera, vtkImageData* input, double pad, int width,
     int height, int rect[4]);
@@ -71,8 +75,7 @@ public:
    * registered with CUDA, the one Draw() then blends: float texels, or with `eightBit` RGBA8
    * rounded as the host path rounds (a quarter of the bytes for the blend to read). The map,
    * copy and unmap are queued on `stream` (the engine's, Engine::deviceImageStream()) after the
-   * frame, so GL waits for the image on the GPU and the host not at all (SPACESKIP_SYNC_FRAME=1,
-   * a measurement switch: on the default stream after the engine waited, as before). False on
+   * frame, so GL waits for the image on the GPU and the host not at all. False on
    * any failure (not NVIDIA's GL, another device, a CUDA error): said once at INFO verbosity,
    * and the host path is used from then on.
    */
@@ -93,8 +96,6 @@ public:
   const std::string& GetCompositePath() const { return this->CompositePath; }
   /// "cuda" (blended into the framebuffer by CUDA), "gl" (drawn from a texture) or "none".
   const std::string& GetBlendPath() const { return this->BlendPath; }
-  /// Why the image cannot be blended by CUDA (empty until it failed once).
-  const std::string& GetTargetProblem() const { return this->TargetProblem; }
   bool GetInteropFailed() const { return this->InteropFailed; }
   const std::string& GetInteropProblem() const { return this->InteropProblem; }
   /// Whether this frame's image came through CUDA-GL interop (CopyDeviceImage succeeded).
@@ -140,6 +141,7 @@ private:
   unsigned int TargetHandle = 0;
   int TargetSize[2] = { 0, 0 };
   bool TargetFailed = false; // once failed: the texture path from then on
+  bool CudaBlend = true;     // SetCudaBlend
   bool Direct = false;       // this frame's image is already blended (Draw has nothing to do)
   std::string TargetProblem;
 };

@@ -45,25 +45,44 @@
 
 namespace
 {
+// The library's only environment variables, read once per process (docs/tuning.md):
 // SPACESKIP_BACKEND=cpu|cuda|auto forces the backend of every mapper in the process, whatever
-// its Backend property says (tests and benchmarks on a GPU machine); -1 when unset or unknown.
-int BackendFromEnvironment()
+// its Backend property says (to run the VTK tests on a GPU machine: bench/device/run-vtk.sh),
+// said once as a warning; SPACESKIP_REPORT (any value) makes each mapper print what ran.
+struct EnvironmentOverrides
 {
-  const char* e = std::getenv("SPACESKIP_BACKEND");
-  const std::string v = e ? e : "";
-  if (v == "cpu" || v == "CPU")
+  int Backend = -1; // -1: none
+  bool Report = false;
+};
+
+const EnvironmentOverrides& Overrides()
+{
+  static const EnvironmentOverrides o = []
   {
-    return vtkSpaceSkippingVolumeMapper::CPU;
-  }
-  if (v == "cuda" || v == "CUDA")
-  {
-    return vtkSpaceSkippingVolumeMapper::CUDA;
-  }
-  if (v == "auto" || v == "Auto")
-  {
-    return vtkSpaceSkippingVolumeMapper::Auto;
-  }
-  return -1;
+    EnvironmentOverrides r;
+    const char* e = std::getenv("SPACESKIP_BACKEND");
+    const std::string v = e ? e : "";
+    if (v == "cpu" || v == "CPU")
+    {
+      r.Backend = vtkSpaceSkippingVolumeMapper::CPU;
+    }
+    else if (v == "cuda" || v == "CUDA")
+    {
+      r.Backend = vtkSpaceSkippingVolumeMapper::CUDA;
+    }
+    else if (v == "auto" || v == "Auto")
+    {
+      r.Backend = vtkSpaceSkippingVolumeMapper::Auto;
+    }
+    if (r.Backend >= 0)
+    {
+      vtkGenericWarningMacro("SPACESKIP_BACKEND=" << v << " in the environment overrides the "
+                                                  << "Backend property of every SpaceSkip mapper");
+    }
+    r.Report = std::getenv("SPACESKIP_REPORT") != nullptr;
+    return r;
+  }();
+  return o;
 }
 
 // The input as a piece of the image of extent `whole` (an empty `whole`: its own extent), and
@@ -72,7 +91,7 @@ int BackendFromEnvironment()
 // composite input: drawn exactly, composited in float). Inactive (the serial path, untouched)
 // when the input is the whole image without ghosts.
 spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
-  bool exact, const std::function<void(const std::string&)>& warn)
+  bool exact, double bias, const std::function<void(const std::string&)>& warn)
 {
   spaceskip::VolumePiece piece;
   int ext[6], w[6];
@@ -156,10 +175,8 @@ spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const in
   piece.ownedLo = spaceskip::vec3l{ own[0] - w[0], own[2] - w[2], own[4] - w[4] };
   piece.ownedHi = spaceskip::vec3l{ own[1] + 1 - w[0], own[3] + 1 - w[2], own[5] + 1 - w[4] };
   // The window and IceT hold 8 bits: a piece in front rounds up by half a unit what IceT's
-  // blend truncates (README, Parallel). SPACESKIP_PIECE_BIAS (in 1/255) overrides, for
-  // measurements.
-  const char* bias = std::getenv("SPACESKIP_PIECE_BIAS");
-  piece.followBias = exact ? 0.f : static_cast<float>((bias ? std::atof(bias) : 0.5) / 255.0);
+  // blend truncates (README, Parallel). `bias`: Tuning::pieceBias (in 1/255).
+  piece.followBias = exact ? 0.f : static_cast<float>(bias / 255.0);
   return piece;
 }
 
@@ -201,7 +218,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   std::string BackendUsed = "none";
   std::string BuilderUsed = "none";
   // SPACESKIP_REPORT set: one stdout line per mapper whenever backend or builder changes.
-  bool Report = std::getenv("SPACESKIP_REPORT") != nullptr;
+  bool Report = Overrides().Report;
+  spaceskip::Tuning Tuning; // SetTuning
   std::string Reported;
 
   // Where the last Render() spent its time (seconds; see the getters).
@@ -297,7 +315,7 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::SelectInput(vtkVolume* vol)
 // it cannot be created.
 bool vtkSpaceSkippingVolumeMapper::vtkInternals::UpdateEngine()
 {
-  const int forced = BackendFromEnvironment();
+  const int forced = Overrides().Backend;
   const int backend = forced >= 0 ? forced : this->Self->Backend;
   if (this->Engine && this->EngineBackend == backend)
   {
@@ -312,6 +330,7 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::UpdateEngine()
     const spaceskip::BackendKind kind =
       backend == CPU ? spaceskip::BackendKind::CPU : spaceskip::BackendKind::Auto;
     this->Engine.reset(new spaceskip::Engine(kind, this->Warn));
+    this->Engine->setTuning(this->Tuning);
   }
   catch (const std::exception& e)
   {
@@ -406,7 +425,8 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::Composite(vtkOpenGLRenderWindow
   const double minSpacing = spacing
     ? std::min({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) })
     : 0.0;
-  vtkSpaceSkipCompositor::VisibleRect(camera, minSpacing > 0 ? input : nullptr,
+  vtkSpaceSkipCompositor::VisibleRect(camera,
+    minSpacing > 0 && !this->Tuning.compositeFull ? input : nullptr,
     2.0 + engine.sampleDistance() / std::max(minSpacing, 1e-300), width, height, rect);
   std::copy(rect, rect + 4, this->CompositeRect);
   const bool eightBit = this->Self->EightBitComposite != 0;
@@ -754,6 +774,21 @@ void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::SetTuning(const spaceskip::Tuning& tuning)
+{
+  vtkInternals& d = *this->Internals;
+  d.Tuning = tuning;
+  d.Compositor.SetCudaBlend(tuning.cudaBlend);
+  if (d.Engine)
+  {
+    d.Engine->setTuning(tuning);
+  }
+}
+const spaceskip::Tuning& vtkSpaceSkippingVolumeMapper::GetTuning() const
+{
+  return this->Internals->Tuning;
+}
+
 void vtkSpaceSkippingVolumeMapper::SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange)
 {
   if (this->Internals->Exchange != exchange)
@@ -956,7 +991,7 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
     // composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
     d.LastPiece = PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent,
       this->UseBlockOwned ? this->BlockOwned : nullptr, this->UseBlockOwned || this->ExactPiece,
-      d.Warn);
+      d.Tuning.pieceBias, d.Warn);
     engine.setPiece(d.LastPiece);
     const double* range = this->UseTableRange ? this->TableRange
       : this->WholeScalarRange[0] <= this->WholeScalarRange[1] ? this->WholeScalarRange

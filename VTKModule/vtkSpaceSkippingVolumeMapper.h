@@ -37,6 +37,12 @@
 class vtkRenderer;
 class vtkVolume;
 class vtkWindow;
+#ifndef __VTK_WRAP__
+namespace spaceskip
+{
+struct Tuning; // Core/spaceskip/Tuning.h
+}
+#endif
 
 class VTKSPACESKIP_EXPORT vtkSpaceSkippingVolumeMapper : public vtkVolumeMapper
 {
@@ -150,9 +156,10 @@ public:
   ///@{
   /**
    * Auto (default): CUDA when a usable device exists, else CPU. The environment variable
-   * SPACESKIP_BACKEND (cpu, cuda or auto) overrides this property for every mapper of the
-   * process (to run tests and benchmarks on a given backend); SPACESKIP_REPORT (any value) prints
-   * one line per mapper with the backend, builder and GL_RENDERER whenever they change.
+   * SPACESKIP_BACKEND (cpu, cuda or auto; read once per process, said once as a warning)
+   * overrides this property for every mapper of the process (to run the tests on a given
+   * backend); SPACESKIP_REPORT (any value) prints one line per mapper with the backend, builder
+   * and GL_RENDERER whenever they change (docs/tuning.md).
    */
   vtkSetClampMacro(Backend, int, Auto, CUDA);
   vtkGetMacro(Backend, int);
@@ -390,6 +397,17 @@ public:
 
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
   void ReleaseGraphicsResources(vtkWindow*) override;
+
+#ifndef __VTK_WRAP__
+  /**
+   * The engine's and the compositor's knobs (spaceskip::Tuning, Core/spaceskip/Tuning.h; the
+   * defaults are the product's behaviour), for benchmarks and tests: the kernels' launch, the
+   * sub-brick masks, DistanceGrid's field, the piece bias under MPI, the CUDA blend, the
+   * composited rectangle. The blocks of composite input get the same (docs/tuning.md).
+   */
+  void SetTuning(const spaceskip::Tuning& tuning);
+  const spaceskip::Tuning& GetTuning() const;
+#endif
 
 #ifndef __VTK_WRAP__
   /**

@@ -2,6 +2,8 @@
 // range-checked, so a typo gives a message naming the option instead of a crash or garbage.
 #include "Options.h"
 
+#include "Environment.h"
+
 #include "spaceskip/render/Integrator.h"
 #include "spaceskip/Parse.h"
 #include "spaceskip/VolumeIO.h"
@@ -25,7 +27,7 @@ const std::set<std::string>& valueOptions() {
       "-o", "--dims", "--seed", "--builder", "--builders", "--leaf", "--mls", "--bins", "--brick", "--backend",
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
-      "--shade", "--cuda-block", "--cuda-carveout", "--scale", "--datasets", "--time-limit", "--memory-budget",
+      "--shade", "--cuda-block", "--scale", "--datasets", "--time-limit", "--memory-budget",
       "--pool-brick", "--edit-tf", "--edits", "--edit-cut"};
   return s;
 }
@@ -142,7 +144,7 @@ bool parseGeneratorSpec(const std::string& spec, uint64_t maxBytes, std::string&
 }
 
 uint64_t maxVolumeBytes(const Options& o) {
-  if (!o.has("--max-volume-bytes")) return defaultMaxVolumeBytes();
+  if (!o.has("--max-volume-bytes")) return maxVolumeBytesFromEnvironment(defaultMaxVolumeBytes());
   uint64_t v = 0;
   const std::string s = o.get("--max-volume-bytes", "");
   if (!parseByteCount(s, v) || v == 0)
@@ -262,8 +264,8 @@ BackendKind backendKind(const Options& o) {
   throw bad("--backend", b, "is not auto, cpu or cuda");
 }
 
-LaunchParams launchParams(const Options& o) {
-  LaunchParams p;
+Tuning tuning(const Options& o) {
+  Tuning p = tuningFromEnvironment();
   if (o.has("--cuda-block")) {
     const std::string b = o.get("--cuda-block", "");
     const size_t x = b.find('x');
@@ -272,7 +274,6 @@ LaunchParams launchParams(const Options& o) {
     p.blockY = int(parseIntArg(b.substr(x + 1), "--cuda-block (height)", 1, 256));
     if (p.blockX * p.blockY < 32 || p.blockX * p.blockY > 256) throw bad("--cuda-block", b, "is not 32..256 threads");
   }
-  p.carveout = int(o.getInt("--cuda-carveout", -1, 0, 100));
   return p;
 }
 

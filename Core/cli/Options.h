@@ -2,7 +2,7 @@
 // Separate from main.cpp so the option fuzzer (Testing/Fuzz) and the tests can call it.
 #pragma once
 #include "spaceskip/Engine.h"
-#include "spaceskip/LaunchParams.h"
+#include "spaceskip/Tuning.h"
 
 #include <cstdint>
 #include <map>
@@ -49,7 +49,8 @@ bool parseGeneratorSpec(const std::string& spec, uint64_t maxBytes, std::string&
 /// Voxel bytes of a generated volume, checked (throws like checkedByteSize).
 uint64_t checkGeneratorSize(const std::string& shape, vec3l dims, uint64_t maxBytes);
 
-/// --max-volume-bytes (N with an optional K/M/G/T suffix), else defaultMaxVolumeBytes().
+/// --max-volume-bytes (N with an optional K/M/G/T suffix), else SPACESKIP_MAX_VOLUME_BYTES
+/// (Environment.h), else defaultMaxVolumeBytes().
 uint64_t maxVolumeBytes(const Options& o);
 
 /// --memory-budget N[K|M|G|T]: the most memory the voxels may take on the backend (0 when
@@ -63,8 +64,9 @@ int poolBrick(const Options& o);
 BuildParams buildParams(const Options& o, const std::string& spec);
 RenderParams renderParams(const Options& o);
 BackendKind backendKind(const Options& o);
-/// --cuda-block WxH (32..256 threads) and --cuda-carveout N (0..100): the CUDA launch shape.
-LaunchParams launchParams(const Options& o);
+/// The engine's knobs: the environment's (Environment.h), then --cuda-block WxH (32..256
+/// threads) over SPACESKIP_CUDA_BLOCK.
+Tuning tuning(const Options& o);
 
 /// Bench-only suffixes of a --builders item, stripped before buildParams sees it:
 /// `hw`/`exact` pick the filter for this item, `cold` times the first build only (no rebuilds:
@@ -73,10 +75,10 @@ struct BenchItem {
   std::string spec;      ///< the item without bench-only suffixes
   int filter = -1;       ///< -1: --filter, else a FilterMode
   bool cold = false;
-  int resident = -1;  ///< `resN`: LaunchParams::resident = N for this item (CUDA launch shape)
+  int resident = -1;  ///< `resN`: Tuning::resident = N for this item (CUDA launch shape)
   /// Sub-brick masks for this item: -2 as the environment says; -1 (`whole`): none
-  /// (SPACESKIP_SUB_MASKS=0); N (`partsN`): bricks with at most N of 64 parts set are walked part
-  /// by part (SPACESKIP_SUB_MASK_MAX=N).
+  /// (Tuning::subMasks off); N (`partsN`): bricks with at most N of 64 parts set are walked part
+  /// by part (Tuning::subMaskMaxSet = N).
   int parts = -2;
 };
 BenchItem benchItem(const std::string& item);

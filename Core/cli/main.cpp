@@ -91,8 +91,8 @@ options:
       --bins (kdtree-gpu, kdtree-gpu-fast; default 4): N >= 2 tries N-1 planes per node;
       0 sweeps every brick boundary, the kdtree-cpu tree (kdtree-cpu always sweeps)
   --backend auto|cpu|cuda     --threads N (oneTBB worker limit)
-  --cuda-block WxH   --cuda-carveout N   CUDA launch shape: threads per block (32..256; default
-                     16x8), percent of L1 given to shared memory (0..100; default: the driver's)
+  --cuda-block WxH   CUDA launch shape: threads per block (32..256; default 16x8; also
+                     SPACESKIP_CUDA_BLOCK; the other SPACESKIP_* knobs: docs/tuning.md)
   --tf PRESET|FILE   presets: ramp grayscale coolwarm band spike opaque zero
   --size WxH         (render default 512x512, bench default 1024x1024)
   --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective
@@ -188,12 +188,12 @@ int cmdRender(const Options& o) {
   int w = 512, h = 512;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   Engine engine(backendKind(o));
+  engine.setTuning(tuning(o));
   engine.setMemoryBudget(memoryBudget(o), poolBrick(o));
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
   engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
   engine.setRenderParams(renderParams(o));
-  engine.setLaunchParams(launchParams(o));
   auto t1 = Clock::now();
   engine.update();
   double prep = since(t1);
@@ -268,6 +268,7 @@ int cmdSparse(const Options& o) {
     auto run = [&](bool sparse) {
       Run out;
       Engine e(backendKind(o));
+      e.setTuning(tuning(o));
       if (sparse) e.setMemoryBudget(memoryBudget(o), poolBrick(o));
       else e.setMemoryBudget(INT64_MAX);  // in core whatever the default budget says
       e.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
@@ -410,29 +411,22 @@ const char* leafName(LeafCriterion l) {
   return l == LeafCriterion::Shallow ? "shallow" : l == LeafCriterion::Empty ? "empty" : "deep";
 }
 
-/// The bench suffixes :whole / :partsN (BenchItem::parts) set the sub-brick mask switches the
-/// backends read at classification; an item whose setting differs from the last item's makes
-/// the engine classify again (an opacity edit and back), so items with and without masks are
-/// measured side by side in one process. -2 restores the environment's own settings.
-void applySubMaskSwitch(Engine& engine, const Volume& v, const Options& o, int parts) {
-  static int applied = -2;
-  static const std::string envMasks = std::getenv("SPACESKIP_SUB_MASKS") ? std::getenv("SPACESKIP_SUB_MASKS") : "";
-  static const std::string envMax = std::getenv("SPACESKIP_SUB_MASK_MAX") ? std::getenv("SPACESKIP_SUB_MASK_MAX") : "";
-  static const bool hadMasks = std::getenv("SPACESKIP_SUB_MASKS") != nullptr;
-  static const bool hadMax = std::getenv("SPACESKIP_SUB_MASK_MAX") != nullptr;
-  if (parts == applied) return;
-  applied = parts;
-  auto put = [](const char* name, bool set, const std::string& value) {
-    if (set) setenv(name, value.c_str(), 1);
-    else unsetenv(name);
-  };
-  if (parts == -2) {
-    put("SPACESKIP_SUB_MASKS", hadMasks, envMasks);
-    put("SPACESKIP_SUB_MASK_MAX", hadMax, envMax);
-  } else {
-    put("SPACESKIP_SUB_MASKS", parts == -1, "0");
-    put("SPACESKIP_SUB_MASK_MAX", parts >= 0, std::to_string(parts));
+/// An item's knobs: the bench's (`base`: the environment and the options), with the suffixes
+/// :resN (BenchItem::resident) and :whole / :partsN (BenchItem::parts) over them. When the
+/// sub-brick mask knobs differ from the engine's, the engine classifies again (an opacity edit
+/// and back), so items with and without masks are measured side by side in one process.
+void applyItemTuning(Engine& engine, const Volume& v, const Options& o, const BenchItem& item, const Tuning& base) {
+  Tuning t = base;
+  if (item.resident >= 0) t.resident = item.resident;
+  if (item.parts == -1) t.subMasks = false;
+  if (item.parts >= 0) {
+    t.subMasks = true;
+    t.subMaskMaxSet = item.parts;
   }
+  const Tuning& was = engine.tuning();
+  const bool reclassify = t.subMasks != was.subMasks || t.subMaskMaxSet != was.subMaskMaxSet;
+  engine.setTuning(t);
+  if (!reclassify) return;
   TransferFunction tf = makeTF(o, v), edited = tf;
   for (vec4f& e : edited.table) e.w = e.w > 0.f ? 0.f : 1.f;  // every brick's state differs
   engine.setTransferFunction(edited);
@@ -441,11 +435,11 @@ void applySubMaskSwitch(Engine& engine, const Volume& v, const Options& o, int p
 }
 
 BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemText, const Options& o, int w, int h,
-                     int frames, int buildReps, const LaunchParams& launch) {
+                     int frames, int buildReps, const Tuning& tuning) {
   BenchRow row;
   const BenchItem item = benchItem(itemText);
   const BuildParams bp = buildParams(o, item.spec);
-  applySubMaskSwitch(engine, v, o, item.parts);
+  applyItemTuning(engine, v, o, item, tuning);
   row.bp = bp;
   RenderParams rp = renderParams(o);
   if (item.filter >= 0) rp.filter = FilterMode(item.filter);
@@ -466,9 +460,6 @@ BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemTex
     engine.update();
     if (rep == 0 || engine.buildStats().seconds < s.seconds) s = engine.buildStats();
   }
-  LaunchParams itemLaunch = launch;
-  if (item.resident >= 0) itemLaunch.resident = item.resident;
-  engine.setLaunchParams(itemLaunch);
   double b6[6];
   v.worldBounds(b6);
   Image img;
@@ -545,7 +536,7 @@ int cmdBench(const Options& o) {
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
   const int frames = int(o.getInt("--frames", 8, 1, 1000000));
   const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
-  const LaunchParams launch = launchParams(o);
+  const Tuning knobs = tuning(o);
   int w = 1024, h = 1024;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
   std::ostringstream json;
@@ -568,11 +559,12 @@ int cmdBench(const Options& o) {
     // One engine per data set: the volume is uploaded (CUDA) and its ranges computed once.
     Engine engine(backendKind(o));
     engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+    engine.setTuning(knobs);
     engine.setMemoryBudget(memoryBudget(o), poolBrick(o));
     engine.setVolume(v);
     engine.setTransferFunction(tf);
     for (const std::string& b : builders) {
-      const BenchRow r = measureItem(engine, v, b, o, w, h, frames, buildReps, launch);
+      const BenchRow r = measureItem(engine, v, b, o, w, h, frames, buildReps, knobs);
       const BuildStats& s = r.s;
       const BuildParams& bp = r.bp;
       if (s.builder == BuilderKind::Naive && naiveFps == 0) naiveFps = r.kernelFps;
@@ -673,7 +665,7 @@ int cmdBenchPaper(const Options& o) {
   const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
   const double timeLimit = o.getDouble("--time-limit", 0, 0, 1e9);  // 0: none
   const uint64_t cap = maxVolumeBytes(o);
-  const LaunchParams launch = launchParams(o);
+  const Tuning knobs = tuning(o);
   int w = 1024, h = 1024;
   if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
 
@@ -764,6 +756,7 @@ int cmdBenchPaper(const Options& o) {
     try {
       engine = std::make_unique<Engine>(backendKind(o));
       engine->setLogger([](const std::string& m) { std::fprintf(stderr, "\n  note: %s\n", m.c_str()); });
+      engine->setTuning(knobs);
       engine->setVolume(v);
       engine->setTransferFunction(tf);
     } catch (const std::exception& e) {
@@ -779,7 +772,7 @@ int cmdBenchPaper(const Options& o) {
         status = "skipped: time limit";
       } else {
         try {
-          r = measureItem(*engine, v, pv.item, o, w, h, frames, buildReps, launch);
+          r = measureItem(*engine, v, pv.item, o, w, h, frames, buildReps, knobs);
         } catch (const std::exception& e) {
           status = std::string("failed: ") + e.what();
           for (char& c : status)
@@ -856,10 +849,10 @@ int cmdAccuracy(const Options& o) {
   const double minSpacing = std::min({v.spacing[0], v.spacing[1], v.spacing[2]});
   Engine engine(backendKind(o));
   engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
+  engine.setTuning(tuning(o));
   engine.setVolume(v);
   engine.setTransferFunction(makeTF(o, v));
   engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
-  engine.setLaunchParams(launchParams(o));
   Camera cam = makeCamera(o, v, w, h);
   RenderParams ref;
   ref.sampleDistance = minSpacing / 8;

@@ -289,10 +289,9 @@ void BrickClassification::computePartRanges(cudaStream_t stream) {
   d_partRanges_.release();
   partRangeBytes_ = 0;
   if (!d_voxels_ || components_ != 1 || !usesSubMasks(brick)) return;
-  // SPACESKIP_PART_RANGES=0 (read at setVolume, a measurement switch): no bounds stored, the
-  // masks from the voxels on the frame after an edit's.
-  if (const char* e = std::getenv("SPACESKIP_PART_RANGES"))
-    if (e[0] == '0') return;
+  // Tuning::partRanges off (read at setVolume): no bounds stored, the masks from the voxels on
+  // the frame after an edit's.
+  if (!tuning.partRanges) return;
   const int64_t nb = numBricks();
   if (nb <= 0 || nb >= int64_t(kUniformBrick)) return;
   if (numSMs_ == 0) numSMs_ = multiprocessors();
@@ -339,7 +338,7 @@ void BrickClassification::computePartRanges(cudaStream_t stream) {
 }
 
 void BrickClassification::masksFromRanges(cudaStream_t stream, unsigned maxCount) {
-  const int maxSet = subMaskMaxSet();
+  const int maxSet = subMaskMaxSet(tuning);
   dispatchVoxelType(type_, [&](auto t) {
     using S = typename PartRangeStore<decltype(t)>::type;
     rangeMaskKernel<S><<<numSMs_ * kMaskBlocksPerSM, kThreads, 0, stream>>>(
@@ -384,7 +383,7 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   uint8_t* next = d_occ[1 - cur].get();
   d_flags_.reserve(1);
   SS_CUDA_CHECK(cudaMemsetAsync(d_flags_.get(), 0, sizeof(ClassifyFlags), stream));
-  haveSub_ = d_voxels_ && components_ == 1 && usesSubMasks(brick) && subMasksEnabled();
+  haveSub_ = d_voxels_ && components_ == 1 && usesSubMasks(brick) && tuning.subMasks;
   const int64_t nb = numBricks();
   if (haveSub_) {
     d_sub_.reserve(size_t(nb));
@@ -423,7 +422,7 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
 void BrickClassification::refreshMasks(cudaStream_t stream) {
   if (!masksPending()) return;
   if (numSMs_ == 0) numSMs_ = multiprocessors();
-  const int maxSet = subMaskMaxSet();
+  const int maxSet = subMaskMaxSet(tuning);
   // setParts is zeroed by classify()'s memset (a range mask kernel over its limit added nothing);
   // the list and its count are classify()'s.
   if (d_partSlot_.get()) {

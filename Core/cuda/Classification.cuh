@@ -96,6 +96,9 @@ class BrickClassification {
   /// Marks DistanceGrid's field `d_dist` (one byte per brick) with markedDistance for the
   /// current states, or clears the marks when there are none (on `stream`, no synchronization).
   void markDistances(uint8_t* d_dist, cudaStream_t stream) const;
+  /// The sub-brick mask knobs (subMasks, subMaskMaxSet: read at each classification;
+  /// partRanges: at setVolume).
+  Tuning tuning;
   int cur = 0;
   bool haveOcc = false;  ///< classify() ran for this volume
   int64_t occupied = 0;

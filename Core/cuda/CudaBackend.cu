@@ -55,7 +55,7 @@ class CudaBackend final : public Backend {
 
   bool classify(const TransferFunction& tf, const CropClip& cc) override {
     tf_ = tf;
-    cls_.editMaskMaxShare = partsShareLimit();
+    cls_.editMaskMaxShare = tuning_.partsShare;
     const bool changed = cls_.classify(tf, cc, stream_);
     classifiedSinceRender_ = true;
     // The field kept across an edit that changed no occupancy (or drawn stale after one that only
@@ -94,11 +94,11 @@ class CudaBackend final : public Backend {
     d_distField_ = nullptr;
     s.builtOn = "cuda";
     if (info.extra == BuilderExtra::DistanceField) {
-      // SPACESKIP_DG_CAP (read per build, 1..127: bit 7 of the field marks sparse bricks): another
-      // cap, a measurement switch (the segments' overlaps against the leaps' length).
-      int cap = kMaxSkipDistance;
-      if (const char* e = std::getenv("SPACESKIP_DG_CAP")) cap = std::clamp(std::atoi(e), 1, 127);
-      d_distField_ = cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, cap, dist_, stream_);
+      // Tuning::distanceCap (1..127: bit 7 of the field marks sparse bricks): another cap (the
+      // segments' overlaps against the leaps' length).
+      const int cap = std::clamp(tuning_.distanceCap, 1, 127);
+      d_distField_ =
+          cuda::computeDistanceField(d_occ_[cur_].get(), bdims_, cap, dist_, stream_, tuning_.distanceSegments);
       // A field computed from the current occupancy carries no marks until the masks mark some
       // bricks sparse: right after an edit (no masks yet) the mark kernel would change nothing.
       if (cls_.brickStates()) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
@@ -135,12 +135,7 @@ class CudaBackend final : public Backend {
   /// parts are at most this share of the occupied bricks' parts: on the H100 the part walk made
   /// the paper's stand-ins 5-26% slower where the share was 0.28 and more, and N-body
   /// 1024^3 / 2048^3 (shares 0.11 / 0.06) 1.12x / 1.59x faster (docs/results/round9-h100).
-  static constexpr double kPartsShare = 0.2;
-  // SPACESKIP_CUDA_PARTS_SHARE (read per frame): another threshold, a measurement and test switch.
-  static double partsShareLimit() {
-    const char* share = std::getenv("SPACESKIP_CUDA_PARTS_SHARE");
-    return share ? std::atof(share) : kPartsShare;
-  }
+  /// Tuning::partsShare (default 0.2).
 
   void render(FrameView f, FilterMode filter, const float* depth, Image& out) override {
     // Sub-brick masks after an opacity edit: with part ranges (BrickClassification) the
@@ -157,7 +152,7 @@ class CudaBackend final : public Backend {
     if (distMarksStale_ && d_distField_) cls_.markDistances(const_cast<uint8_t*>(d_distField_), stream_);
     distMarksStale_ = false;
     f.traversal = traversal_;
-    const double maxShare = partsShareLimit();
+    const double maxShare = tuning_.partsShare;
     const bool parts = traversal_ == TraversalKind::Grid && cls_.subMasks() && cls_.setFraction <= maxShare;
     if (traversal_ == TraversalKind::Hybrid && hybridGridValid_)
       f.grid = GridView{d_hybrid_.get(), hybridDims_, hybridBrick_};
@@ -185,7 +180,11 @@ class CudaBackend final : public Backend {
   void* deviceImageStream() const override {
     return exec_.hasDeviceImage() ? static_cast<void*>(static_cast<cudaStream_t>(stream_)) : nullptr;
   }
-  void setLaunchParams(const LaunchParams& p) override { exec_.setLaunchParams(p); }
+  void setTuning(const Tuning& t) override {
+    tuning_ = t;
+    exec_.setTuning(t);
+    cls_.tuning = t;
+  }
   double lastFrameDeviceSeconds() const override { return exec_.lastFrameDeviceSeconds(); }
 
   const OccupancyGrid& occupancy() override { return cls_.occupancy(stream_); }
@@ -245,6 +244,7 @@ class CudaBackend final : public Backend {
   int poolBrick_ = kPoolBrick;
   cuda::BrickClassification cls_;
   cuda::CudaExecutor exec_;
+  Tuning tuning_;  ///< setTuning (the executor and the classification hold copies)
   // The classification under the names build() reads (until the builder registry replaces its switch).
   DeviceBuffer<uint8_t> (&d_occ_)[2] = cls_.d_occ;
   const int& cur_ = cls_.cur;

@@ -2,6 +2,7 @@
 // Every CUDA call goes through SS_CUDA_CHECK: a failure becomes a BackendError (the Engine falls
 // back to the CPU backend), never an abort.
 #pragma once
+#include "spaceskip/Tuning.h"
 #include "spaceskip/Types.h"
 
 #include <cuda_runtime.h>
@@ -41,26 +42,17 @@ inline std::atomic<int64_t>& liveDeviceBytes() {
   return bytes;
 }
 
-/// Testing aid: SPACESKIP_CUDA_MEMORY_LIMIT=<bytes> caps the device memory SpaceSkip may hold; an
-/// allocation that would exceed it fails with cudaErrorMemoryAllocation, exactly as a real
-/// out-of-memory does (so the "volume too large for the device" fallback can be tested on any
-/// GPU). Read at every allocation; unset, empty or unparsable means no cap.
-inline int64_t deviceMemoryLimit() {
-  const char* s = std::getenv("SPACESKIP_CUDA_MEMORY_LIMIT");
-  if (!s || !*s) return -1;
-  char* end = nullptr;
-  const unsigned long long v = std::strtoull(s, &end, 10);
-  if (end == s || *end != '\0') return -1;
-  return v > uint64_t(INT64_MAX) ? INT64_MAX : int64_t(v);
-}
+/// Testing aid (spaceskip::testing::setDeviceMemoryLimit, Tuning.h): caps the device memory
+/// SpaceSkip may hold; an allocation that would exceed it fails with cudaErrorMemoryAllocation,
+/// exactly as a real out-of-memory does (so the "volume too large for the device" fallback can
+/// be tested on any GPU). Negative: no cap.
+inline int64_t deviceMemoryLimit() { return ::spaceskip::testing::deviceMemoryLimit(); }
 
-/// Testing aid: SPACESKIP_CUDA_FAIL_RENDER=1 makes every render launch report
+/// Testing aid (spaceskip::testing::setFailRender, Tuning.h): every render launch reports
 /// cudaErrorLaunchFailure, a CUDA error in the middle of a frame, so that the fallback to the CPU
-/// backend's image can be tested on any GPU (TestCuda.cpp sets it). Read at every render launch;
-/// anything else: off. Unlike the launch shape (LaunchParams), no caller sets this in earnest.
+/// backend's image can be tested on any GPU (TestCuda.cpp).
 inline cudaError_t injectedRenderError() {
-  const char* s = std::getenv("SPACESKIP_CUDA_FAIL_RENDER");
-  return s && s[0] == '1' && s[1] == '\0' ? cudaErrorLaunchFailure : cudaSuccess;
+  return ::spaceskip::testing::failRender() ? cudaErrorLaunchFailure : cudaSuccess;
 }
 
 inline bool overDeviceMemoryLimit(size_t bytes) {
@@ -68,7 +60,7 @@ inline bool overDeviceMemoryLimit(size_t bytes) {
   return limit >= 0 && (bytes > uint64_t(limit) || liveDeviceBytes().load() + int64_t(bytes) > limit);
 }
 
-/// cudaMalloc, counted and capped by SPACESKIP_CUDA_MEMORY_LIMIT.
+/// cudaMalloc, counted and capped by the testing limit (deviceMemoryLimit).
 inline cudaError_t deviceMalloc(void** p, size_t bytes) {
   *p = nullptr;
   if (overDeviceMemoryLimit(bytes)) return cudaErrorMemoryAllocation;

@@ -14,7 +14,7 @@ namespace spaceskip::cuda {
 
 namespace {
 
-// Launch shape: 2-D grid of 16x8 blocks (LaunchParams::blockX/Y override), one thread per pixel.
+// Launch shape: 2-D grid of 16x8 blocks (Tuning::blockX/Y override), one thread per pixel.
 // One kernel per traversal: a kernel holding every traversal is allocated the registers of the
 // tree traversal (64 per thread, half occupancy), which the naive and grid marches do not need.
 // SPACESKIP_CUDA_HW_MIN_BLOCKS > 1 asks the hardware-filtered kernels to fit that many blocks of
@@ -155,49 +155,18 @@ int raySegments(const FrameView& f) {
   return int(std::max(1.0, std::min(double(kRaySegments), std::floor(samples / kSamplesPerSegment))));
 }
 
-/// Samples a GPU march fetches together (FrameView::sampleBatch, IntervalMarcher::takeBatch):
-/// kMaxSampleBatch, or SPACESKIP_SAMPLE_BATCH (read per frame, 1..kMaxSampleBatch; 1: one
-/// sample at a time, as before round 14), a measurement switch.
-int sampleBatch() {
-  const char* e = std::getenv("SPACESKIP_SAMPLE_BATCH");
-  const int n = e ? std::atoi(e) : kMaxSampleBatch;
-  return std::max(1, std::min(kMaxSampleBatch, n));
-}
-
-/// How a segmented frame's layers are laid out (CudaExecutor::launch): SPACESKIP_SEGMENT_LAYERS.
-enum class SegmentLayers { Dense, Flags, Rect };
-SegmentLayers segmentLayers() {
-  const char* e = std::getenv("SPACESKIP_SEGMENT_LAYERS");
-  if (e && std::strcmp(e, "dense") == 0) return SegmentLayers::Dense;
-  if (e && std::strcmp(e, "flags") == 0) return SegmentLayers::Flags;
-  return SegmentLayers::Rect;
-}
-
-bool validBlock(const LaunchParams& p) {
+bool validBlock(const Tuning& p) {
   return p.blockX > 0 && p.blockY > 0 && p.blockX * p.blockY >= 32 && p.blockX * p.blockY <= kMaxRenderThreads;
 }
 
 }  // namespace
 
 CudaExecutor::CudaExecutor() {
-  // Measurement overrides from the environment (LaunchParams.h): SPACESKIP_CUDA_BLOCK=WxH,
-  // SPACESKIP_CUDA_CARVEOUT=0..100.
-  if (const char* b = std::getenv("SPACESKIP_CUDA_BLOCK")) {
-    unsigned w = 0, h = 0;
-    if (std::sscanf(b, "%ux%u", &w, &h) == 2 && w * h >= 32 && w * h <= unsigned(kMaxRenderThreads)) {
-      env_.blockX = int(w);
-      env_.blockY = int(h);
-    }
-  }
   int dev = 0;
   if (cudaGetDevice(&dev) != cudaSuccess ||
       cudaDeviceGetAttribute(&numSMs_, cudaDevAttrMultiProcessorCount, dev) != cudaSuccess || numSMs_ < 1) {
     (void)cudaGetLastError();
     numSMs_ = 1;
-  }
-  if (const char* c = std::getenv("SPACESKIP_CUDA_CARVEOUT")) {
-    const int v = std::atoi(c);
-    if (v >= 0 && v <= 100) env_.carveout = v;
   }
 }
 
@@ -235,7 +204,9 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   timingPending_ = false;  // the last frame's time, if nobody asked for it, is not kept
   lastDeviceSeconds_ = -1;
   f.tf = table_;
-  f.sampleBatch = sampleBatch();
+  // Samples a GPU march fetches together (IntervalMarcher::takeBatch; batches against one sample
+  // at a time: docs/results/round14-h100).
+  f.sampleBatch = tuning_.sampleBatch > 0 ? std::min(tuning_.sampleBatch, kMaxSampleBatch) : kMaxSampleBatch;
   layers_ = SegmentLayersView{};  // launch() sets it for a segmented frame
   deviceImageValid_ = false;
   f.depth = nullptr;
@@ -256,8 +227,8 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
     f.sampleCount = d_counts_.get();
   }
   d_image_.reserve(pixels);
-  const LaunchParams& shape = validBlock(launch_) ? launch_ : env_;
-  const unsigned bx = validBlock(shape) ? unsigned(shape.blockX) : 16u, by = validBlock(shape) ? unsigned(shape.blockY) : 8u;
+  const bool shaped = validBlock(tuning_);
+  const unsigned bx = shaped ? unsigned(tuning_.blockX) : 16u, by = shaped ? unsigned(tuning_.blockY) : 8u;
   const dim3 block(bx, by);
   const dim3 grid(unsigned((f.width + bx - 1) / bx), unsigned((f.height + by - 1) / by));
   SS_CUDA_CHECK(cudaEventRecord(ev0_, stream));
@@ -284,16 +255,12 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   }
   SS_CUDA_CHECK_LAUNCH(renderKernel);
   SS_CUDA_CHECK(injectedRenderError());
-  const char* sync = std::getenv("SPACESKIP_SYNC_FRAME");
-  const bool wait = sync && sync[0] == '1';
   // A segmented frame's layers (launch) are composited into d_image_ here, or, when the image
   // stays on the device, when someone asks for d_image_ (deviceImage()): the CUDA blend into a
   // window reads the layers themselves (deviceImageView()), which spares writing and reading the
-  // flat image. SPACESKIP_FUSED_BLEND=0 (read per frame, a measurement switch) composites here.
-  const char* fuse = std::getenv("SPACESKIP_FUSED_BLEND");
+  // flat image.
   stream_ = stream;
-  if (layers_.layers && !(imageOnDevice_ && !hostCounts && !wait && !(fuse && fuse[0] == '0')))
-    compositeLayers();
+  if (layers_.layers && !(imageOnDevice_ && !hostCounts)) compositeLayers();
   SS_CUDA_CHECK(cudaEventRecord(ev1_, stream));
   out.width = f.width;
   out.height = f.height;
@@ -301,16 +268,8 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   if (imageOnDevice_ && !hostCounts) {
     // The caller draws d_image_ itself (CUDA-GL interop), queuing its copy on `stream`: no
     // download, and no wait here, so that the host's work for the frame overlaps the kernel.
-    // SPACESKIP_SYNC_FRAME=1 (read per frame, a measurement switch) waits as before this change.
     out.rgba.clear();
-    if (!wait) {
-      timingPending_ = true;
-      deviceImageValid_ = true;
-      return;
-    }
-    SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-    SS_CUDA_CHECK(cudaEventElapsedTime(&ms, ev0_, ev1_));
-    lastDeviceSeconds_ = double(ms) * 1e-3;
+    timingPending_ = true;
     deviceImageValid_ = true;
     return;
   }
@@ -357,16 +316,13 @@ template <class Sampler>
 void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes,
                           cudaStream_t stream) {
   // Persistent launch with N blocks per SM taking tiles from a counter (0: one block per tile, the
-  // plain launch): LaunchParams::resident, else SPACESKIP_CUDA_RESIDENT (read per frame), else automatic.
+  // plain launch): Tuning::resident, else automatic.
   int residentBlocks =
       std::is_same<Sampler, TextureSampler>::value && textureBytes > kLargeTextureBytes && f.traversal == TraversalKind::Naive
           ? std::max(1, kLargeTextureResident * 128 / int(block.x * block.y))
           : 0;
-  if (launch_.resident >= 0) residentBlocks = launch_.resident;
-  else if (const char* r = std::getenv("SPACESKIP_CUDA_RESIDENT")) residentBlocks = std::max(0, std::atoi(r));
+  if (tuning_.resident >= 0) residentBlocks = tuning_.resident;
   RenderKernelPtr<Sampler> k = renderKernelFor<Sampler>(f);
-  const int carveout = launch_.carveout >= 0 && launch_.carveout <= 100 ? launch_.carveout : env_.carveout;
-  if (carveout >= 0) SS_CUDA_CHECK(cudaFuncSetAttribute(k, cudaFuncAttributePreferredSharedMemoryCarveout, carveout));
   if (residentBlocks <= 0) {
     // Rays cut into kRaySegments segments marched by separate threads, composited front to back
     // (segmentableFrame: composite plain frames without early ray termination). A frame takes as
@@ -374,35 +330,26 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
     // clusters: 0.6-0.9 ms while the median tile takes 1.3 us. Measured on the H100
     // (docs/results/round13-h100/segments): 4 segments 1.07-1.18x kernel fps on five stand-ins
     // (DistanceGrid, DistanceGrid:hw, Auto), 8 less; short rays lose (N-body 128^3 in a 1024^2
-    // window: kernel 0.30 -> 0.35 ms), hence raySegments. SPACESKIP_RAY_SEGMENTS (read per
-    // frame; 1..16 fixed, 1: whole rays; 0 or unset: raySegments) is the measurement switch.
-    const char* seg = std::getenv("SPACESKIP_RAY_SEGMENTS");
-    const int forced = seg ? std::max(0, std::min(16, std::atoi(seg))) : 0;
+    // window: kernel 0.30 -> 0.35 ms), hence raySegments. Tuning::raySegments forces a count
+    // (1..16; 1: whole rays).
+    const int forced = std::max(0, std::min(16, tuning_.raySegments));
     const int segments = forced > 0 ? forced : raySegments(f);
     if (segments > 1 && segmentableFrame(f)) {
       // The layers cover the pixels whose rays can meet the box (boxPixelRect), and a segment
       // writes its layer only where it coloured the pixel (flags): at N-body 2048^3 in a 1024^2
       // window about half the pixels miss the box and most segments colour nothing, which spared
-      // the layers' traffic (4 x 16 MB written and read a frame). SPACESKIP_SEGMENT_LAYERS (read
-      // per frame), a measurement switch: "dense" every pixel and layer (round 13's layout),
-      // "flags" every pixel with flags, else (the default) the rectangle with flags.
-      const SegmentLayers layout = segmentLayers();
+      // the layers' traffic (4 x 16 MB written and read a frame).
       const int64_t pixels = int64_t(f.width) * f.height;
       int rect[4] = {0, 0, f.width, f.height};
-      if (layout == SegmentLayers::Rect) {
-        boxPixelRect(f, rect);
-        // Whole tiles of the full frame's launch: the same pixels share a block as without the
-        // rect (measured: a rect cutting tiles made Menger's frame 1 % slower).
-        rect[0] -= rect[0] % int(block.x);
-        rect[1] -= rect[1] % int(block.y);
-      }
+      boxPixelRect(f, rect);
+      // Whole tiles of the full frame's launch: the same pixels share a block as without the
+      // rect (measured: a rect cutting tiles made Menger's frame 1 % slower).
+      rect[0] -= rect[0] % int(block.x);
+      rect[1] -= rect[1] % int(block.y);
       const int4 r = make_int4(rect[0], rect[1], rect[2], rect[3]);
       d_layers_.reserve(size_t(pixels) * size_t(segments));
-      unsigned char* flags = nullptr;
-      if (layout != SegmentLayers::Dense) {
-        d_layerFlags_.reserve(size_t(pixels) * size_t(segments));
-        flags = d_layerFlags_.get();
-      }
+      d_layerFlags_.reserve(size_t(pixels) * size_t(segments));
+      unsigned char* flags = d_layerFlags_.get();
       if (r.z > r.x && r.w > r.y) {
         const dim3 rectGrid(unsigned((r.z - r.x + int(block.x) - 1) / int(block.x)),
                             unsigned((r.w - r.y + int(block.y) - 1) / int(block.y)), unsigned(segments));

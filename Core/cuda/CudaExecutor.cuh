@@ -5,7 +5,7 @@
 #include "DeviceVolume.cuh"
 #include "spaceskip/BrickPool.h"
 #include "spaceskip/DeviceImageCopy.h"
-#include "spaceskip/LaunchParams.h"
+#include "spaceskip/Tuning.h"
 #include "spaceskip/Types.h"
 #include "spaceskip/render/Integrator.h"
 
@@ -15,10 +15,11 @@ namespace spaceskip::cuda {
 
 class CudaExecutor {
  public:
-  /// Reads the SM count and the environment's launch overrides (LaunchParams.h).
+  /// Reads the SM count.
   CudaExecutor();
 
-  void setLaunchParams(const LaunchParams& p) { launch_ = p; }
+  /// The launch knobs (blockX/Y, resident, raySegments) of the frames after this call.
+  void setTuning(const Tuning& t) { tuning_ = t; }
   /// The (opacity-corrected) table the integrator samples, copied on `stream` through a pinned
   /// staging buffer (no host wait; the frames after it on `stream` read it).
   void setTransferTable(const std::vector<vec4f>& table, float lo, float scale, cudaStream_t stream);
@@ -51,8 +52,7 @@ class CudaExecutor {
   void launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes, cudaStream_t stream);
 
   Event ev0_, ev1_;
-  LaunchParams launch_;
-  LaunchParams env_;  ///< SPACESKIP_CUDA_BLOCK / _CARVEOUT as read at construction
+  Tuning tuning_;
   int numSMs_ = 1;
   DeviceBuffer<vec4f> d_table_;
   PinnedBuffer h_table_;  ///< the table on its way to d_table_
@@ -64,7 +64,7 @@ class CudaExecutor {
   DeviceBuffer<unsigned> d_counts_;
   DeviceBuffer<vec4f> d_image_;
   DeviceBuffer<unsigned> d_tileCounter_;
-  DeviceBuffer<vec4f> d_layers_;  ///< a segmented frame's layers (SPACESKIP_RAY_SEGMENTS)
+  DeviceBuffer<vec4f> d_layers_;  ///< a segmented frame's layers (raySegments)
   DeviceBuffer<unsigned char> d_layerFlags_;  ///< which layers a segment coloured (1) or left empty (0)
   mutable SegmentLayersView layers_;  ///< the last frame's layers while not yet composited into d_image_
   cudaStream_t stream_ = nullptr;     ///< the last frame's stream

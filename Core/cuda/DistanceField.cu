@@ -155,19 +155,15 @@ size_t stagedBytes(int n, int cap, int segs) {
 constexpr size_t kStagedMaxBytes = 96 * 1024;  // opted in (the default is 48 KiB)
 
 /// Threads a line for lines of n bricks: up to 8, segments of at least 32 bricks, within
-/// kStagedMaxBytes; SPACESKIP_DG_SEGMENTS (a measurement switch) caps it. 0: the unstaged
+/// kStagedMaxBytes; `maxSegments` (Tuning::distanceSegments) caps it. 0: the unstaged
 /// kernel, for lines shorter than 128 bricks or too long for shared memory. On the H100 the
 /// staged kernel was slower than the unstaged one with one segment a line (N-body 2048^3: 0.73-1.17
 /// vs 0.62 ms a build) and on lines of 64-104 bricks (two segments: 0.07-0.10 vs 0.05-0.08 ms),
 /// faster with 4-8 segments on lines of 128-256 bricks (2048^3: 0.45 ms; 128 bricks: 0.09 vs
 /// 0.12 ms) (docs/results/round10-h100).
-int segmentsFor(int n, int cap) {
-  static const int cap_env = [] {
-    const char* e = std::getenv("SPACESKIP_DG_SEGMENTS");
-    return e ? std::max(1, std::atoi(e)) : 8;
-  }();
+int segmentsFor(int n, int cap, int maxSegments) {
   if (n < 128) return 0;
-  for (int segs = std::min(cap_env, 8); segs >= 2; segs /= 2)
+  for (int segs = std::min(std::max(1, maxSegments), 8); segs >= 2; segs /= 2)
     if (n >= 32 * segs && stagedBytes(n, cap, segs) <= kStagedMaxBytes) return segs;
   return 0;
 }
@@ -175,7 +171,7 @@ int segmentsFor(int n, int cap) {
 }  // namespace
 
 const uint8_t* computeDistanceField(const uint8_t* occ, vec3i dims, int cap, DistanceWorkspace& ws,
-                                    cudaStream_t stream) {
+                                    cudaStream_t stream, int maxSegments) {
   cap = cap < 1 ? 1 : cap > 255 ? 255 : cap;
   const int64_t n = int64_t(dims.x) * dims.y * dims.z;
   ws.a.reserve(size_t(n));
@@ -196,7 +192,7 @@ const uint8_t* computeDistanceField(const uint8_t* occ, vec3i dims, int cap, Dis
     const int u = axis == 0 ? 1 : 0, w = axis == 2 ? 1 : 2;
     const int64_t lines = int64_t(dims[u]) * dims[w];
     if (lines <= 0) continue;
-    int segs = segmentsFor(dims[axis], cap);
+    int segs = segmentsFor(dims[axis], cap, maxSegments);
     if (!optedIn && stagedBytes(dims[axis], cap, segs) > 48 * 1024) segs = 0;
     if (segs > 0) {
       const size_t bytes = stagedBytes(dims[axis], cap, segs);

@@ -14,9 +14,10 @@ struct DistanceWorkspace {
 };
 
 /// Fills ws.a with the capped Chebyshev distance field of the occupancy `occ` (dims bricks);
-/// returns ws.a's pointer. Synchronizes `stream`.
+/// returns ws.a's pointer. Synchronizes `stream`. `maxSegments` (Tuning::distanceSegments, 1..8)
+/// caps the threads a line of the staged kernel uses.
 const uint8_t* computeDistanceField(const uint8_t* occ, vec3i dims, int cap, DistanceWorkspace& ws,
-                                    cudaStream_t stream);
+                                    cudaStream_t stream, int maxSegments = 8);
 /// The same from a host grid to a host field, on the default stream (for the tests).
 std::vector<uint8_t> fieldOnDevice(const OccupancyGrid& occ, int cap);
 

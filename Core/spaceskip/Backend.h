@@ -3,8 +3,8 @@
 #pragma once
 #include "Classification.h"
 #include "DeviceImageCopy.h"
-#include "LaunchParams.h"
 #include "Tree.h"
+#include "Tuning.h"
 #include "Types.h"
 #include "Volume.h"
 #include "render/Integrator.h"
@@ -48,8 +48,8 @@ class Backend {
   /// wait for a frame it leaves on the device: work the caller queues on this stream after
   /// render() sees the finished image, and the next render() overwrites it only after that work.
   virtual void* deviceImageStream() const { return nullptr; }
-  /// The launch shape of the render kernels (the CUDA backend; others ignore it).
-  virtual void setLaunchParams(const LaunchParams& /*p*/) {}
+  /// The knobs of Tuning.h this backend reads (each backend keeps a copy).
+  virtual void setTuning(const Tuning& /*t*/) {}
   /// Seconds the last render() spent in device work (CUDA events), -1 when not measured. For a
   /// frame left on the device (not waited for by render()) this waits for the frame.
   virtual double lastFrameDeviceSeconds() const { return -1; }

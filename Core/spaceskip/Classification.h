@@ -3,6 +3,7 @@
 #pragma once
 #include "CropClip.h"
 #include "TransferFunction.h"
+#include "Tuning.h"
 #include "Volume.h"
 
 #include <cstdint>
@@ -219,29 +220,26 @@ SS_FUNC uint8_t markedDistance(uint8_t dist, uint8_t state) {
 }
 
 /// The masks and states of `occ` (one per brick, x fastest) for the voxels of `v` and `tf`
-/// (oneTBB); empty when subMasksEnabled() or usesSubMasks(occ.brick) is false or `v` has
-/// several components.
+/// (oneTBB); empty when `t.subMasks` or usesSubMasks(occ.brick) is false or `v` has several
+/// components.
 struct SubMasks {
   std::vector<uint64_t> mask;
   std::vector<uint8_t> state;
   double share = 1.0;  ///< set parts over all parts of the occupied bricks
 };
-SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf);
+SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf,
+                         const Tuning& t = Tuning{});
 /// The CUDA backend's masks for `v` classified against `tf` at `brick` (tests): `path` 0 from the
 /// voxels (the next frame's kernel), 1 from the part ranges stored at setVolume in the
 /// classification, 2 from them on the next frame (*rangeBytes says what they take, 0 when none
 /// are stored: then the voxels). Throws BackendError without a device.
 SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int brick, int path,
                              size_t* rangeBytes = nullptr);
-/// Whether the backends compute sub-brick masks: yes unless SPACESKIP_SUB_MASKS=0 (read at each
-/// classification; a measurement switch: without masks an occupied brick is marched whole).
-bool subMasksEnabled();
-/// The most set parts a brick may have to be walked part by part (subBrickState): 40 of 64
-/// (round 12: on the H100 1.02-1.06x kernel fps over 24 where frames walk parts, N-body 1024^3
-/// and 2048^3, the other stand-ins unchanged; the oneTBB frames of the 11 stand-ins at 1/8 scale
-/// 0.99-1.11x, geometric mean 1.05, in adjacent processes: docs/results/round12-h100),
-/// or SPACESKIP_SUB_MASK_MAX (0..64, read at each classification; a measurement switch).
-constexpr int kSubMaskMaxSetDefault = 40;
-int subMaskMaxSet();
+/// The most set parts a brick may have to be walked part by part (subBrickState):
+/// Tuning::subMaskMaxSet clamped to 0..64. The default 40 of 64: on the H100 1.02-1.06x kernel
+/// fps over 24 where frames walk parts, N-body 1024^3 and 2048^3, the other stand-ins unchanged;
+/// the oneTBB frames of the 11 stand-ins at 1/8 scale 0.99-1.11x, geometric mean 1.05, in
+/// adjacent processes (docs/results/round12-h100).
+inline int subMaskMaxSet(const Tuning& t) { return t.subMaskMaxSet < 0 ? 0 : t.subMaskMaxSet > 64 ? 64 : t.subMaskMaxSet; }
 
 }  // namespace spaceskip

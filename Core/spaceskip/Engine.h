@@ -8,6 +8,7 @@
 #include "DeviceImageCopy.h"
 #include "Tree.h"
 #include "TransferFunction.h"
+#include "Tuning.h"
 #include "Types.h"
 #include "Volume.h"
 #include "VolumePiece.h"
@@ -25,7 +26,6 @@ namespace spaceskip {
 double effectiveSampleDistance(const Volume& v, double requested, std::string* note = nullptr);
 
 class Backend;
-struct LaunchParams;  // LaunchParams.h
 
 class Engine {
  public:
@@ -88,8 +88,12 @@ class Engine {
   /// stream after render() sees the finished image (e.g. the CUDA-GL interop copy), and the next
   /// render() overwrites the image only after that work.
   void* deviceImageStream() const;
-  /// CUDA: the launch shape of the render kernels (LaunchParams.h); other backends ignore it.
-  void setLaunchParams(const LaunchParams& p);
+  /// The kernels', builders' and classification's knobs (Tuning.h; the defaults are the
+  /// product's behaviour). A launch knob takes effect at the next frame, a classification knob
+  /// at the next classification (partRanges at the next setVolume), a DistanceGrid knob at the
+  /// next build; a backend made later (a fallback) gets them too.
+  void setTuning(const Tuning& t);
+  const Tuning& tuning() const;
   /// The most memory the voxels may take on the backend, in bytes (0, the default: CUDA takes
   /// the free device memory less what its other structures need; the CPU backend has no limit).
   /// A volume above it is kept sparse (BrickPool.h): each frame makes resident only the pool

@@ -42,7 +42,6 @@ SS_FUNC void setAxis(vec3i& v, int i, int s) {
 SS_FUNC float axisOf(const vec3f& v, int i) { return v[i]; }
 SS_FUNC int axisOf(const vec3i& v, int i) { return v[i]; }
 
-SS_FUNC vec3f make_vec3f(float x, float y, float z) { return vec3f{x, y, z}; }
 SS_FUNC vec3f operator+(vec3f a, vec3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 SS_FUNC vec3f operator-(vec3f a, vec3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 SS_FUNC vec3f operator*(vec3f a, float s) { return {a.x * s, a.y * s, a.z * s}; }

@@ -80,9 +80,9 @@ void validate(const Volume& v);
 /// Largest axis length any volume may have (cell indices are 32-bit in the traversals).
 constexpr int64_t kMaxAxisVoxels = int64_t(1) << 30;
 
-/// Default cap on a volume's voxel bytes for readers and generators: SPACESKIP_MAX_VOLUME_BYTES
-/// when set (bytes, or with a K/M/G/T suffix), else min(64 GiB, physical memory). Throws
-/// std::runtime_error when that variable is set but malformed.
+/// Default cap on a volume's voxel bytes for readers and generators: min(64 GiB, physical
+/// memory). Callers raise or lower it through ReadLimits::maxBytes (the CLI: --max-volume-bytes
+/// or SPACESKIP_MAX_VOLUME_BYTES, Core/cli/Environment.h).
 uint64_t defaultMaxVolumeBytes();
 
 /// dims.x*dims.y*dims.z*voxelSize(t), checked: throws std::runtime_error starting with `what`

@@ -89,24 +89,13 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, cons
   return o;
 }
 
-bool subMasksEnabled() {
-  const char* e = std::getenv("SPACESKIP_SUB_MASKS");
-  return !(e && e[0] == '0');
-}
-
-int subMaskMaxSet() {
-  const char* e = std::getenv("SPACESKIP_SUB_MASK_MAX");
-  const int v = e ? std::atoi(e) : kSubMaskMaxSetDefault;
-  return std::clamp(v, 0, 64);
-}
-
-SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf) {
+SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf, const Tuning& t) {
   SubMasks out;
-  if (!subMasksEnabled() || !usesSubMasks(occ.brick) || v.components != 1 || !v.data || occ.occ.empty()) return out;
+  if (!t.subMasks || !usesSubMasks(occ.brick) || v.components != 1 || !v.data || occ.occ.empty()) return out;
   out.mask.resize(size_t(occ.size()));
   out.state.resize(size_t(occ.size()));
   OpacityRangeMax rmq(tf);
-  const int maxSet = subMaskMaxSet();
+  const int maxSet = subMaskMaxSet(t);
   const int64_t bx = occ.dims.x, by = occ.dims.y;
   dispatchVoxelType(v.type, [&](auto t) {
     using T = decltype(t);

@@ -37,6 +37,8 @@ class CpuBackend final : public Backend {
     tree_ = Tree{};
   }
 
+  void setTuning(const Tuning& t) override { tuning_ = t; }
+
   bool classify(const TransferFunction& tf, const CropClip& cc) override {
     OccupancyGrid o = spaceskip::classify(ranges_, tf, cc);
     const bool sameDims = o.dims.x == occ_.dims.x && o.dims.y == occ_.dims.y && o.dims.z == occ_.dims.z &&
@@ -46,7 +48,7 @@ class CpuBackend final : public Backend {
     for (size_t i = 0; onlyEmptied_ && i < o.occ.size(); ++i)
       if (o.occ[i] && !occ_.occ[i]) onlyEmptied_ = false;
     occ_ = std::move(o);
-    sub_ = computeSubMasks(volume_, occ_, tf);
+    sub_ = computeSubMasks(volume_, occ_, tf, tuning_);
     markDistances();  // a field kept across the edit takes the new states' marks
     tf_ = tf;
     if (changed) ++generation_;
@@ -176,6 +178,7 @@ class CpuBackend final : public Backend {
   OccupancyGrid hybridGrid_;
   std::vector<uint8_t> dist_;  ///< DistanceGrid's field over occ_
   SubMasks sub_;  ///< sub-brick masks and brick states of occ_ (Classification.h); empty: none
+  Tuning tuning_;  ///< setTuning: the sub-brick mask knobs
   bool onlyEmptied_ = false;   ///< the last classify() only emptied bricks (lastClassifyOnlyEmptied)
   Tree tree_;
   TraversalKind traversal_ = TraversalKind::Naive;

@@ -75,6 +75,7 @@ struct Engine::Impl {
   RenderParams render;
   int64_t memoryBudget = 0;  ///< setMemoryBudget (0: the backend's default)
   int poolBrick = 16;
+  Tuning tuning;      ///< setTuning, handed to every backend made
   VolumePiece piece;  ///< inactive: the volume is whole
 
   bool rangesDirty = true, opacityDirty = true, colorDirty = true, buildDirty = true, tableDirty = true;
@@ -414,14 +415,17 @@ struct Engine::Impl {
     if (requested == BackendKind::CPU) {
       backend = makeCpuBackend();
       backend->setMemoryBudget(memoryBudget, poolBrick);
+      backend->setTuning(tuning);
       return;
     }
     try {
       backend = makeCudaBackend();
       backend->setMemoryBudget(memoryBudget, poolBrick);
+      backend->setTuning(tuning);
     } catch (const BackendError& e) {
       if (requested == BackendKind::CUDA) warn(std::string("CUDA backend unavailable (") + e.what() + "); using the CPU backend");
       backend = makeCpuBackend();
+      backend->setTuning(tuning);
     }
   }
 
@@ -435,6 +439,7 @@ struct Engine::Impl {
   void fallBackToCpu(const std::string& why) {
     warn("CUDA backend failed (" + why + "); falling back to the CPU backend");
     backend = makeCpuBackend();
+    backend->setTuning(tuning);
     rangesDirty = opacityDirty = buildDirty = tableDirty = true;
     autoState = AutoState{};
   }
@@ -985,7 +990,11 @@ bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice
 const void* Engine::deviceImage() const { return impl_->backend->deviceImage(); }
 DeviceImageView Engine::deviceImageView() const { return impl_->backend->deviceImageView(); }
 void* Engine::deviceImageStream() const { return impl_->backend->deviceImageStream(); }
-void Engine::setLaunchParams(const LaunchParams& p) { impl_->backend->setLaunchParams(p); }
+void Engine::setTuning(const Tuning& t) {
+  impl_->tuning = t;
+  impl_->backend->setTuning(t);
+}
+const Tuning& Engine::tuning() const { return impl_->tuning; }
 void Engine::setMemoryBudget(int64_t bytes, int poolBrick) {
   bytes = bytes > 0 ? bytes : 0;
   poolBrick = std::clamp(poolBrick, 1, 1024);

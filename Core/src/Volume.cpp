@@ -186,13 +186,6 @@ std::string dimsText(vec3l d) {
 }  // namespace
 
 uint64_t defaultMaxVolumeBytes() {
-  if (const char* env = std::getenv("SPACESKIP_MAX_VOLUME_BYTES")) {
-    uint64_t v = 0;
-    if (!parseByteCount(env, v) || v == 0)
-      throw std::runtime_error(std::string("SPACESKIP_MAX_VOLUME_BYTES='") + env +
-                               "' is not a positive byte count (e.g. 68719476736 or 64G)");
-    return v;
-  }
   // A volume is read into host memory whole, so more than physical memory cannot succeed.
   uint64_t cap = uint64_t(64) << 30;
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);

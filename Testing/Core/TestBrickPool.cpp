@@ -502,8 +502,8 @@ TEST(BrickPool, CudaOverflowFallsBackToTheCpuWithOneMessage) {
 }
 
 TEST(BrickPool, CudaVolumeAboveTheDeviceStaysOnItSparse) {
-  // The default budget follows the device's memory (here capped by SPACESKIP_CUDA_MEMORY_LIMIT,
-  // which fails allocations as a real out-of-memory does): a volume above it is kept sparse on
+  // The default budget follows the device's memory (here capped by
+  // spaceskip::testing::setDeviceMemoryLimit, which fails allocations as a real out-of-memory does): a volume above it is kept sparse on
   // the device instead of falling back to the CPU.
   std::string why;
   if (!cudaAvailable(&why)) GTEST_SKIP() << why;
@@ -511,7 +511,7 @@ TEST(BrickPool, CudaVolumeAboveTheDeviceStaysOnItSparse) {
   const TransferFunction tf = rampFrom(60);
   const int64_t bricks = int64_t(20) * 20 * 20;
   const int64_t limit = (int64_t(1) << 30) + bricks * 32 + int64_t(v.byteSize()) * 3 / 5;
-  setenv("SPACESKIP_CUDA_MEMORY_LIMIT", std::to_string(limit).c_str(), 1);
+  spaceskip::testing::setDeviceMemoryLimit(limit);
   std::vector<std::string> said;
   Image img;
   ResidencyStats s;
@@ -524,7 +524,7 @@ TEST(BrickPool, CudaVolumeAboveTheDeviceStaysOnItSparse) {
     s = e.frameStats().residency;
     backend = e.frameStats().backend;
   }
-  unsetenv("SPACESKIP_CUDA_MEMORY_LIMIT");
+  spaceskip::testing::setDeviceMemoryLimit(-1);
   EXPECT_EQ(backend, "cuda");
   EXPECT_TRUE(s.sparse);
   EXPECT_LT(s.budgetBytes, int64_t(v.byteSize()));

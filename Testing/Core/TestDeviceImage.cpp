@@ -79,10 +79,7 @@ TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
     void* stream = e.deviceImageStream();
     ASSERT_NE(image, nullptr);
     ASSERT_NE(stream, nullptr);
-    const char* sync = std::getenv("SPACESKIP_SYNC_FRAME");
-    if (!(sync && sync[0] == '1')) {
-      EXPECT_EQ(e.frameStats(false).deviceSeconds, -1.0) << "render() waited for the kernel";
-    }
+    EXPECT_EQ(e.frameStats(false).deviceSeconds, -1.0) << "render() waited for the kernel";
     // Queued behind the kernel on the engine's stream: the finished frame.
     Image dev;
     ASSERT_TRUE(download(image, stream, w, h, dev));
@@ -185,18 +182,19 @@ TEST(DeviceImage, LayersBlendLikeTheFlatImage) {
   // flat image is asked for (Engine::deviceImage composites them then); the CUDA blend composites
   // the layers as it reads them. Both blends must write the same texels bit for bit, and the
   // flat image must equal the host image. 4 segments forced (rays this short are whole by
-  // default), the box's rectangle with flags and every layer written (SPACESKIP_SEGMENT_LAYERS).
+  // default; Tuning::raySegments), the box's rectangle with flags.
   std::string why;
   if (!cudaAvailable(&why)) GTEST_SKIP() << why;
   Scene s;
   const int w = 120, h = 90;
-  setenv("SPACESKIP_RAY_SEGMENTS", "4", 1);
+  Tuning segmented;
+  segmented.raySegments = 4;
   const cudaChannelFormatDesc desc = cudaCreateChannelDesc(8, 8, 8, 8, cudaChannelFormatKindUnsigned);
-  for (const char* layout : {"rect", "dense"}) {
-    setenv("SPACESKIP_SEGMENT_LAYERS", layout, 1);
+  {
     for (bool eightBit : {true, false}) {
-      SCOPED_TRACE(std::string(layout) + (eightBit ? " 8-bit" : " float"));
+      SCOPED_TRACE(eightBit ? "8-bit" : "float");
       Engine e(BackendKind::CUDA);
+      e.setTuning(segmented);
       test::load(e, s.v, s.tf, test::builder(BuilderKind::DistanceGrid));
       Image host;
       e.render(s.cam, w, h, host);
@@ -241,7 +239,5 @@ TEST(DeviceImage, LayersBlendLikeTheFlatImage) {
       EXPECT_EQ(back[0], back[1]) << "the blend from the layers differs from the blend of the flat image";
     }
   }
-  unsetenv("SPACESKIP_SEGMENT_LAYERS");
-  unsetenv("SPACESKIP_RAY_SEGMENTS");
 }
 #endif

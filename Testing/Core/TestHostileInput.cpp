@@ -1,5 +1,6 @@
 // Issue 14, readers and parsers: crafted files (written here at run time) and option values must
 // give a clear error naming the file and field, quickly, without allocating what they claim.
+#include "Environment.h"
 #include "Options.h"
 #include "spaceskip/TransferFunctionIO.h"
 #include "spaceskip/VolumeIO.h"
@@ -303,16 +304,21 @@ TEST(HostileInput, ValidateRefusesOverflowingDims) {
              "more than the limit");
 }
 
-TEST(HostileInput, DefaultCapFollowsTheEnvironment) {
+TEST(HostileInput, CliCapFollowsTheEnvironment) {
+  // SPACESKIP_MAX_VOLUME_BYTES is the CLI's (Core/cli/Environment.h): the library's default cap
+  // reads no environment.
   const char* old = std::getenv("SPACESKIP_MAX_VOLUME_BYTES");
   const std::string saved = old ? old : "";
   setenv("SPACESKIP_MAX_VOLUME_BYTES", "3M", 1);
-  EXPECT_EQ(defaultMaxVolumeBytes(), uint64_t(3) << 20);
-  EXPECT_EQ(ReadLimits{}.maxBytes, uint64_t(3) << 20);
+  EXPECT_EQ(cli::maxVolumeBytesFromEnvironment(7), uint64_t(3) << 20);
+  EXPECT_EQ(cli::maxVolumeBytes(cli::Options{}), uint64_t(3) << 20);
+  EXPECT_EQ(ReadLimits{}.maxBytes, defaultMaxVolumeBytes());
+  EXPECT_GT(defaultMaxVolumeBytes(), uint64_t(3) << 20);
   setenv("SPACESKIP_MAX_VOLUME_BYTES", "12abc", 1);
-  EXPECT_HAS(errorOf([] { defaultMaxVolumeBytes(); }), "SPACESKIP_MAX_VOLUME_BYTES");
+  EXPECT_HAS(errorOf([] { cli::maxVolumeBytesFromEnvironment(7); }), "SPACESKIP_MAX_VOLUME_BYTES");
+  unsetenv("SPACESKIP_MAX_VOLUME_BYTES");
+  EXPECT_EQ(cli::maxVolumeBytesFromEnvironment(7), uint64_t(7));
   if (old) setenv("SPACESKIP_MAX_VOLUME_BYTES", saved.c_str(), 1);
-  else unsetenv("SPACESKIP_MAX_VOLUME_BYTES");
   EXPECT_GE(defaultMaxVolumeBytes(), uint64_t(1) << 20);
   EXPECT_LE(defaultMaxVolumeBytes(), uint64_t(64) << 30);
 }

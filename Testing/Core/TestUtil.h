@@ -83,10 +83,12 @@ inline OccupancyGrid randomBrickGrid(vec3i dims, double p, unsigned seed) {
   return g;
 }
 
-/// One CPU frame of builder `k` from `cam` (with render parameters `rp`), with the samples it took.
+/// One CPU frame of builder `k` from `cam` (with render parameters `rp` and knobs `t`), with the
+/// samples it took.
 inline Image renderCounting(const Volume& v, const TransferFunction& tf, BuilderKind k, const Camera& cam, int size,
-                            int64_t& samples, RenderParams rp = RenderParams{}) {
+                            int64_t& samples, RenderParams rp = RenderParams{}, const Tuning& t = Tuning{}) {
   Engine e(BackendKind::CPU);
+  e.setTuning(t);
   load(e, v, tf, builder(k));
   rp.countSamples = true;
   e.setRenderParams(rp);

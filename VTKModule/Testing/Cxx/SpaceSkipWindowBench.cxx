@@ -5,10 +5,10 @@
 // mapper's parts, the first frame's parts, and the time from an opacity edit that changes the
 // occupied cells to the end of the first new frame (with its engine update, kernel, builds and
 // builder), and of the frame after it (where Auto rebuilds the structure a stand-in drew the
-// edit's frame with). Run by Testing/gpu/run-gpu-vtk.sh.
+// edit's frame with). Run by bench/device/run-vtk.sh.
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
-//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:sync|:full|:float|:glblend|:segN|:batchN]]
+//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:full|:float|:glblend|:segN|:batchN]]
 //       [--vtk-gpu]
 //       [--edits E (4)] [--edit-cut C (the edits move the ramp's zero between 10% and C of the
 //        range: 0.3 by default, which changes N-body's occupied cells; 0.2 does not, as its
@@ -20,18 +20,14 @@
 //       [--shade (gradient shading, VTK's default headlight and material)]
 //       [--depth-actor (an opaque point actor outside the volume: the mapper reads the window's
 //        depth as with geometry in the scene; without it a volume-only scene skips the readback)]
-// Item suffixes for measuring the frame around the kernel in one process (issue 13): :sync sets
-// SPACESKIP_SYNC_FRAME=1 for the item (the host waits for the kernel and copies on the default
-// stream, as before the asynchronous interop), :full SPACESKIP_COMPOSITE_FULL=1 (copy and blend
-// the whole window, not the volume's rectangle), :float the mapper's EightBitComposite off (a
-// float texture), :glblend SPACESKIP_CUDA_BLEND=0 (the image copied into a texture that GL
-// draws, instead of blended by CUDA into the window's framebuffer), :segN SPACESKIP_RAY_SEGMENTS=N
-// (rays cut into N segments; 1: whole rays), :batchN SPACESKIP_SAMPLE_BATCH=N (samples a GPU
-// march fetches together; 1: one at a time), :layersdense / :layersflags
-// SPACESKIP_SEGMENT_LAYERS=dense / flags (a segmented frame's layers over every pixel, each
-// written (round 13), or over every pixel with flags; default: the box's pixel rectangle with flags),
-// :nofuse SPACESKIP_FUSED_BLEND=0 (a segmented frame's layers composited into the flat image
-// before the CUDA blend reads it, instead of by the blend itself). Columns render_ms and finish_ms split the frame into the time in Render() and
+// The mapper's knobs (spaceskip::Tuning) come from the environment (Core/cli/Environment.h,
+// docs/tuning.md), and item suffixes set some of them for one item, for measuring the frame
+// around the kernel in one process: :full Tuning::compositeFull (copy and blend the whole window,
+// not the volume's rectangle), :float the mapper's EightBitComposite off (a float texture),
+// :glblend Tuning::cudaBlend off (the image copied into a texture that GL draws, instead of
+// blended by CUDA into the window's framebuffer), :segN Tuning::raySegments = N (rays cut into N
+// segments; 1: whole rays), :batchN Tuning::sampleBatch = N (samples a GPU march fetches
+// together; 1: one at a time). Columns render_ms and finish_ms split the frame into the time in Render() and
 // the wait in glFinish() after it. stream_ms / stream_fps: the same orbit rendered back to back
 // with one glFinish() at the end (throughput; frame_ms is the latency of one waited-for frame).
 // edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
@@ -65,7 +61,9 @@
 #include "vtkPolyDataMapper.h"
 #include "vtk_glew.h"
 
+#include "cli/Environment.h"
 #include "spaceskip/Generators.h"
+#include "spaceskip/Tuning.h"
 
 #include <dlfcn.h>
 
@@ -288,14 +286,11 @@ struct Item
   int mls = 0;
   int brick = 8;
   int filter = -1; ///< vtkSpaceSkippingVolumeMapper::FilterModeTypes; -1: --filter's
-  bool sync = false;  ///< SPACESKIP_SYNC_FRAME=1
-  bool full = false;  ///< SPACESKIP_COMPOSITE_FULL=1
+  bool full = false; ///< Tuning::compositeFull
   bool floatComposite = false;
-  bool glBlend = false; ///< SPACESKIP_CUDA_BLEND=0
-  int segments = 0;     ///< SPACESKIP_RAY_SEGMENTS (0: unset, the default)
-  int batch = 0;        ///< SPACESKIP_SAMPLE_BATCH (0: unset, the default)
-  std::string layers;   ///< SPACESKIP_SEGMENT_LAYERS (empty: unset, the default)
-  bool noFuse = false;  ///< SPACESKIP_FUSED_BLEND=0
+  bool glBlend = false; ///< Tuning::cudaBlend off
+  int segments = 0;     ///< Tuning::raySegments (0: the environment's)
+  int batch = 0;        ///< Tuning::sampleBatch (0: the environment's)
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -342,10 +337,6 @@ bool ParseItem(const std::string& spec, Item& it)
     {
       it.filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
     }
-    else if (parts[i] == "sync")
-    {
-      it.sync = true;
-    }
     else if (parts[i] == "full")
     {
       it.full = true;
@@ -365,14 +356,6 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i].rfind("batch", 0) == 0 && parts[i].size() > 5)
     {
       it.batch = std::atoi(parts[i].c_str() + 5);
-    }
-    else if (parts[i] == "layersdense" || parts[i] == "layersflags")
-    {
-      it.layers = parts[i].substr(6);
-    }
-    else if (parts[i] == "nofuse")
-    {
-      it.noFuse = true;
     }
     else
     {
@@ -686,6 +669,7 @@ int main(int argc, char* argv[])
   mapper->SetBlendMode(blend);
   std::printf("composite: %s image upload\n", floatComposite ? "32-bit float" : "8-bit");
   volume->SetMapper(mapper);
+  const spaceskip::Tuning baseTuning = spaceskip::cli::tuningFromEnvironment();
   bool firstOfAll = true;
   int imageMismatches = 0; // items whose GPU-path image differs from the host path's by > 1/255
   for (const Item& it : items)
@@ -696,34 +680,18 @@ int main(int argc, char* argv[])
     mapper->SetMacroCellSize(it.brick);
     mapper->SetFilterMode(it.filter);
     mapper->SetEightBitComposite(!(floatComposite || it.floatComposite));
-    auto setSwitch = [](const char* name, bool on) {
-      if (on)
-        setenv(name, "1", 1);
-      else
-        unsetenv(name);
-    };
-    setSwitch("SPACESKIP_SYNC_FRAME", it.sync);
-    setSwitch("SPACESKIP_COMPOSITE_FULL", it.full);
-    if (it.glBlend)
-      setenv("SPACESKIP_CUDA_BLEND", "0", 1);
-    else
-      unsetenv("SPACESKIP_CUDA_BLEND");
+    spaceskip::Tuning tuning = baseTuning;
+    tuning.compositeFull = tuning.compositeFull || it.full;
+    tuning.cudaBlend = tuning.cudaBlend && !it.glBlend;
     if (it.segments > 0)
-      setenv("SPACESKIP_RAY_SEGMENTS", std::to_string(it.segments).c_str(), 1);
-    else
-      unsetenv("SPACESKIP_RAY_SEGMENTS");
+    {
+      tuning.raySegments = it.segments;
+    }
     if (it.batch > 0)
-      setenv("SPACESKIP_SAMPLE_BATCH", std::to_string(it.batch).c_str(), 1);
-    else
-      unsetenv("SPACESKIP_SAMPLE_BATCH");
-    if (!it.layers.empty())
-      setenv("SPACESKIP_SEGMENT_LAYERS", it.layers.c_str(), 1);
-    else
-      unsetenv("SPACESKIP_SEGMENT_LAYERS");
-    if (it.noFuse)
-      setenv("SPACESKIP_FUSED_BLEND", "0", 1);
-    else
-      unsetenv("SPACESKIP_FUSED_BLEND");
+    {
+      tuning.sampleBatch = it.batch;
+    }
+    mapper->SetTuning(tuning);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
@@ -856,8 +824,7 @@ int main(int argc, char* argv[])
     }
   }
 
-  unsetenv("SPACESKIP_SYNC_FRAME");
-  unsetenv("SPACESKIP_COMPOSITE_FULL");
+  mapper->SetTuning(baseTuning);
   if (vtkGpu)
   {
     // VTK's own GPU ray caster in the same window: same property, sample distance half a voxel

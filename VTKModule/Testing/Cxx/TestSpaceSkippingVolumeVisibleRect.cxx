@@ -16,6 +16,7 @@
 #include "vtkVolumeProperty.h"
 
 #include "SpaceSkipTestHelpers.h"
+#include "spaceskip/Tuning.h"
 
 #include <cstdlib>
 #include <string>
@@ -55,10 +56,12 @@ int TestSpaceSkippingVolumeVisibleRect(int, char*[])
     win->Render();
     auto background = sstest::Capture(win);
     volume->VisibilityOn();
-    setenv("SPACESKIP_COMPOSITE_FULL", "1", 1);
+    spaceskip::Tuning wholeViewport;
+    wholeViewport.compositeFull = true;
+    mapper->SetTuning(wholeViewport);
     win->Render();
     auto full = sstest::Capture(win);
-    unsetenv("SPACESKIP_COMPOSITE_FULL");
+    mapper->SetTuning(spaceskip::Tuning{});
     win->Render();
     auto rect = sstest::Capture(win);
     int r[4], vw, vh, vx, vy;

@@ -1,0 +1,71 @@
+// Every knob of the kernels, the builders, the classification and the VTK compositor that a
+// benchmark or a test may turn: plain data, set through Engine::setTuning (the backends get a
+// copy) and vtkSpaceSkippingVolumeMapper::SetTuning. The library reads no environment for these:
+// the CLI and the window benchmark fill a Tuning from SPACESKIP_* variables in one place
+// (Core/cli/Environment.h; docs/tuning.md lists them). Each default is the product's behaviour.
+#pragma once
+
+#include <cstdint>
+
+namespace spaceskip {
+
+struct Tuning {
+  // --- CUDA launch of the render kernels (the CPU backend ignores these) ---
+  /// Threads per block, W x H with 32 <= W*H <= 256; 0: 16x8.
+  int blockX = 0, blockY = 0;
+  /// Persistent launch: N resident blocks per SM take tiles from a counter; 0: one block per tile
+  /// (the plain launch); -1: automatic (persistent for hardware-filtered volumes above 2 GiB).
+  int resident = -1;
+  /// Rays cut into this many segments marched by separate threads (1..16; 1: whole rays); 0:
+  /// automatic (up to 4, by the box's length in samples; CudaExecutor.cu raySegments).
+  int raySegments = 0;
+  /// Samples a hardware-filtered GPU march fetches before compositing the first (1..4; 0: 4,
+  /// kMaxSampleBatch). 1 (one at a time) stays for the test that batches give the same image.
+  int sampleBatch = 0;
+  /// Grid and DistanceGrid frames walk the parts of sparse bricks only where the set parts are
+  /// at most this share of the occupied bricks' parts (CudaBackend.cu; measured in
+  /// docs/results/round9-h100).
+  double partsShare = 0.2;
+
+  // --- classification (both backends) ---
+  /// Sub-brick masks: without them an occupied brick is marched whole.
+  bool subMasks = true;
+  /// The most set parts (of 64) a brick may have to be walked part by part (subBrickState); 40
+  /// measured best over 24 on the H100 and the oneTBB backend (docs/results/round12-h100).
+  int subMaskMaxSet = 40;
+  /// CUDA: part ranges stored at setVolume, so that an edit's classification computes the masks
+  /// from 128 bounds a brick (BrickClassification::partRangeBytes); off: from the voxels, on the
+  /// frame after the edit's.
+  bool partRanges = true;
+
+  // --- DistanceGrid (CUDA) ---
+  /// The distance field's cap in bricks (1..127; kMaxSkipDistance, DistanceField.h).
+  int distanceCap = 32;
+  /// The most threads a line of the field's staged kernel uses (1..8; DistanceField.cu).
+  int distanceSegments = 8;
+
+  // --- VTK mapper and compositor ---
+  /// Under MPI, the colour a piece in front adds where its ray goes on into another piece, in
+  /// 1/255 (VolumePiece::followBias: IceT's 8-bit blend truncates).
+  double pieceBias = 0.5;
+  /// CUDA: blend the frame straight into the window's colour texture when it can; off: the
+  /// texture path (upload and GL draw).
+  bool cudaBlend = true;
+  /// Composite the whole viewport instead of the volume's projected rectangle.
+  bool compositeFull = false;
+};
+
+/// Fault injection for tests (process-wide, off by default); the CUDA backend reads these at
+/// each allocation and render launch, a relaxed atomic load each.
+namespace testing {
+/// Caps the device bytes SpaceSkip may hold: an allocation above it fails with
+/// cudaErrorMemoryAllocation as a real out-of-memory does. Negative: no cap (the default).
+void setDeviceMemoryLimit(int64_t bytes);
+int64_t deviceMemoryLimit();
+/// Every CUDA render launch reports cudaErrorLaunchFailure (a CUDA error in the middle of a
+/// frame), so that the fallback to the CPU backend's image can be tested on any GPU.
+void setFailRender(bool on);
+bool failRender();
+}  // namespace testing
+
+}  // namespace spaceskip
