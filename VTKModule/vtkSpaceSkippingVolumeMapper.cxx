@@ -331,6 +331,17 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::UpdateEngine()
       backend == CPU ? spaceskip::BackendKind::CPU : spaceskip::BackendKind::Auto;
     this->Engine.reset(new spaceskip::Engine(kind, this->Warn));
     this->Engine->setTuning(this->Tuning);
+    // The engine's steps as the algorithm's progress (ParaView's progress bar): the text names
+    // the step, the fraction runs over the update and frame together.
+    vtkSpaceSkippingVolumeMapper* self = this->Self;
+    this->Engine->setProgress([self](double fraction, const char* step) {
+      const std::string text = std::string("Space Skipping Volume: ") + step;
+      if (!self->GetProgressText() || text != self->GetProgressText())
+      {
+        self->SetProgressText(text.c_str());
+      }
+      self->UpdateProgress(fraction);
+    });
   }
   catch (const std::exception& e)
   {

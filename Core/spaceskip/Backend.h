@@ -9,6 +9,7 @@
 #include "Volume.h"
 #include "render/Integrator.h"
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -36,6 +37,9 @@ class Backend {
   virtual void build(const BuildParams& p, BuildStats& stats) = 0;
   /// `f` carries camera, box, sampling; the backend fills pointers and traversal kind.
   virtual void render(FrameView f, FilterMode filter, const float* depth, Image& out) = 0;
+  /// Called on the caller's thread with the fraction of a frame drawn, where a frame takes long
+  /// (the CPU backend's large frames); empty: none.
+  virtual void setProgress(std::function<void(double)> /*progress*/) {}
   /// When `on` (and supported: returns whether it is), render() leaves the image in device memory
   /// (deviceImage()) and gives `out` only its size: for callers that draw it with CUDA-GL interop.
   virtual bool setImageOnDevice(bool /*on*/) { return false; }

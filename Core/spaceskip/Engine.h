@@ -42,6 +42,11 @@ class Engine {
   const char* backendName() const;
   /// Messages (warnings, fallbacks) go here; default prints to stderr.
   void setLogger(std::function<void(const std::string&)> log);
+  /// Called on the caller's thread as update() and render() go, with the fraction of the work
+  /// done (0..1) and the step under way ("value ranges", "classification", "build",
+  /// "measuring", "frame"): what a progress bar shows (the VTK mapper's progress events).
+  /// The CPU backend also reports inside a large frame. Empty: none.
+  void setProgress(std::function<void(double, const char*)> progress);
 
   /// The engine borrows `v.data` (or shares `v.storage`): keep it alive while rendering.
   void setVolume(const Volume& v);

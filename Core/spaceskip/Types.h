@@ -58,9 +58,16 @@ struct BuildParams {
   /// kept structure took longer than this to build, the first frame is drawn with Grid (no build
   /// beyond classification) and the kept structure is rebuilt for the frame after. < 0: never.
   double autoQuickBuildSeconds = 1e-3;
+  /// Builder Auto, where it measures: 1: on probes, reduced frames (1/4 of each axis or less, at
+  /// most 128 pixels a side) of the same view drawn inside the frame that needs a decision, so
+  /// the user's frames always draw with the best structure known and measuring costs a fraction
+  /// of one frame; 0: on the user's frames, one candidate a frame (cheap where frames take
+  /// milliseconds); -1 (default): probes on the CPU backend, frames on CUDA.
+  int autoProbe = -1;
   bool operator==(const BuildParams& o) const {
     return builder == o.builder && leaf == o.leaf && maxLeafSize == o.maxLeafSize &&
-           bins == o.bins && brick == o.brick && autoQuickBuildSeconds == o.autoQuickBuildSeconds;
+           bins == o.bins && brick == o.brick && autoQuickBuildSeconds == o.autoQuickBuildSeconds &&
+           autoProbe == o.autoProbe;
   }
   bool operator!=(const BuildParams& o) const { return !(*this == o); }
 };
@@ -212,6 +219,10 @@ struct Counters {
   int staleFrames = 0;
   int colorUpdates = 0;
   int frames = 0;
+  /// Measurings Builder Auto ran on probes (BuildParams::autoProbe), each inside one frame.
+  int autoProbeMeasurings = 0;
+  /// Probe frames drawn for them (not counted in `frames`).
+  int autoProbeFrames = 0;
   /// Whole-table compares of Engine::setTransferFunction (the parts its caller said may differ).
   int colorCompares = 0, opacityCompares = 0;
 };

@@ -65,6 +65,15 @@ struct Engine::Impl {
   BackendKind requested;
   std::unique_ptr<Backend> backend;
   std::function<void(const std::string&)> log = [](const std::string& m) { std::cerr << "spaceskip: " << m << "\n"; };
+  std::function<void(double, const char*)> progress;  ///< setProgress
+  void report(double fraction, const char* step) const {
+    if (progress) progress(std::clamp(fraction, 0.0, 1.0), step);
+  }
+  /// The backend's hook: its fraction of a frame as the last fifth of the engine's work.
+  std::function<void(double)> backendProgress() {
+    if (!progress) return {};
+    return [this](double f) { report(0.8 + 0.2 * f, "frame"); };
+  }
 
   Volume volume;
   int valueExponent = 0;  ///< voxel values (and so the TF range) times 2^this; see setVolume
@@ -148,6 +157,8 @@ struct Engine::Impl {
     ViewKey recheckAt;            ///< the view a re-check started at
     int rechecks = 0;             ///< re-checks at a new view since the measuring
     int switches = 0;             ///< changes of the kept structure by a re-check
+    int fullWidth = 0, fullHeight = 0;  ///< the user's frame size (probes: `width` is the probe's)
+    double timeScale = 1;         ///< probes: the user's frame pixels over a probe's
     std::string choice;
   } autoState;
   static constexpr double kAutoReexplore = 0.1;
@@ -286,6 +297,92 @@ struct Engine::Impl {
     t = a.frames[size_t(a.current)]++ == 0 ? seconds : std::min(t, seconds);
   }
 
+  /// Starts a re-check of the kept structure at `view` against its contenders: those within
+  /// kAutoPrune of it when it was measured, at least the runner-up (the likeliest to overtake it
+  /// at another view); the queue is the kept one, the contenders, them again reversed, the kept
+  /// one. False (nothing started) with a single candidate.
+  bool startRecheck(const ViewKey& view) {
+    AutoState& a = autoState;
+    std::vector<int> q;
+    int runnerUp = -1;
+    for (size_t i = 0; i < a.candidates.size(); ++i) {
+      if (int(i) == a.kept || !(a.seconds[i] > 0)) continue;
+      if (autoCost(i) < kAutoPrune * autoCost(size_t(a.kept))) q.push_back(int(i));
+      if (runnerUp < 0 || autoCost(i) < autoCost(size_t(runnerUp))) runnerUp = int(i);
+    }
+    if (q.empty() && runnerUp >= 0) q.push_back(runnerUp);
+    if (q.empty()) {  // a single candidate: nothing to re-check
+      a.measuredAt = view;
+      return false;
+    }
+    const int contenders = int(q.size());
+    for (int i = contenders - 1; i >= 0; --i) q.push_back(q[size_t(i)]);  // round 2, reversed
+    q.push_back(a.kept);
+    ++a.rechecks;
+    a.recheckAt = view;
+    std::vector<int> queue{a.kept};
+    queue.insert(queue.end(), q.begin(), q.end());
+    beginMeasuring(queue, true);
+    return true;
+  }
+
+  /// Whether Auto measures on probes (BuildParams::autoProbe).
+  bool autoProbes() const {
+    return build.autoProbe > 0 || (build.autoProbe < 0 && backend->kind() == BackendKind::CPU);
+  }
+
+  /// The probe size for a frame of width x height: 1/4 of each axis or less, at most 128 pixels
+  /// a side, at least 16 (or the frame's own size below that).
+  static void probeSize(int width, int height, int& pw, int& ph) {
+    const double f = std::max(4.0, double(std::max(width, height)) / 128.0);
+    pw = std::max(std::min(width, 16), int(width / f));
+    ph = std::max(std::min(height, 16), int(height / f));
+  }
+
+  /// Auto on probes, before the user's frame `full` (width x height, seen from `view`) is drawn:
+  /// the triggers of the per-frame protocol (a new frame size; a still camera far from where
+  /// the choice was measured, without an edit in this frame) start a measuring, and a measuring
+  /// runs to its decision here, every candidate built and drawn on probes of the same view.
+  /// The user's frame then draws with the kept structure.
+  void autoProbe(const FrameView& full, int width, int height, const ViewKey& view) {
+    AutoState& a = autoState;
+    const ViewKey previous = a.lastView;
+    a.lastView = view;
+    const bool tfEdit = a.tfEdit;
+    a.tfEdit = false;
+    if (!a.exploring && !a.standIn) {
+      if (width != a.fullWidth || height != a.fullHeight) startAutoExploration();
+      else if (!tfEdit && !near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) &&
+               near(view, previous, kAutoStillDegrees, kAutoStillZoom))
+        startRecheck(view);
+    }
+    if (!a.exploring) return;
+    a.fullWidth = width;
+    a.fullHeight = height;
+    FrameView p = full;
+    probeSize(width, height, p.width, p.height);
+    p.depth = nullptr;  // per pixel of the user's frame
+    p.alphaIn = nullptr;
+    p.sampleCount = nullptr;
+    a.timeScale = double(width) * double(height) / (double(p.width) * double(p.height));
+    Image img;
+    // Each candidate at most 1 + 1 + kAutoMaxRepeats probes (a re-check: 2 + 2): a bound, not a rule.
+    const int bound = 8 * int(a.candidates.size());
+    for (int guard = 0; a.exploring && guard < bound; ++guard) {
+      report(0.5 + 0.3 * double(guard) / double(bound), "measuring");
+      update();  // builds the candidate to measure
+      const auto t0 = Clock::now();
+      backend->render(p, render.filter, nullptr, img);
+      const double t = backend->lastFrameDeviceSeconds() > 0 ? backend->lastFrameDeviceSeconds() : since(t0);
+      ++counters.autoProbeFrames;
+      autoFrameDone([t] { return t; }, p.width, p.height, view);
+    }
+    if (a.exploring) {  // the bound was hit: keep the cheapest measured so far
+      cancelRecheck();
+    }
+    ++counters.autoProbeMeasurings;
+  }
+
   /// After a frame of `seconds()` at width x height seen from `view`: records it and picks the
   /// next build. `seconds` is called only when a time is recorded (it may wait for the device).
   void autoFrameDone(const std::function<double()>& seconds, int width, int height, const ViewKey& view) {
@@ -306,28 +403,7 @@ struct Engine::Impl {
       if (tfEdit || near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) ||
           !near(view, previous, kAutoStillDegrees, kAutoStillZoom))
         return;
-      // The contenders: those within kAutoPrune of the kept one where it was measured, at least
-      // the runner-up (the likeliest to overtake it at another view).
-      std::vector<int> q;
-      int runnerUp = -1;
-      for (size_t i = 0; i < a.candidates.size(); ++i) {
-        if (int(i) == a.kept || !(a.seconds[i] > 0)) continue;
-        if (autoCost(i) < kAutoPrune * autoCost(size_t(a.kept))) q.push_back(int(i));
-        if (runnerUp < 0 || autoCost(i) < autoCost(size_t(runnerUp))) runnerUp = int(i);
-      }
-      if (q.empty() && runnerUp >= 0) q.push_back(runnerUp);
-      if (q.empty()) {  // a single candidate: nothing to re-check
-        a.measuredAt = view;
-        return;
-      }
-      const int contenders = int(q.size());
-      for (int i = contenders - 1; i >= 0; --i) q.push_back(q[size_t(i)]);  // round 2, reversed
-      q.push_back(a.kept);
-      ++a.rechecks;
-      a.recheckAt = view;
-      std::vector<int> queue{a.kept};
-      queue.insert(queue.end(), q.begin(), q.end());
-      beginMeasuring(queue, true);
+      if (!startRecheck(view)) return;
       record(seconds());  // the frame just drawn: the kept one at this view
       a.queue.erase(a.queue.begin());
       a.current = a.queue.front();
@@ -391,20 +467,39 @@ struct Engine::Impl {
     describeAutoChoice();
   }
 
+  /// "0.19 s", "12 ms", "0.35 ms": a duration a reader takes in at a glance.
+  static std::string readableSeconds(double s) {
+    char buf[32];
+    if (s >= 1.0) std::snprintf(buf, sizeof buf, "%.2g s", s);
+    else if (s >= 0.1) std::snprintf(buf, sizeof buf, "%.2f s", s);
+    else std::snprintf(buf, sizeof buf, "%.2g ms", 1e3 * s);
+    return buf;
+  }
+
+  /// Builder Choice: "Auto chose Grid: 0.19 s a frame, 1.4% occupied; measured (a frame
+  /// [+ build/30]): Naive 4.1 s, Grid 0.19 s + 0.012 ms, ..." (probes: times scaled to the
+  /// user's frame by its pixel count, and said so).
   void describeAutoChoice() {
     AutoState& a = autoState;
+    const size_t k = size_t(a.kept);
     char buf[160];
-    std::snprintf(buf, sizeof buf, "Auto: %s (%.3g ms/frame) at occupancy %.3f",
-                  builderName(a.candidates[size_t(a.kept)].builder), 1e3 * a.seconds[size_t(a.kept)], a.occupancy);
+    std::snprintf(buf, sizeof buf, "Auto chose %s: %s a frame, %.3g%% occupied", builderName(a.candidates[k].builder),
+                  readableSeconds(a.seconds[k] * a.timeScale).c_str(), 100.0 * a.occupancy);
     std::string line = buf;
     if (a.rechecks) line += ", re-checked " + std::to_string(a.rechecks) + "x at new views";
     if (a.switches) line += ", switched " + std::to_string(a.switches) + "x";
-    std::snprintf(buf, sizeof buf, "; measured (ms, best frame + build/%g)", kAutoFramesPerBuild);
+    std::snprintf(buf, sizeof buf, "; measured (a frame + build/%g):", kAutoFramesPerBuild);
     line += buf;
     for (size_t i = 0; i < a.seconds.size(); ++i) {
       const double b = a.buildSeconds[i] > 0 ? a.buildSeconds[i] : 0.0;
-      std::snprintf(buf, sizeof buf, "%s %s %.3g+%.2g", i ? "," : "", builderName(a.candidates[i].builder),
-                    1e3 * a.seconds[i], 1e3 * b / kAutoFramesPerBuild);
+      line += std::string(i ? ", " : " ") + builderName(a.candidates[i].builder) + " " +
+              (a.seconds[i] > 0 ? readableSeconds(a.seconds[i] * a.timeScale) : std::string("-"));
+      // A build term under 1% of the frame is left out: it changes nothing.
+      if (b / kAutoFramesPerBuild > 0.01 * a.seconds[i] * a.timeScale)
+        line += " + " + readableSeconds(b / kAutoFramesPerBuild);
+    }
+    if (a.timeScale > 1) {
+      std::snprintf(buf, sizeof buf, " (from probes of 1/%.0f of the frame's pixels)", a.timeScale);
       line += buf;
     }
     a.choice = line;
@@ -439,6 +534,7 @@ struct Engine::Impl {
   void fallBackToCpu(const std::string& why) {
     warn("CUDA backend failed (" + why + "); falling back to the CPU backend");
     backend = makeCpuBackend();
+    backend->setProgress(backendProgress());
     backend->setTuning(tuning);
     rangesDirty = opacityDirty = buildDirty = tableDirty = true;
     autoState = AutoState{};
@@ -546,6 +642,7 @@ struct Engine::Impl {
     }
     const bool newRanges = rangesDirty;
     if (rangesDirty) {
+      report(0.0, "value ranges");
       backend->setVolume(volume, build.brick);
       ++counters.rangeGrids;
       rangesDirty = false;
@@ -558,6 +655,7 @@ struct Engine::Impl {
       cancelRecheck();
     }
     if (opacityDirty || cropClipDirty) {
+      report(0.3, "classification");
       auto t0 = Clock::now();
       bool changed = backend->classify(scaledTF(), cropClip);
       stats.classifySeconds = since(t0);
@@ -627,6 +725,7 @@ struct Engine::Impl {
         p.builder = info.fallback;
       }
       BuildStats s;
+      if (!autoState.exploring) report(0.4, "build");
       try {
         backend->build(p, s);
       } catch (const BackendError& e) {
@@ -668,6 +767,10 @@ Engine::~Engine() = default;
 BackendKind Engine::backendKind() const { return impl_->backend->kind(); }
 const char* Engine::backendName() const { return impl_->backend->name(); }
 void Engine::setLogger(std::function<void(const std::string&)> log) { impl_->log = std::move(log); }
+void Engine::setProgress(std::function<void(double, const char*)> progress) {
+  impl_->progress = std::move(progress);
+  impl_->backend->setProgress(impl_->backendProgress());
+}
 
 void Engine::setVolume(const Volume& v) {
   validate(v);
@@ -954,6 +1057,12 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     counts.assign(size_t(width) * size_t(height), 0u);
     f.sampleCount = counts.data();
   }
+  const bool autoProbes = d.build.builder == BuilderKind::Auto && d.autoProbes();
+  if (autoProbes) {
+    d.autoProbe(f, width, height, d.viewKey(cam));
+    d.update();  // the kept structure, when measuring ended on another
+  }
+  d.report(0.8, "frame");
   auto t0 = Clock::now();
   try {
     d.backend->render(f, d.render.filter, depth, out);
@@ -981,7 +1090,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   if (d.frame.residency.overflow)
     d.warn("the bricks this view needs exceed the memory budget: sampled from the whole volume in host memory");
   ++d.counters.frames;
-  if (d.build.builder == BuilderKind::Auto)
+  if (d.build.builder == BuilderKind::Auto && !autoProbes)
     d.autoFrameDone([&d] { return d.frameDeviceSeconds() > 0 ? d.frame.deviceSeconds : d.frame.seconds; }, width,
                     height, d.viewKey(cam));
 }

@@ -14,8 +14,11 @@
 #include "vtkObjectFactory.h"
 #include "vtkOutlineSource.h"
 #include "vtkPointData.h"
+#include "vtkProcessModule.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkPVLODVolume.h"
+#include "vtkPVProgressHandler.h"
+#include "vtkPVSession.h"
 #include "vtkPVRenderView.h"
 #include "vtkPVView.h"
 #include "vtkPartitionedDataSet.h"
@@ -174,6 +177,15 @@ vtkSpaceSkipVolumeRepresentation::vtkSpaceSkipVolumeRepresentation()
   this->SpaceSkipMapper = mapper;
   this->VolumeMapper = mapper;
   this->Actor->SetMapper(mapper);
+  // The mapper's progress (value ranges, classification, build, Auto's measuring, long CPU
+  // frames) to ParaView's progress bar: the session's handler listens to algorithms it is told
+  // of, and the mapper lives inside this representation, out of its sight.
+  vtkProcessModule* pm = vtkProcessModule::GetProcessModule();
+  vtkPVSession* session = pm ? vtkPVSession::SafeDownCast(pm->GetActiveSession()) : nullptr;
+  if (session && session->GetProgressHandler())
+  {
+    session->GetProgressHandler()->RegisterProgressEvent(mapper, 0);
+  }
 }
 
 //------------------------------------------------------------------------------
