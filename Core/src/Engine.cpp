@@ -1,6 +1,7 @@
 // Engine: keeps scene state, decides what a change requires, and falls back from CUDA to CPU.
 #include "spaceskip/Engine.h"
 
+#include "spaceskip/AutoBuilder.h"
 #include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
 
@@ -107,403 +108,39 @@ struct Engine::Impl {
     return frame.deviceSeconds;
   }
 
-  // Builder Auto ("never slower than naive"): skipping is lossless, so every candidate draws the
-  // same image and only its speed differs. Measuring: every candidate renders a frame, in turn
-  // (round 1); those within kAutoPrune of round 1's cheapest render again, in the reverse order
-  // (round 2: A B C D, then D C B A, so a drift of the machine's load favours none and the last
-  // structure of round 1 needs no rebuild), short frames several times in a row (until
-  // kAutoMinMeasureSeconds, at most kAutoMaxRepeats frames: one sub-millisecond frame is at the
-  // mercy of a launch's jitter); a candidate's frame time is the minimum of its frames (other
-  // work only ever adds time). Its cost is that frame time plus its build time spread over
-  // kAutoFramesPerBuild frames (autoCost): a structure that draws a few percent faster at the
-  // measured view but takes milliseconds to rebuild on every opacity edit loses to one nearly as
-  // fast that rebuilds at once. The cheapest is kept, over Naive only when kAutoMargin cheaper.
-  // The candidates are measured again when the occupancy moves by more than kAutoReexplore or
-  // the image size changes, otherwise an occupancy change rebuilds the chosen one only.
-  // Frame times depend on the view, so measurements are compared only when taken at one view:
-  // once the camera has moved far (kAutoFarDegrees, or a zoom of kAutoFarZoom) from where the
-  // choice was measured and then stays still, the kept structure is re-checked there against the
-  // contenders (those within kAutoPrune of it when it was measured, at least the runner-up), two
-  // frames each; a moving camera (an orbit) never triggers a re-check, and one that moves during
-  // it cancels it. A frame that carries a TF or crop/clip change never builds a contender: it
-  // cancels a re-check under way and starts none, so an edit under Auto costs what the kept
-  // structure's edit costs (a user editing at a resting view would otherwise pay a contender's
-  // build on the frames that show the edits).
-  struct ViewKey {
-    double dir[3] = {0, 0, 0};  ///< the camera's backward axis in world space
-    double zoom = 0;            ///< |proj[0][0]|
-    double distance = 0;        ///< the eye's distance from the volume's centre (perspective)
-    bool valid = false;
-  };
-  struct AutoState {
-    std::vector<BuildParams> candidates;
-    std::vector<double> seconds;  ///< measured frame time per candidate (minimum), < 0: not yet
-    std::vector<double> buildSeconds;  ///< last build time per candidate, < 0: not yet
-    std::vector<int> frames;      ///< frames measured per candidate in the current measuring
-    std::vector<int> queue;       ///< the candidates still to render in this measuring, in order
-    bool standIn = false;         ///< this frame draws Grid while the kept one waits (refinement)
-    bool tfEdit = false;          ///< this frame carries a transfer-function (or crop/clip) change
-    bool refined = false;         ///< the kept structure was rebuilt after a stand-in frame
-    int current = -1;             ///< the candidate to draw with (built when it differs from `built`)
-    int built = -1;               ///< the candidate the backend holds, -1: none (or stale)
-    int kept = -1;                ///< the kept structure (during a re-check: the one before it)
-    bool exploring = false;       ///< measuring (all candidates, or a re-check)
-    bool rechecking = false;      ///< this measuring is a re-check of the kept one at a new view
-    int round = 0;                ///< 1 or 2 while measuring all candidates
-    double occupancy = -1;        ///< when the choice was made
-    int width = 0, height = 0;
-    ViewKey measuredAt;           ///< the view of the last measuring
-    ViewKey lastView;             ///< the previous frame's view
-    ViewKey recheckAt;            ///< the view a re-check started at
-    int rechecks = 0;             ///< re-checks at a new view since the measuring
-    int switches = 0;             ///< changes of the kept structure by a re-check
-    int fullWidth = 0, fullHeight = 0;  ///< the user's frame size (probes: `width` is the probe's)
-    double timeScale = 1;         ///< probes: the user's frame pixels over a probe's
-    std::string choice;
-  } autoState;
-  static constexpr double kAutoReexplore = 0.1;
-  /// Round 2 (and a re-check) measures only candidates within this factor of the cheapest.
-  static constexpr double kAutoPrune = 1.5;
-  /// Round 2 renders a candidate until its frames there add up to this, at most kAutoMaxRepeats.
-  static constexpr double kAutoMinMeasureSeconds = 2e-3;
-  static constexpr int kAutoMaxRepeats = 3;
-  /// A candidate's build time counts as if spread over this many frames (autoCost): an opacity
-  /// edit about every second at 30 frames/s, as when a user drags a TF point. On the H100 (round
-  /// 7, docs/results/round7-h100/auto) the k-d tree drew the first, axis-aligned view of aneurism,
-  /// stag beetle and kingsnake 3-8% faster than DistanceGrid and the orbit 5-11% slower, with
-  /// builds of 0.9-2.2 ms against 0.03-0.33 ms: this weight keeps DistanceGrid there, and the
-  /// k-d tree where it is 17-58% faster (Menger, Richtmyer-Meshkov).
-  static constexpr double kAutoFramesPerBuild = 30;
-  /// A structure is kept over Naive (or over the kept one in a re-check) only when this much faster.
-  static constexpr double kAutoMargin = 1.05;
-  /// A view this far from the measured one (degrees between view directions, or zoom ratio) is
-  /// another view; consecutive frames within kAutoStill* of each other are a still camera.
-  static constexpr double kAutoFarDegrees = 25.0, kAutoFarZoom = 1.25;
-  static constexpr double kAutoStillDegrees = 2.0, kAutoStillZoom = 1.02;
-  /// A re-check is cancelled when the camera moves this far from where it started.
-  static constexpr double kAutoRecheckDrift = 5.0;
+  AutoBuilder autoBuilder;  ///< Builder Auto's measuring (AutoBuilder.h)
 
-  ViewKey viewKey(const Camera& cam) const {
-    ViewKey k;
-    const double* v = cam.view.m;  // column-major: row 2 of the rotation is the backward axis
-    const double n = std::sqrt(v[2] * v[2] + v[6] * v[6] + v[10] * v[10]);
-    mat4 iv;
-    if (!(n > 0) || !invert(cam.view, iv)) return k;
-    for (int i = 0; i < 3; ++i) k.dir[i] = v[2 + 4 * i] / n;
-    k.zoom = std::fabs(cam.proj.m[0]);
+  AutoBuilder::ViewKey viewKey(const Camera& cam) const {
     double b[6];
     volume.worldBounds(b);
-    double d2 = 0;
-    for (int i = 0; i < 3; ++i) {
-      const double d = iv.m[12 + i] - 0.5 * (b[2 * i] + b[2 * i + 1]);
-      d2 += d * d;
-    }
-    k.distance = std::sqrt(d2);
-    k.valid = std::isfinite(k.zoom) && std::isfinite(k.distance);
-    return k;
+    return AutoBuilder::viewKey(cam, b);
   }
-  /// Whether two views are within `degrees` and a factor `zoom` (in scale and, for perspective
-  /// cameras, eye distance) of each other; an invalid one is near nothing.
-  static bool near(const ViewKey& a, const ViewKey& b, double degrees, double zoom) {
-    if (!a.valid || !b.valid) return false;
-    const double c = a.dir[0] * b.dir[0] + a.dir[1] * b.dir[1] + a.dir[2] * b.dir[2];
-    const double angle = std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
-    auto ratio = [](double x, double y) { return x > 0 && y > 0 ? std::max(x / y, y / x) : (x == y ? 1.0 : 1e30); };
-    return angle <= degrees && ratio(a.zoom, b.zoom) <= zoom && ratio(a.distance, b.distance) <= zoom;
+  void startAuto(bool afterEdit = false) { autoBuilder.start(build, backend->kind(), afterEdit); }
+  std::function<double()> occupied() const {
+    return [this] { return backend->occupiedFraction(); };
   }
-
-  std::vector<BuildParams> autoCandidates() const {
-    auto with = [&](BuilderKind k, int mls) {
-      BuildParams p = build;
-      p.builder = k;
-      p.leaf = LeafCriterion::Deep;
-      p.maxLeafSize = mls;
-      return p;
-    };
-    if (backend->kind() == BackendKind::CUDA) {
-      // The k-d tree with the Empty split rule (sweep): faster than MLS 128 on 7 of the paper's
-      // 9 GPU rows and by 13% on the Menger sponge (docs/results/paper-bench, H100).
-      BuildParams kd = with(BuilderKind::KdTreeGPUFast, 0);
-      kd.leaf = LeafCriterion::Empty;
-      kd.bins = 0;
-      return {with(BuilderKind::Naive, 0), with(BuilderKind::Grid, 0), with(BuilderKind::DistanceGrid, 0), kd,
-              with(BuilderKind::LBVH, 0)};
-    }
-    return {with(BuilderKind::Naive, 0), with(BuilderKind::Grid, 0), with(BuilderKind::DistanceGrid, 0),
-            with(BuilderKind::KdTreeCPU, 32)};
-  }
-
-  /// The Grid candidate's index, -1 when there is none.
-  int gridCandidate() const {
-    for (size_t i = 0; i < autoState.candidates.size(); ++i)
-      if (autoState.candidates[i].builder == BuilderKind::Grid) return int(i);
-    return -1;
-  }
-
-  /// Starts measuring: every candidate (round 1), or, for a re-check, the kept one and its
-  /// contenders; the first in the queue is built next.
-  void beginMeasuring(std::vector<int> queue, bool recheck) {
-    AutoState& a = autoState;
-    a.frames.assign(a.candidates.size(), 0);
-    a.queue = std::move(queue);
-    a.exploring = true;
-    a.rechecking = recheck;
-    a.round = recheck ? 0 : 1;
-    a.current = a.queue.front();
-  }
-
-  /// Measures every candidate from the start. `afterEdit`: an opacity edit moved the occupancy,
-  /// and the frame that shows it is the first measured: Grid (no build beyond the
-  /// classification) draws it instead of Naive, so the edit costs what Grid's frame costs.
-  void startAutoExploration(bool afterEdit = false) {
-    AutoState& a = autoState;
-    a.candidates = autoCandidates();
-    a.seconds.assign(a.candidates.size(), -1.0);
-    a.buildSeconds.assign(a.candidates.size(), -1.0);
-    a.kept = -1;
-    a.current = -1;
-    a.rechecks = a.switches = 0;
-    std::vector<int> all(a.candidates.size());
-    for (size_t i = 0; i < all.size(); ++i) all[i] = int(i);
-    const int grid = gridCandidate();
-    if (afterEdit && grid > 0) std::rotate(all.begin(), all.begin() + grid, all.begin() + grid + 1);
-    beginMeasuring(all, false);
-    a.choice = "Auto: measuring " + std::to_string(a.candidates.size()) + " structures";
-    a.built = -1;  // the candidates are new: build whatever is current
-  }
-
-  /// Ends a re-check without a decision: the kept structure draws the next frame.
-  void cancelRecheck() {
-    AutoState& a = autoState;
-    if (!a.rechecking) return;
-    a.exploring = a.rechecking = false;
-    a.queue.clear();
-    a.current = a.kept;
-  }
-
-  /// A candidate's cost per frame: its measured frame time plus its last build time spread over
-  /// kAutoFramesPerBuild frames; < 0 when it has no frame time yet.
-  double autoCost(size_t i) const {
-    const AutoState& a = autoState;
-    if (!(a.seconds[i] > 0)) return -1.0;
-    const double b = i < a.buildSeconds.size() && a.buildSeconds[i] > 0 ? a.buildSeconds[i] : 0.0;
-    return a.seconds[i] + b / kAutoFramesPerBuild;
-  }
-
-  /// Records a measured frame of the current candidate (the minimum of its frames so far).
-  void record(double seconds) {
-    AutoState& a = autoState;
-    double& t = a.seconds[size_t(a.current)];
-    t = a.frames[size_t(a.current)]++ == 0 ? seconds : std::min(t, seconds);
-  }
-
-  /// Starts a re-check of the kept structure at `view` against its contenders: those within
-  /// kAutoPrune of it when it was measured, at least the runner-up (the likeliest to overtake it
-  /// at another view); the queue is the kept one, the contenders, them again reversed, the kept
-  /// one. False (nothing started) with a single candidate.
-  bool startRecheck(const ViewKey& view) {
-    AutoState& a = autoState;
-    std::vector<int> q;
-    int runnerUp = -1;
-    for (size_t i = 0; i < a.candidates.size(); ++i) {
-      if (int(i) == a.kept || !(a.seconds[i] > 0)) continue;
-      if (autoCost(i) < kAutoPrune * autoCost(size_t(a.kept))) q.push_back(int(i));
-      if (runnerUp < 0 || autoCost(i) < autoCost(size_t(runnerUp))) runnerUp = int(i);
-    }
-    if (q.empty() && runnerUp >= 0) q.push_back(runnerUp);
-    if (q.empty()) {  // a single candidate: nothing to re-check
-      a.measuredAt = view;
-      return false;
-    }
-    const int contenders = int(q.size());
-    for (int i = contenders - 1; i >= 0; --i) q.push_back(q[size_t(i)]);  // round 2, reversed
-    q.push_back(a.kept);
-    ++a.rechecks;
-    a.recheckAt = view;
-    std::vector<int> queue{a.kept};
-    queue.insert(queue.end(), q.begin(), q.end());
-    beginMeasuring(queue, true);
-    return true;
-  }
-
-  /// Whether Auto measures on probes (BuildParams::autoProbe).
-  bool autoProbes() const {
-    return build.autoProbe > 0 || (build.autoProbe < 0 && backend->kind() == BackendKind::CPU);
-  }
-
-  /// The probe size for a frame of width x height: 1/4 of each axis or less, at most 128 pixels
-  /// a side, at least 16 (or the frame's own size below that).
-  static void probeSize(int width, int height, int& pw, int& ph) {
-    const double f = std::max(4.0, double(std::max(width, height)) / 128.0);
-    pw = std::max(std::min(width, 16), int(width / f));
-    ph = std::max(std::min(height, 16), int(height / f));
-  }
-
-  /// Auto on probes, before the user's frame `full` (width x height, seen from `view`) is drawn:
-  /// the triggers of the per-frame protocol (a new frame size; a still camera far from where
-  /// the choice was measured, without an edit in this frame) start a measuring, and a measuring
-  /// runs to its decision here, every candidate built and drawn on probes of the same view.
-  /// The user's frame then draws with the kept structure.
-  void autoProbe(const FrameView& full, int width, int height, const ViewKey& view) {
-    AutoState& a = autoState;
-    const ViewKey previous = a.lastView;
-    a.lastView = view;
-    const bool tfEdit = a.tfEdit;
-    a.tfEdit = false;
-    if (!a.exploring && !a.standIn) {
-      if (width != a.fullWidth || height != a.fullHeight) startAutoExploration();
-      else if (!tfEdit && !near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) &&
-               near(view, previous, kAutoStillDegrees, kAutoStillZoom))
-        startRecheck(view);
-    }
-    if (!a.exploring) return;
-    a.fullWidth = width;
-    a.fullHeight = height;
+  /// Auto on probes (AutoBuilder::measureOnProbes) before the user's frame `full` is drawn: each
+  /// probe is `full` reduced, drawn with the candidate the AutoBuilder asks for.
+  void measureOnProbes(const FrameView& full, int width, int height, const AutoBuilder::ViewKey& view) {
     FrameView p = full;
-    probeSize(width, height, p.width, p.height);
     p.depth = nullptr;  // per pixel of the user's frame
     p.alphaIn = nullptr;
     p.sampleCount = nullptr;
-    a.timeScale = double(width) * double(height) / (double(p.width) * double(p.height));
     Image img;
-    // Each candidate at most 1 + 1 + kAutoMaxRepeats probes (a re-check: 2 + 2): a bound, not a rule.
-    const int bound = 8 * int(a.candidates.size());
-    for (int guard = 0; a.exploring && guard < bound; ++guard) {
-      report(0.5 + 0.3 * double(guard) / double(bound), "measuring");
+    auto drawProbe = [&](int pw, int ph) {
+      p.width = pw;
+      p.height = ph;
       update();  // builds the candidate to measure
       const auto t0 = Clock::now();
       backend->render(p, render.filter, nullptr, img);
-      const double t = backend->lastFrameDeviceSeconds() > 0 ? backend->lastFrameDeviceSeconds() : since(t0);
       ++counters.autoProbeFrames;
-      autoFrameDone([t] { return t; }, p.width, p.height, view);
-    }
-    if (a.exploring) {  // the bound was hit: keep the cheapest measured so far
-      cancelRecheck();
-    }
+      return backend->lastFrameDeviceSeconds() > 0 ? backend->lastFrameDeviceSeconds() : since(t0);
+    };
+    auto progress = [this](double f) { report(0.5 + 0.3 * f, "measuring"); };
+    bool decided = false;
+    if (!autoBuilder.measureOnProbes(width, height, view, drawProbe, progress, occupied(), decided)) return;
+    if (decided) stats.choice = autoBuilder.choice();
     ++counters.autoProbeMeasurings;
-  }
-
-  /// After a frame of `seconds()` at width x height seen from `view`: records it and picks the
-  /// next build. `seconds` is called only when a time is recorded (it may wait for the device).
-  void autoFrameDone(const std::function<double()>& seconds, int width, int height, const ViewKey& view) {
-    AutoState& a = autoState;
-    const ViewKey previous = a.lastView;
-    a.lastView = view;
-    const bool tfEdit = a.tfEdit;
-    a.tfEdit = false;
-    if (a.standIn) return;  // Grid stood in for the kept structure: not its frame time
-    if (!a.exploring) {
-      if (width != a.width || height != a.height) {
-        startAutoExploration();
-        return;
-      }
-      // Settled: the kept structure's frame at a view far from the measured one, with the camera
-      // still since the previous frame and no edit in this frame, starts a re-check here (this
-      // frame is its first).
-      if (tfEdit || near(view, a.measuredAt, kAutoFarDegrees, kAutoFarZoom) ||
-          !near(view, previous, kAutoStillDegrees, kAutoStillZoom))
-        return;
-      if (!startRecheck(view)) return;
-      record(seconds());  // the frame just drawn: the kept one at this view
-      a.queue.erase(a.queue.begin());
-      a.current = a.queue.front();
-      return;
-    }
-    const bool first = !a.rechecking && a.frames == std::vector<int>(a.frames.size(), 0);
-    if (!first && (width != a.width || height != a.height)) {  // not comparable: from the start
-      startAutoExploration();
-      return;
-    }
-    if (a.rechecking && !near(view, a.recheckAt, kAutoRecheckDrift, kAutoStillZoom)) {
-      // The camera moved during the re-check: its times are not comparable; keep the choice and
-      // measure again when the camera rests (measuredAt stays where it was).
-      cancelRecheck();
-      return;
-    }
-    if (first) {
-      a.width = width;
-      a.height = height;
-      a.measuredAt = view;
-    }
-    record(seconds());
-    a.queue.erase(a.queue.begin());
-    if (a.queue.empty() && a.round == 1) {
-      // Round 2: the candidates within kAutoPrune of round 1's cheapest, in the reverse order,
-      // each for frames adding up to kAutoMinMeasureSeconds (round 1's time), at most kAutoMaxRepeats.
-      double cheapest = std::numeric_limits<double>::infinity();
-      for (size_t i = 0; i < a.candidates.size(); ++i)
-        if (autoCost(i) > 0) cheapest = std::min(cheapest, autoCost(i));
-      for (int i = int(a.candidates.size()) - 1; i >= 0; --i) {
-        const double c = autoCost(size_t(i));
-        if (!(c > 0) || c > kAutoPrune * cheapest) continue;
-        const double t = a.seconds[size_t(i)];
-        const int repeats = std::clamp(int(std::ceil(kAutoMinMeasureSeconds / t)), 1, kAutoMaxRepeats);
-        for (int k = 0; k < repeats; ++k) a.queue.push_back(i);
-      }
-      a.round = 2;
-    }
-    if (!a.queue.empty()) {
-      a.current = a.queue.front();
-      return;
-    }
-    // The decision over the candidates measured in this measuring: the cheapest (autoCost).
-    int best = -1;
-    for (size_t i = 0; i < a.candidates.size(); ++i)
-      if (a.frames[i] > 0 && (best < 0 || autoCost(i) < autoCost(size_t(best)))) best = int(i);
-    // Never slower than Naive: a structure must beat Naive by kAutoMargin to be kept (on dense
-    // noise, 256^3, one frame each once put Grid 4% ahead of Naive and the next frames 11% behind
-    // it); in a re-check the kept structure wins likewise unless another beats it by the margin.
-    for (size_t i = 0; i < a.candidates.size(); ++i) {
-      const bool favoured = a.rechecking ? int(i) == a.kept : a.candidates[i].builder == BuilderKind::Naive;
-      if (favoured && a.frames[i] > 0 && int(i) != best && autoCost(size_t(best)) * kAutoMargin > autoCost(i))
-        best = int(i);
-    }
-    if (a.rechecking && best != a.kept) ++a.switches;
-    a.exploring = a.rechecking = false;
-    a.round = 0;
-    a.measuredAt = view;
-    a.occupancy = backend->occupiedFraction();
-    a.current = a.kept = best;
-    describeAutoChoice();
-  }
-
-  /// "0.19 s", "12 ms", "0.35 ms": a duration a reader takes in at a glance.
-  static std::string readableSeconds(double s) {
-    char buf[32];
-    if (s >= 1.0) std::snprintf(buf, sizeof buf, "%.2g s", s);
-    else if (s >= 0.1) std::snprintf(buf, sizeof buf, "%.2f s", s);
-    else std::snprintf(buf, sizeof buf, "%.2g ms", 1e3 * s);
-    return buf;
-  }
-
-  /// Builder Choice: "Auto chose Grid: 0.19 s a frame, 1.4% occupied; measured (a frame
-  /// [+ build/30]): Naive 4.1 s, Grid 0.19 s + 0.012 ms, ..." (probes: times scaled to the
-  /// user's frame by its pixel count, and said so).
-  void describeAutoChoice() {
-    AutoState& a = autoState;
-    const size_t k = size_t(a.kept);
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "Auto chose %s: %s a frame, %.3g%% occupied", builderName(a.candidates[k].builder),
-                  readableSeconds(a.seconds[k] * a.timeScale).c_str(), 100.0 * a.occupancy);
-    std::string line = buf;
-    if (a.rechecks) line += ", re-checked " + std::to_string(a.rechecks) + "x at new views";
-    if (a.switches) line += ", switched " + std::to_string(a.switches) + "x";
-    std::snprintf(buf, sizeof buf, "; measured (a frame + build/%g):", kAutoFramesPerBuild);
-    line += buf;
-    for (size_t i = 0; i < a.seconds.size(); ++i) {
-      const double b = a.buildSeconds[i] > 0 ? a.buildSeconds[i] : 0.0;
-      line += std::string(i ? ", " : " ") + builderName(a.candidates[i].builder) + " " +
-              (a.seconds[i] > 0 ? readableSeconds(a.seconds[i] * a.timeScale) : std::string("-"));
-      // A build term under 1% of the frame is left out: it changes nothing.
-      if (b / kAutoFramesPerBuild > 0.01 * a.seconds[i] * a.timeScale)
-        line += " + " + readableSeconds(b / kAutoFramesPerBuild);
-    }
-    if (a.timeScale > 1) {
-      std::snprintf(buf, sizeof buf, " (from probes of 1/%.0f of the frame's pixels)", a.timeScale);
-      line += buf;
-    }
-    a.choice = line;
-    stats.choice = a.choice;
   }
 
   void chooseBackend() {
@@ -537,7 +174,7 @@ struct Engine::Impl {
     backend->setProgress(backendProgress());
     backend->setTuning(tuning);
     rangesDirty = opacityDirty = buildDirty = tableDirty = true;
-    autoState = AutoState{};
+    autoBuilder.reset();
   }
 
   /// 4 dependent components: the colour channels' finite ranges (of the sampled values).
@@ -630,17 +267,14 @@ struct Engine::Impl {
     return c;
   }
 
-  void update() {
-    if (!haveVolume) throw std::runtime_error("no volume set");
-    if (!haveTF) throw std::runtime_error("no transfer function set");
-    const bool refineNow = autoState.standIn;  // the last frame stood in: build the kept one now
-    bool edited = false;                       // this update's classification changed the occupancy
+  /// Value ranges and classification, as far as they are stale. Returns whether the
+  /// classification changed the occupancy (an edit).
+  bool classifyIfNeeded() {
     const CropClip cc = cropClipFor();
     if (cc != cropClip) {
       cropClip = cc;
       cropClipDirty = true;
     }
-    const bool newRanges = rangesDirty;
     if (rangesDirty) {
       report(0.0, "value ranges");
       backend->setVolume(volume, build.brick);
@@ -649,107 +283,97 @@ struct Engine::Impl {
       opacityDirty = true;
       buildDirty = true;
     }
-    if (opacityDirty || colorDirty || cropClipDirty) {
-      // A TF (or crop/clip) edit: no contender is built on the frame that shows it.
-      autoState.tfEdit = true;
-      cancelRecheck();
+    // A TF (or crop/clip) edit: no contender is built on the frame that shows it.
+    if (opacityDirty || colorDirty || cropClipDirty) autoBuilder.edited();
+    if (!opacityDirty && !cropClipDirty) return false;
+    report(0.3, "classification");
+    auto t0 = Clock::now();
+    const bool changed = backend->classify(scaledTF(), cropClip);
+    stats.classifySeconds = since(t0);
+    stats.classifyWaitSeconds = backend->lastClassifyWaitSeconds();
+    ++counters.classifications;
+    if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
+    opacityDirty = cropClipDirty = false;
+    if (changed) buildDirty = true;
+    if (changed && build.builder == BuilderKind::Auto && autoBuilder.occupancyMoved(backend->occupiedFraction()))
+      startAuto(true);
+    return changed;
+  }
+
+  /// The transfer table for the sample distance and blend mode, when stale.
+  void updateTable() {
+    if (!tableDirty && !colorDirty) return;
+    if (!tableDirty) ++counters.colorUpdates;
+    std::string note;
+    const double step = effectiveSampleDistance(latticeShape(), render.sampleDistance, &note);
+    if (!note.empty()) warn(note);
+    float lo, scale;
+    tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
+    backend->setTransferTable(tableForBlend(tf, float(step), blendMode()), lo, scale);
+    tableDirty = colorDirty = false;
+  }
+
+  /// Builds `p` (or its fallback where this backend cannot) and keeps its statistics.
+  void buildStructure(BuildParams p, int autoCandidate) {
+    const BuilderInfo& info = builderInfo(p.builder);
+    if (!runsOnCpu(info) && backend->kind() != BackendKind::CUDA) {
+      warn(std::string("builder ") + info.name + " needs the CUDA backend; building " + builderName(info.fallback) +
+           " with the same parameters");
+      p.builder = info.fallback;
     }
-    if (opacityDirty || cropClipDirty) {
-      report(0.3, "classification");
-      auto t0 = Clock::now();
-      bool changed = backend->classify(scaledTF(), cropClip);
-      stats.classifySeconds = since(t0);
-      stats.classifyWaitSeconds = backend->lastClassifyWaitSeconds();
-      ++counters.classifications;
-      if (opacityDirty) tableDirty = true;  // planes alone leave the table as it is
-      opacityDirty = cropClipDirty = false;
-      if (changed) buildDirty = edited = true;
-      if (changed && build.builder == BuilderKind::Auto && !autoState.exploring && autoState.occupancy >= 0 &&
-          std::fabs(backend->occupiedFraction() - autoState.occupancy) > kAutoReexplore)
-        startAutoExploration(true);
+    BuildStats s;
+    if (!autoBuilder.exploring()) report(0.4, "build");
+    try {
+      backend->build(p, s);
+    } catch (const BackendError& e) {
+      if (backend->kind() == BackendKind::CUDA) throw;
+      warn(std::string(e.what()) + "; using the Grid traversal");
+      p.builder = BuilderKind::Grid;
+      backend->build(p, s);
     }
-    if (build.builder == BuilderKind::Auto && autoState.candidates.empty()) startAutoExploration();
-    if (tableDirty || colorDirty) {
-      if (!tableDirty) ++counters.colorUpdates;
-      std::string note;
-      const double step = effectiveSampleDistance(latticeShape(), render.sampleDistance, &note);
-      if (!note.empty()) warn(note);
-      float lo, scale;
-      tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
-      backend->setTransferTable(tableForBlend(tf, float(step), blendMode()), lo, scale);
-      tableDirty = colorDirty = false;
-    }
+    s.builder = p.builder;
+    s.classifySeconds = stats.classifySeconds;
+    s.classifyWaitSeconds = stats.classifyWaitSeconds;
+    s.occupancy = backend->occupiedFraction();
+    if (autoCandidate >= 0) s.choice = autoBuilder.builtCandidate(autoCandidate, s.seconds);
+    stats = s;
+    ++counters.builds;
+    buildDirty = false;
+  }
+
+  void update() {
+    if (!haveVolume) throw std::runtime_error("no volume set");
+    if (!haveTF) throw std::runtime_error("no transfer function set");
+    const bool isAuto = build.builder == BuilderKind::Auto;
+    const bool refineNow = autoBuilder.standingIn();  // the last frame stood in: build the kept one now
+    const bool newRanges = rangesDirty;
+    const bool edited = classifyIfNeeded();  // this update's classification changed the occupancy
+    if (isAuto && !autoBuilder.started()) startAuto();
+    updateTable();
     if (refineNow && !buildDirty) buildDirty = true;
     // Progressive refinement without any build: an edit that only emptied bricks leaves the
     // structure Auto holds covering every occupied brick, so the edit's frame draws with it
     // (lossless: it only visits some bricks that are empty now, whose sub-brick masks are 0)
     // and the next frame rebuilds it.
-    if (buildDirty && edited && !newRanges && build.builder == BuilderKind::Auto && build.autoQuickBuildSeconds >= 0 &&
-        !autoState.exploring && autoState.built >= 0 && autoState.built == autoState.current &&
-        buildsBeyondClassification(autoState.candidates[size_t(autoState.current)].builder) &&
-        backend->lastClassifyOnlyEmptied()) {
-      AutoState& a = autoState;
-      a.standIn = true;
-      a.refined = false;
+    std::string note;
+    if (buildDirty && edited && !newRanges && isAuto && build.autoQuickBuildSeconds >= 0 &&
+        backend->lastClassifyOnlyEmptied() && autoBuilder.drawStale(note)) {
       buildDirty = false;
       stats.seconds = 0;
       stats.occupancy = backend->occupiedFraction();
-      stats.choice = a.choice + "; this frame: the " + builderName(a.candidates[size_t(a.current)].builder) +
-                     " built before the edit (it only emptied bricks), rebuilt next frame";
+      stats.choice = note;
       ++counters.staleFrames;
     }
     // Auto: the structure to draw with is built when the backend holds another (measuring moves
-    // `current`; a cancelled re-check whose contender was never built rebuilds nothing).
-    if (build.builder == BuilderKind::Auto && autoState.current != autoState.built) buildDirty = true;
-    if (buildDirty) {
-      const bool isAuto = build.builder == BuilderKind::Auto;
-      int use = isAuto ? autoState.current : -1;
-      if (isAuto) {
-        // Progressive refinement: right after an edit, a kept structure that is slow to build
-        // gives way to Grid (its occupancy grid is classification's output) for one frame; the
-        // image is the same (lossless), only that frame's speed differs.
-        AutoState& a = autoState;
-        const int grid = gridCandidate();
-        const double kept = a.buildSeconds.empty() ? -1.0 : a.buildSeconds[size_t(a.current)];
-        a.standIn = edited && !a.exploring && grid >= 0 && grid != a.current &&
-                    a.candidates[size_t(a.current)].builder != BuilderKind::Naive && build.autoQuickBuildSeconds >= 0 &&
-                    kept > build.autoQuickBuildSeconds;
-        a.refined = refineNow && !a.standIn;
-        if (a.standIn) use = grid;
-      }
-      BuildParams p = isAuto ? autoState.candidates[size_t(use)] : build;
-      const BuilderInfo& info = builderInfo(p.builder);
-      if (!runsOnCpu(info) && backend->kind() != BackendKind::CUDA) {
-        warn(std::string("builder ") + info.name + " needs the CUDA backend; building " + builderName(info.fallback) +
-             " with the same parameters");
-        p.builder = info.fallback;
-      }
-      BuildStats s;
-      if (!autoState.exploring) report(0.4, "build");
-      try {
-        backend->build(p, s);
-      } catch (const BackendError& e) {
-        if (backend->kind() == BackendKind::CUDA) throw;
-        warn(std::string(e.what()) + "; using the Grid traversal");
-        p.builder = BuilderKind::Grid;
-        backend->build(p, s);
-      }
-      s.builder = p.builder;
-      s.classifySeconds = stats.classifySeconds;
-      s.classifyWaitSeconds = stats.classifyWaitSeconds;
-      s.occupancy = backend->occupiedFraction();
-      if (isAuto) {
-        autoState.built = use;
-        autoState.buildSeconds[size_t(use)] = s.seconds;
-        s.choice = autoState.choice;
-        if (autoState.standIn)
-          s.choice += std::string("; this frame: Grid after the edit, ") +
-                      builderName(autoState.candidates[size_t(autoState.current)].builder) + " next frame";
-      }
-      stats = s;
-      ++counters.builds;
-      buildDirty = false;
-    }
+    // the current candidate; a cancelled re-check whose contender was never built rebuilds nothing).
+    if (isAuto && autoBuilder.needsBuild()) buildDirty = true;
+    if (!buildDirty) return;
+    if (!isAuto) return buildStructure(build, -1);
+    // Progressive refinement: right after an edit, a kept structure that is slow to build gives
+    // way to Grid (its occupancy grid is classification's output) for one frame; the image is the
+    // same (lossless), only that frame's speed differs.
+    const int use = autoBuilder.chooseBuild(edited, refineNow, build.autoQuickBuildSeconds);
+    buildStructure(autoBuilder.candidate(use), use);
   }
 };
 
@@ -776,7 +400,7 @@ void Engine::setVolume(const Volume& v) {
   validate(v);
   impl_->volume = v;
   impl_->valueExponent = 0;
-  impl_->autoState = Impl::AutoState{};
+  impl_->autoBuilder.reset();
   // The integrator samples in float: magnitudes near the ends of double's (or float's) range
   // would overflow trilinear interpolation or the table mapping (+-1e308 gave a blank image),
   // and denormal-scale data would collapse to one table entry. Such volumes are sampled from a
@@ -834,7 +458,7 @@ void Engine::setBuildParams(const BuildParams& p) {
   if (p.brick != d.build.brick) d.rangesDirty = true;
   if (p != d.build) {
     d.buildDirty = true;
-    d.autoState = Impl::AutoState{};  // Auto measures again with the new parameters
+    d.autoBuilder.reset();  // Auto measures again with the new parameters
   }
   d.build = p;
   d.build.brick = std::max(1, p.brick);
@@ -1057,9 +681,10 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     counts.assign(size_t(width) * size_t(height), 0u);
     f.sampleCount = counts.data();
   }
-  const bool autoProbes = d.build.builder == BuilderKind::Auto && d.autoProbes();
+  const bool autoProbes =
+      d.build.builder == BuilderKind::Auto && AutoBuilder::usesProbes(d.build, d.backend->kind());
   if (autoProbes) {
-    d.autoProbe(f, width, height, d.viewKey(cam));
+    d.measureOnProbes(f, width, height, d.viewKey(cam));
     d.update();  // the kept structure, when measuring ended on another
   }
   d.report(0.8, "frame");
@@ -1091,8 +716,9 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     d.warn("the bricks this view needs exceed the memory budget: sampled from the whole volume in host memory");
   ++d.counters.frames;
   if (d.build.builder == BuilderKind::Auto && !autoProbes)
-    d.autoFrameDone([&d] { return d.frameDeviceSeconds() > 0 ? d.frame.deviceSeconds : d.frame.seconds; }, width,
-                    height, d.viewKey(cam));
+    if (d.autoBuilder.frameDone([&d] { return d.frameDeviceSeconds() > 0 ? d.frame.deviceSeconds : d.frame.seconds; },
+                                width, height, d.viewKey(cam), d.occupied()))
+      d.stats.choice = d.autoBuilder.choice();
 }
 
 bool Engine::setImageOnDevice(bool on) { return impl_->backend->setImageOnDevice(on); }
@@ -1116,7 +742,8 @@ void Engine::setMemoryBudget(int64_t bytes, int poolBrick) {
 
 const BuildStats& Engine::buildStats() const { return impl_->stats; }
 bool Engine::exploring() const {
-  return impl_->build.builder == BuilderKind::Auto && (impl_->autoState.exploring || impl_->autoState.candidates.empty());
+  const AutoBuilder& a = impl_->autoBuilder;
+  return impl_->build.builder == BuilderKind::Auto && (a.exploring() || !a.started());
 }
 const FrameStats& Engine::frameStats(bool waitForDevice) const {
   if (waitForDevice) impl_->frameDeviceSeconds();
