@@ -43,8 +43,6 @@ struct TransferFunction {
   static TransferFunction fromPoints(std::vector<TFPoint> pts, double lo, double hi, int size = 1024);
   /// Named presets over [lo, hi]: "ramp", "grayscale", "coolwarm", "spike", "band", "opaque", "zero".
   static TransferFunction preset(const std::string& name, double lo, double hi, int size = 1024);
-  /// Text file: optional "range LO HI", "size N", "unit U" lines, then "value r g b a" lines.
-  static TransferFunction load(const std::string& path, double lo, double hi);
 
   bool sameOpacity(const TransferFunction& o) const;
   bool sameColor(const TransferFunction& o) const;

@@ -1,7 +1,6 @@
 // Transfer-function tables, presets and the sparse-table range-max query.
 #include "spaceskip/TransferFunction.h"
 
-#include "spaceskip/TransferFunctionIO.h"
 
 #include <algorithm>
 #include <cmath>
@@ -69,10 +68,6 @@ TransferFunction TransferFunction::preset(const std::string& name, double lo, do
                                 "' (ramp, grayscale, coolwarm, band, spike, opaque, zero)");
   }
   return fromPoints(p, lo, hi, size);
-}
-
-TransferFunction TransferFunction::load(const std::string& path, double lo, double hi) {
-  return loadTransferFunction(path, lo, hi);  // bounded, strict parser: TransferFunctionIO.cpp
 }
 
 bool TransferFunction::sameOpacity(const TransferFunction& o) const {

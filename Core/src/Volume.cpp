@@ -1,7 +1,6 @@
 // Volume metadata helpers.
 #include "spaceskip/Volume.h"
 
-#include "spaceskip/Parse.h"
 
 #include <unistd.h>
 

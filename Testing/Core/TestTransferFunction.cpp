@@ -1,5 +1,6 @@
 // Transfer-function table, opacity correction and the classification range query.
 #include "spaceskip/TransferFunction.h"
+#include "spaceskip/TransferFunctionIO.h"
 
 #include <gtest/gtest.h>
 
@@ -52,7 +53,7 @@ TEST(TransferFunction, RangeMaxSeesOneEntrySpike) {
 
 TEST(TransferFunction, PresetsAndErrors) {
   EXPECT_THROW(TransferFunction::preset("nope", 0, 1), std::invalid_argument);
-  EXPECT_THROW(TransferFunction::load("/nonexistent.tf", 0, 1), std::runtime_error);
+  EXPECT_THROW(loadTransferFunction("/nonexistent.tf", 0, 1), std::runtime_error);
   // Constant data: a degenerate range still yields a usable table.
   auto tf = TransferFunction::preset("ramp", 5, 5);
   EXPECT_GT(tf.rangeMax, tf.rangeMin);

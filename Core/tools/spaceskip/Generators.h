@@ -1,7 +1,7 @@
 // Procedural stand-ins for the paper's data sets (DESIGN.md "Benchmarks").
 #pragma once
-#include "TransferFunction.h"
-#include "Volume.h"
+#include "spaceskip/TransferFunction.h"
+#include "spaceskip/Volume.h"
 
 #include <string>
 #include <vector>

@@ -1,6 +1,6 @@
 // PNG output (libpng) and image comparison metrics.
 #pragma once
-#include "Types.h"
+#include "spaceskip/Types.h"
 
 #include <string>
 

@@ -1,6 +1,6 @@
 // Reading and writing volumes: Open SciVis raw naming (name_XxYxZ_type.raw) and NRRD.
 #pragma once
-#include "Volume.h"
+#include "spaceskip/Volume.h"
 
 #include <cstdint>
 #include <istream>

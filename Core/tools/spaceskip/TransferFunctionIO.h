@@ -1,6 +1,7 @@
-// Transfer-function text files (TransferFunction::load's format), read with bounded input.
+// Transfer-function text files (optional "range LO HI", "size N", "unit U" lines, then
+// "value r g b a" lines), read with bounded input.
 #pragma once
-#include "TransferFunction.h"
+#include "spaceskip/TransferFunction.h"
 
 #include <cstdint>
 #include <istream>
