@@ -243,7 +243,9 @@ TEST(CudaBackend, ClassificationEqualsCpu) {
   int vi = 0;
   for (const Volume& v : classificationVolumes()) {
     for (int brick : {8, 4}) {
-      for (const char* preset : {"ramp", "band", "spike", "zero", "opaque"}) {
+      // grayscale: ParaView's default opacity ramp (0 at the minimum, rising linearly), under
+      // which bricks of exact data-minimum voxels are empty (exact-zero classification).
+      for (const char* preset : {"ramp", "band", "spike", "zero", "opaque", "grayscale"}) {
         SCOPED_TRACE(std::string("volume ") + std::to_string(vi) + " " + voxelTypeName(v.type) + " brick " +
                      std::to_string(brick) + " tf " + preset);
         TransferFunction tf = tfFor(v, preset);
@@ -517,7 +519,10 @@ INSTANTIATE_TEST_SUITE_P(
                       ImageCase{"shell", 48, "band", VoxelType::Int8}, ImageCase{"noise", 40, "band", VoxelType::Float32},
                       ImageCase{"vessels", 64, "coolwarm", VoxelType::UInt16},
                       ImageCase{"shell", 40, "spike", VoxelType::Int16},
-                      ImageCase{"noise", 33, "ramp", VoxelType::Float64}),
+                      ImageCase{"noise", 33, "ramp", VoxelType::Float64},
+                      // ParaView's default ramp over exact-zero backgrounds: empty bricks by exact zeros
+                      ImageCase{"nbody", 64, "grayscale", VoxelType::UInt8},
+                      ImageCase{"vessels", 64, "grayscale", VoxelType::Float32}),
     [](const ::testing::TestParamInfo<ImageCase>& i) {
       return std::string(i.param.shape) + "_" + voxelTypeName(i.param.type) + "_" + std::to_string(i.index);
     });
