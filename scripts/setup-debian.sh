@@ -6,11 +6,13 @@
 # python3-dev: the headers the Python wrapping of the VTK module needs (SPACESKIP_WRAP_PYTHON).
 # clang + libclang-rt-14-dev: the libFuzzer harnesses (scripts/fuzz.sh; -fsanitize=fuzzer needs the
 # runtime, which clang-14 only recommends).
+# libhwy-dev: Highway, the CPU backend's SIMD ray packets (Core/src/CpuMarch.cpp; optional: without
+# it the CPU backend marches one ray at a time).
 set -euo pipefail
 pkgs=(build-essential cmake ninja-build pkg-config libtbb-dev libpng-dev libgtest-dev googletest
       paraview paraview-dev python3-paraview python3-numpy python3-dev xvfb xauth
       libopenmpi-dev openmpi-bin libdouble-conversion-dev liblz4-dev libglew-dev libutfcpp-dev libtiff-dev
-      clang libclang-rt-14-dev)
+      clang libclang-rt-14-dev libhwy-dev)
 # SPACESKIP_PLOTS=1: also matplotlib for scripts/plot-paper-bench.py (not needed by the tests or CI).
 if [ "${SPACESKIP_PLOTS:-0}" = 1 ]; then pkgs+=(python3-matplotlib); fi
 missing=()

@@ -4,6 +4,7 @@
 #include "spaceskip/BrickPool.h"
 #include "spaceskip/Builders.h"
 #include "spaceskip/DistanceField.h"
+#include "src/CpuMarch.h"
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
@@ -151,17 +152,36 @@ class CpuBackend final : public Backend {
                                       volume_.dims.z, volume_.components});
       return;
     }
+    if (packetMarchable(f, volume_.type, volume_.components, volume_.dims.x, volume_.dims.y, volume_.dims.z)) {
+      packetTiles(f, out);  // SIMD ray packets (CpuMarch.h): the same pixels as the scalar integrator's
+      return;
+    }
     tiles(f, out, ArraySampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y, volume_.dims.z});
+  }
+
+  void packetTiles(const FrameView& f, Image& out) {
+    vec4f* px = out.rgba.data();
+    packetPairTable(f.tf, pairs_);
+    const float* pairs = pairs_.data();
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, f.height, kTile, 0, f.width, kTile),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                        marchPacketTile(f, pairs, volume_.type, volume_.data, volume_.dims.x, volume_.dims.y,
+                                        volume_.dims.z, r.cols().begin(), r.rows().begin(), r.cols().end(),
+                                        r.rows().end(), px);
+                      });
   }
 
   template <class Sampler>
   void tiles(const FrameView& f, Image& out, const Sampler& s) {
     vec4f* px = out.rgba.data();
+    // Plain frames take the integrator's composite-only code (renderPixel's Plain), as on CUDA.
+    const bool plain = isPlainFrame(f);
     tbb::parallel_for(tbb::blocked_range2d<int>(0, f.height, kTile, 0, f.width, kTile),
                       [&](const tbb::blocked_range2d<int>& r) {
                         for (int y = r.rows().begin(); y != r.rows().end(); ++y)
                           for (int x = r.cols().begin(); x != r.cols().end(); ++x)
-                            px[size_t(y) * size_t(f.width) + size_t(x)] = renderPixel(f, s, x, y);
+                            px[size_t(y) * size_t(f.width) + size_t(x)] =
+                                plain ? renderPixel<Sampler, -1, true>(f, s, x, y) : renderPixel(f, s, x, y);
                       });
   }
 
@@ -183,6 +203,7 @@ class CpuBackend final : public Backend {
   Tree tree_;
   TraversalKind traversal_ = TraversalKind::Naive;
   std::vector<vec4f> table_;
+  std::vector<float> pairs_;  ///< the table as the SIMD packets read it (packetPairTable)
   float tfLo_ = 0, tfScale_ = 1;
 };
 

@@ -1,0 +1,507 @@
+// SIMD ray packets for the oneTBB backend (CpuMarch.h). Compiled once per instruction set by
+// Highway's foreach_target; the scalar parts (ray set-up, odd pixels) are compiled once.
+// The build compiles this file with -ffp-contract=off: a fused multiply-add would round the
+// samples differently from the scalar integrator.
+#include "src/CpuMarch.h"
+
+#include "spaceskip/render/Integrator.h"
+
+#include <cmath>
+#include <cstring>
+
+#ifndef SPACESKIP_CPU_MARCH_ONCE
+#define SPACESKIP_CPU_MARCH_ONCE
+namespace spaceskip {
+namespace march_detail {
+
+/// One ray's share of a packet, set up as renderPixel sets it up for a plain frame: the ray
+/// (index space), the lattice anchor t0 and the drawn part [a, b) of the ray.
+struct LaneSetup {
+  enum Kind { Empty, Packet, Scalar } kind;
+  Ray r;
+  vec3f inv;
+  float t0, a, b;
+};
+
+/// renderPixel<Sampler, -1, true> up to its march. Scalar: a pixel the packet leaves to
+/// renderPixel (its first sample lies past the box's exit, or sample indices too large for
+/// exact float lanes).
+inline LaneSetup setupLane(const FrameView& f, int px, int py) {
+  LaneSetup s{};
+  const PrimaryRay p = primaryRay(f, px, py);
+  if (!(p.tEnter < p.tExit)) {
+    s.kind = LaneSetup::Empty;
+    return s;
+  }
+  const float lead =
+      f.firstSample * f.dt + (f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f);
+  const float a = p.tEnter, b = p.tExit;
+  if (f.firstSample > 0.f && !(a + lead < b)) {
+    s.kind = LaneSetup::Scalar;
+    return s;
+  }
+  const float t0 = a + lead;
+  // Every run of the ray lies in [a, b): its sample indices are at most this one's.
+  const int64_t kEnd = int64_t(ceilf((b - t0) / f.dt));
+  constexpr int64_t kExact = int64_t(1) << 24;  // float(k) exact in a float lane
+  if (kEnd > kExact) {
+    s.kind = LaneSetup::Scalar;
+    return s;
+  }
+  s.kind = LaneSetup::Packet;
+  s.r = p.r;
+  s.inv = p.inv;
+  s.t0 = t0;
+  s.a = a;
+  s.b = b;
+  return s;
+}
+
+/// The Naive traversal as an iterator: the whole drawn part of the ray, one interval.
+struct WholeIter {
+  float a, b;
+  bool done;
+  template <class Marcher>
+  Step next(const Marcher&, float& x, float& y) {
+    if (done) return Step::Done;
+    done = true;
+    x = a;
+    y = b;
+    return Step::Interval;
+  }
+};
+
+/// Stands in for the marcher the iterators ask which bricks are active: in plain frames every
+/// occupied brick is (IntervalMarcher::active with Plain).
+struct PlainMarcher {
+  bool active(float, float) const { return true; }
+};
+
+/// IntervalMarcher::marchRuns for one lane, a run at a time: touching intervals merged into
+/// runs, and the samples of each run as IntervalMarcher::range gives them (never one twice).
+template <class Iter>
+struct LaneRuns {
+  Iter it;
+  float ra = 0.f, rb = 0.f;
+  bool have = false, done = false;
+  int64_t nextK = 0;
+
+  /// The next run with samples: k in [kBegin, kEnd). false: the ray has no samples left.
+  bool next(float t0, float dt, int64_t& kBegin, int64_t& kEnd) {
+    float a, b;
+    while (run(a, b)) {
+      kBegin = int64_t(ceilf((a - t0) / dt));
+      kEnd = int64_t(ceilf((b - t0) / dt));
+      if (kBegin < nextK) kBegin = nextK;
+      if (kEnd > nextK) nextK = kEnd;
+      if (kBegin < kEnd) return true;
+    }
+    return false;
+  }
+
+  bool run(float& a, float& b) {
+    const PlainMarcher m;
+    while (!done) {
+      float x, y;
+      const Step st = it.next(m, x, y);
+      if (st == Step::Done) {
+        done = true;
+        break;
+      }
+      if (st != Step::Interval) continue;
+      if (have && x == rb) {
+        rb = y;
+        continue;
+      }
+      const bool had = have;
+      a = ra;
+      b = rb;
+      ra = x;
+      rb = y;
+      have = true;
+      if (had) return true;
+    }
+    if (!have) return false;
+    a = ra;
+    b = rb;
+    have = false;
+    return true;
+  }
+};
+
+/// The traversal iterator of frame `f` over [a, b) of ray r, as renderPixel's march starts it.
+inline void initIter(WholeIter& it, const FrameView&, const LaneSetup& s) { it = WholeIter{s.a, s.b, false}; }
+inline void initIter(GridIter& it, const FrameView& f, const LaneSetup& s) { it.init(f.grid, s.r, s.inv, s.a, s.b); }
+inline void initIter(GridPartsIter& it, const FrameView& f, const LaneSetup& s) {
+  it.init(f.grid, s.r, s.inv, s.a, s.b);
+}
+inline void initIter(TreeIter& it, const FrameView& f, const LaneSetup& s) { it.init(f.tree, s.r, s.inv, s.a, s.b); }
+inline void initIter(HybridIter& it, const FrameView& f, const LaneSetup& s) {
+  it.init(f.tree, f.grid, s.r, s.inv, s.a, s.b);
+}
+
+template <class T>
+vec4f scalarPixel(const FrameView& f, const T* v, int64_t nx, int64_t ny, int64_t nz, int px, int py) {
+  return renderPixel<ArraySampler<T>, -1, true>(f, ArraySampler<T>{v, nx, ny, nz}, px, py);
+}
+
+}  // namespace march_detail
+}  // namespace spaceskip
+#endif  // SPACESKIP_CPU_MARCH_ONCE
+
+#ifdef SPACESKIP_HAVE_HWY
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "src/CpuMarch.cpp"
+#include <hwy/foreach_target.h>  // re-includes this file once per target
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace spaceskip {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using DU = hn::RebindToUnsigned<DF>;
+using VF = hn::Vec<DF>;
+using VI = hn::Vec<DI>;
+using MF = hn::Mask<DF>;
+
+/// ss_clamp(v, lo, hi) lane by lane: v < lo ? lo : (v > hi ? hi : v).
+HWY_INLINE VF Clamp(VF v, VF lo, VF hi) {
+  return hn::IfThenElse(hn::Lt(v, lo), lo, hn::IfThenElse(hn::Gt(v, hi), hi, v));
+}
+
+/// base[i] and base[i + 1] for each lane: one 64-bit gather per pair of lanes' pairs (half the
+/// elements of two 32-bit gathers), split into the two vectors.
+HWY_INLINE void GatherPairs(const float* base, VI i, VF& v0, VF& v1) {
+  const DF df;
+#if HWY_TARGET == HWY_SCALAR
+  const DI di;
+  v0 = hn::GatherIndex(df, base, i);
+  v1 = hn::GatherIndex(df, base, hn::Add(i, hn::Set(di, 1)));
+#else
+  const hn::Repartition<int64_t, DF> d64;
+  const hn::Half<DI> dh;
+  const auto off0 = hn::ShiftLeft<2>(hn::PromoteTo(d64, hn::LowerHalf(dh, i)));
+  const auto off1 = hn::ShiftLeft<2>(hn::PromoteTo(d64, hn::UpperHalf(dh, i)));
+  const int64_t* b = reinterpret_cast<const int64_t*>(base);
+  const VF lo = hn::BitCast(df, hn::GatherOffset(d64, b, off0));  // lanes 0..N/2-1: (v0, v1) pairs
+  const VF hi = hn::BitCast(df, hn::GatherOffset(d64, b, off1));
+  v0 = hn::ConcatEven(df, hi, lo);
+  v1 = hn::ConcatOdd(df, hi, lo);
+#endif
+}
+
+/// The voxels at index i and i + 1 (x and x + 1 of a row), as voxelValue() gives them.
+HWY_INLINE void FetchPair(const float* d, VI i, VF& v0, VF& v1) {
+  const DF df;
+  const VF big = hn::Set(df, 1.2676506e30f), nbig = hn::Set(df, -1.2676506e30f);
+  VF a, b;
+  GatherPairs(d, i, a, b);
+  v0 = hn::IfThenElse(hn::Gt(a, big), big, hn::IfThenElse(hn::Lt(a, nbig), nbig, a));
+  v1 = hn::IfThenElse(hn::Gt(b, big), big, hn::IfThenElse(hn::Lt(b, nbig), nbig, b));
+}
+// 16-bit voxels: one 32-bit gather at voxel i holds voxels i and i + 1 (little endian), never
+// reading past voxel i + 1.
+HWY_INLINE void FetchPair(const uint16_t* d, VI i, VF& v0, VF& v1) {
+  const DF df;
+  const DI di;
+  const DU du;
+  const VI w = hn::GatherOffset(di, reinterpret_cast<const int32_t*>(d), hn::ShiftLeft<1>(i));
+  v0 = hn::ConvertTo(df, hn::And(w, hn::Set(di, 0xFFFF)));
+  v1 = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(hn::BitCast(du, w))));
+}
+HWY_INLINE void FetchPair(const int16_t* d, VI i, VF& v0, VF& v1) {
+  const DF df;
+  const DI di;
+  const VI w = hn::GatherOffset(di, reinterpret_cast<const int32_t*>(d), hn::ShiftLeft<1>(i));
+  v0 = hn::ConvertTo(df, hn::ShiftRight<16>(hn::ShiftLeft<16>(w)));
+  v1 = hn::ConvertTo(df, hn::ShiftRight<16>(w));
+}
+// 8-bit voxels: the 32-bit word at byte max(i - 2, 0) holds voxels i and i + 1 and ends no
+// later than voxel i + 1 (or voxel 3 for i < 2; volumes have at least 8 voxels here).
+HWY_INLINE hn::Vec<DU> BytePairWord(const void* d, VI i) {
+  const DI di;
+  const DU du;
+  const VI off = hn::Max(hn::Sub(i, hn::Set(di, 2)), hn::Zero(di));
+  const VI w = hn::GatherOffset(di, static_cast<const int32_t*>(d), off);
+  return hn::BitCast(du, w) >> hn::BitCast(du, hn::ShiftLeft<3>(hn::Sub(i, off)));
+}
+HWY_INLINE void FetchPair(const uint8_t* d, VI i, VF& v0, VF& v1) {
+  const DF df;
+  const DI di;
+  const DU du;
+  const auto w = BytePairWord(d, i);
+  v0 = hn::ConvertTo(df, hn::BitCast(di, hn::And(w, hn::Set(du, 0xFFu))));
+  v1 = hn::ConvertTo(df, hn::BitCast(di, hn::And(hn::ShiftRight<8>(w), hn::Set(du, 0xFFu))));
+}
+HWY_INLINE void FetchPair(const int8_t* d, VI i, VF& v0, VF& v1) {
+  const DF df;
+  const DI di;
+  const VI w = hn::BitCast(di, BytePairWord(d, i));
+  v0 = hn::ConvertTo(df, hn::ShiftRight<24>(hn::ShiftLeft<24>(w)));
+  v1 = hn::ConvertTo(df, hn::ShiftRight<24>(hn::ShiftLeft<16>(w)));
+}
+
+/// ArraySampler::axis for a vector of coordinates (n >= 2): i0 and the fraction.
+HWY_INLINE void Axis(VF p, VF hiF, VI hiI, VI& i0, VF& fr) {
+  const DF df;
+  const DI di;
+  const VF x = Clamp(p, hn::Zero(df), hiF);
+  i0 = hn::Min(hn::ConvertTo(di, x), hiI);
+  fr = hn::Sub(x, hn::ConvertTo(df, i0));
+}
+
+template <class T, class Iter>
+void MarchTileT(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny, int64_t nz, int x0,
+                int y0, int x1, int y1, vec4f* px) {
+  using march_detail::LaneSetup;
+  const DF df;
+  const DI di;
+  const size_t N = hn::Lanes(df);
+  constexpr size_t kMax = HWY_MAX_BYTES / sizeof(float);
+  // A packet is a block of pixels (4x4 for 16 lanes, 4x2 for 8, 2x2 for 4): neighbouring rays
+  // have similar lengths and fetch neighbouring voxels.
+  const int bw = N >= 8 ? 4 : (N >= 4 ? 2 : int(N));
+  const int bh = int(N) / bw;
+
+  HWY_ALIGN float ox[kMax], oy[kMax], oz[kMax], dx[kMax], dy[kMax], dz[kMax], t0[kMax];
+  HWY_ALIGN int32_t kc[kMax], ke[kMax];
+  HWY_ALIGN float rx[kMax], ry[kMax], rz[kMax], rw[kMax];
+  int64_t outAt[kMax];
+  march_detail::LaneRuns<Iter> runs[kMax];
+
+  const VF hx = hn::Set(df, float(nx - 1)), hy = hn::Set(df, float(ny - 1)), hz = hn::Set(df, float(nz - 1));
+  const VI mx = hn::Set(di, int32_t(nx - 2)), my = hn::Set(di, int32_t(ny - 2)), mz = hn::Set(di, int32_t(nz - 2));
+  const VI sy = hn::Set(di, int32_t(nx)), sz = hn::Set(di, int32_t(nx * ny));
+  const VI sxy = hn::Set(di, int32_t(nx + nx * ny));
+  const VI nyv = hn::Set(di, int32_t(ny));
+  const VI one = hn::Set(di, 1);
+  const VF dtv = hn::Set(df, f.dt), onef = hn::Set(df, 1.f), ert = hn::Set(df, f.ertThreshold);
+  const VF tfLo = hn::Set(df, f.tf.lo), tfScale = hn::Set(df, f.tf.scale), tfHi = hn::Set(df, float(f.tf.size - 1));
+  const int64_t pairStride = 2 * int64_t(f.tf.size);  // floats per channel in `pairs`
+
+  for (int by = y0; by < y1; by += bh)
+    for (int bx = x0; bx < x1; bx += bw) {
+      bool any = false;
+      for (size_t l = 0; l < N; ++l) {
+        const int x = bx + int(l) % bw, y = by + int(l) / bw;
+        kc[l] = ke[l] = 0;
+        ox[l] = oy[l] = oz[l] = dx[l] = dy[l] = dz[l] = t0[l] = 0.f;
+        outAt[l] = -1;
+        if (x >= x1 || y >= y1) continue;
+        const int64_t at = int64_t(y) * f.width + x;
+        const LaneSetup s = march_detail::setupLane(f, x, y);
+        if (s.kind == LaneSetup::Empty) {
+          px[at] = vec4f{0, 0, 0, 0};
+          continue;
+        }
+        if (s.kind == LaneSetup::Scalar) {
+          px[at] = march_detail::scalarPixel(f, vox, nx, ny, nz, x, y);
+          continue;
+        }
+        outAt[l] = at;
+        ox[l] = s.r.org.x;
+        oy[l] = s.r.org.y;
+        oz[l] = s.r.org.z;
+        dx[l] = s.r.dir.x;
+        dy[l] = s.r.dir.y;
+        dz[l] = s.r.dir.z;
+        t0[l] = s.t0;
+        runs[l] = march_detail::LaneRuns<Iter>{};
+        march_detail::initIter(runs[l].it, f, s);
+        int64_t kb = 0, kEnd = 0;
+        if (runs[l].next(s.t0, f.dt, kb, kEnd)) {
+          kc[l] = int32_t(kb);
+          ke[l] = int32_t(kEnd);
+        }
+        any = true;
+      }
+      if (!any) continue;
+
+      const VF vox_ = hn::Load(df, ox), voy = hn::Load(df, oy), voz = hn::Load(df, oz);
+      const VF vdx = hn::Load(df, dx), vdy = hn::Load(df, dy), vdz = hn::Load(df, dz);
+      const VF vt0 = hn::Load(df, t0);
+      VI k = hn::Load(di, kc), kEnd = hn::Load(di, ke);
+      VF ax = hn::Zero(df), ay = hn::Zero(df), az = hn::Zero(df), aw = hn::Zero(df);
+      MF stopped = hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd)));  // no samples, or terminated
+      for (;;) {
+        MF live = hn::Not(stopped);
+        // Lanes whose run is used up take their next run (IntervalMarcher::marchRuns, lane by lane).
+        const MF spent = hn::AndNot(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
+        if (!hn::AllFalse(df, spent)) {
+          hn::Store(k, di, kc);
+          hn::Store(kEnd, di, ke);
+          HWY_ALIGN int32_t stop[kMax];
+          hn::Store(hn::VecFromMask(di, hn::RebindMask(di, stopped)), di, stop);
+          for (size_t l = 0; l < N; ++l) {
+            if (stop[l] || kc[l] < ke[l]) continue;
+            int64_t kb = 0, kx = 0;
+            if (runs[l].next(t0[l], f.dt, kb, kx)) {
+              kc[l] = int32_t(kb);
+              ke[l] = int32_t(kx);
+            } else {
+              kc[l] = ke[l] = 0;
+            }
+          }
+          k = hn::Load(di, kc);
+          kEnd = hn::Load(di, ke);
+          stopped = hn::Or(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
+          live = hn::Not(stopped);
+        }
+        if (hn::AllFalse(df, live)) break;
+        // IntervalMarcher::take(k): t = t0 + float(k) * dt, p = org + dir * t.
+        const VF t = hn::Add(vt0, hn::Mul(hn::ConvertTo(df, k), dtv));
+        const VF px_ = hn::Add(vox_, hn::Mul(vdx, t));
+        const VF py_ = hn::Add(voy, hn::Mul(vdy, t));
+        const VF pz_ = hn::Add(voz, hn::Mul(vdz, t));
+        // ArraySampler::sample.
+        VI ix, iy, iz;
+        VF fx, fy, fz;
+        Axis(px_, hx, mx, ix, fx);
+        Axis(py_, hy, my, iy, fy);
+        Axis(pz_, hz, mz, iz, fz);
+        const VI base = hn::Add(ix, hn::Mul(sy, hn::Add(iy, hn::Mul(nyv, iz))));
+        VF v000, v100, v010, v110, v001, v101, v011, v111;
+        FetchPair(vox, base, v000, v100);
+        FetchPair(vox, hn::Add(base, sy), v010, v110);
+        FetchPair(vox, hn::Add(base, sz), v001, v101);
+        FetchPair(vox, hn::Add(base, sxy), v011, v111);
+        const VF c00 = hn::Add(v000, hn::Mul(hn::Sub(v100, v000), fx));
+        const VF c10 = hn::Add(v010, hn::Mul(hn::Sub(v110, v010), fx));
+        const VF c01 = hn::Add(v001, hn::Mul(hn::Sub(v101, v001), fx));
+        const VF c11 = hn::Add(v011, hn::Mul(hn::Sub(v111, v011), fx));
+        const VF c0 = hn::Add(c00, hn::Mul(hn::Sub(c10, c00), fy));
+        const VF c1 = hn::Add(c01, hn::Mul(hn::Sub(c11, c01), fy));
+        const VF v = hn::Add(c0, hn::Mul(hn::Sub(c1, c0), fz));
+        // lookup(): NaN is transparent; opacity first, colour only where a lane composites.
+        VF xt = hn::Mul(hn::Sub(v, tfLo), tfScale);
+        const MF nan = hn::IsNaN(xt);
+        xt = Clamp(hn::IfThenZeroElse(nan, xt), hn::Zero(df), tfHi);
+        const VI e0 = hn::ConvertTo(di, xt);
+        const VF fr = hn::Sub(xt, hn::ConvertTo(df, e0));
+        // Entry e0 and the next one (e1 = min(e0 + 1, size - 1)) side by side in the pair table.
+        const VI q = hn::ShiftLeft<1>(e0);
+        VF a0, a1;
+        GatherPairs(pairs + 3 * pairStride, q, a0, a1);
+        const VF cw = hn::Add(a0, hn::Mul(hn::Sub(a1, a0), fr));
+        const MF comp = hn::And(live, hn::AndNot(nan, hn::Gt(cw, hn::Zero(df))));
+        if (!hn::AllFalse(df, comp)) {
+          VF r0, r1, g0, g1, b0, b1;
+          GatherPairs(pairs, q, r0, r1);
+          GatherPairs(pairs + pairStride, q, g0, g1);
+          GatherPairs(pairs + 2 * pairStride, q, b0, b1);
+          const VF cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
+          const VF cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
+          const VF cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
+          // IntervalMarcher::composite, front-to-back "over".
+          const VF w = hn::Mul(hn::Sub(onef, aw), cw);
+          ax = hn::IfThenElse(comp, hn::Add(ax, hn::Mul(w, cx)), ax);
+          ay = hn::IfThenElse(comp, hn::Add(ay, hn::Mul(w, cy)), ay);
+          az = hn::IfThenElse(comp, hn::Add(az, hn::Mul(w, cz)), az);
+          aw = hn::IfThenElse(comp, hn::Add(aw, w), aw);
+          // Early ray termination after a composited sample: !(acc.w < threshold).
+          stopped = hn::Or(stopped, hn::AndNot(hn::Lt(aw, ert), comp));
+        }
+        k = hn::Add(k, one);
+      }
+      hn::Store(ax, df, rx);
+      hn::Store(ay, df, ry);
+      hn::Store(az, df, rz);
+      hn::Store(aw, df, rw);
+      for (size_t l = 0; l < N; ++l)
+        if (outAt[l] >= 0) px[outAt[l]] = vec4f{rx[l], ry[l], rz[l], rw[l]};
+    }
+}
+
+template <class T>
+void MarchTileOf(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny, int64_t nz, int x0,
+                 int y0, int x1, int y1, vec4f* px) {
+  switch (f.traversal) {
+    case TraversalKind::Naive:
+      return MarchTileT<T, march_detail::WholeIter>(f, pairs, vox, nx, ny, nz, x0, y0, x1, y1, px);
+    case TraversalKind::Grid: return MarchTileT<T, GridIter>(f, pairs, vox, nx, ny, nz, x0, y0, x1, y1, px);
+    case TraversalKind::GridParts:
+      return MarchTileT<T, GridPartsIter>(f, pairs, vox, nx, ny, nz, x0, y0, x1, y1, px);
+    case TraversalKind::Tree: return MarchTileT<T, TreeIter>(f, pairs, vox, nx, ny, nz, x0, y0, x1, y1, px);
+    case TraversalKind::Hybrid: return MarchTileT<T, HybridIter>(f, pairs, vox, nx, ny, nz, x0, y0, x1, y1, px);
+  }
+}
+
+void MarchTile(const FrameView& f, const float* pairs, VoxelType type, const void* voxels, int64_t nx, int64_t ny,
+               int64_t nz, int x0, int y0, int x1, int y1, vec4f* px) {
+  switch (type) {
+    case VoxelType::UInt8:
+      return MarchTileOf(f, pairs, static_cast<const uint8_t*>(voxels), nx, ny, nz, x0, y0, x1, y1, px);
+    case VoxelType::Int8:
+      return MarchTileOf(f, pairs, static_cast<const int8_t*>(voxels), nx, ny, nz, x0, y0, x1, y1, px);
+    case VoxelType::UInt16:
+      return MarchTileOf(f, pairs, static_cast<const uint16_t*>(voxels), nx, ny, nz, x0, y0, x1, y1, px);
+    case VoxelType::Int16:
+      return MarchTileOf(f, pairs, static_cast<const int16_t*>(voxels), nx, ny, nz, x0, y0, x1, y1, px);
+    case VoxelType::Float32:
+      return MarchTileOf(f, pairs, static_cast<const float*>(voxels), nx, ny, nz, x0, y0, x1, y1, px);
+    case VoxelType::Float64: break;  // packetMarchable refuses it
+  }
+}
+
+const char* TargetName() { return hwy::TargetName(HWY_TARGET); }
+
+}  // namespace HWY_NAMESPACE
+}  // namespace spaceskip
+HWY_AFTER_NAMESPACE();
+#endif  // SPACESKIP_HAVE_HWY
+
+#if !defined(SPACESKIP_HAVE_HWY) || HWY_ONCE
+namespace spaceskip {
+
+#ifdef SPACESKIP_HAVE_HWY
+HWY_EXPORT(MarchTile);
+HWY_EXPORT(TargetName);
+#endif
+
+bool packetMarchable(const FrameView& f, VoxelType type, int components, int64_t nx, int64_t ny, int64_t nz) {
+#ifdef SPACESKIP_HAVE_HWY
+  if (!isPlainFrame(f) || f.lattice.active || f.alphaIn || f.sampleCount || f.grid.vmin) return false;
+  if (components != 1 || type == VoxelType::Float64) return false;
+  // 32-bit gathers: float32 by index, the others by byte offset (voxel index * size + 1).
+  if (nx < 2 || ny < 2 || nz < 2 || nx * ny * nz * int64_t(voxelSize(type)) >= (int64_t(1) << 31) - 4) return false;
+  return f.tf.size >= 1 && f.tf.size < (1 << 28) && f.dt > 0.f;
+#else
+  (void)f, (void)type, (void)components, (void)nx, (void)ny, (void)nz;
+  return false;
+#endif
+}
+
+void packetPairTable(const TransferFunctionView& tf, std::vector<float>& pairs) {
+  const size_t n = size_t(tf.size > 0 ? tf.size : 0);
+  pairs.resize(8 * n);
+  for (int c = 0; c < 4; ++c)
+    for (size_t i = 0; i < n; ++i) {
+      const vec4f& a = tf.table[i];
+      const vec4f& b = tf.table[i + 1 < n ? i + 1 : i];
+      pairs[c * 2 * n + 2 * i] = c == 0 ? a.x : c == 1 ? a.y : c == 2 ? a.z : a.w;
+      pairs[c * 2 * n + 2 * i + 1] = c == 0 ? b.x : c == 1 ? b.y : c == 2 ? b.z : b.w;
+    }
+}
+
+void marchPacketTile(const FrameView& f, const float* pairs, VoxelType type, const void* voxels, int64_t nx,
+                     int64_t ny, int64_t nz, int x0, int y0, int x1, int y1, vec4f* px) {
+#ifdef SPACESKIP_HAVE_HWY
+  HWY_DYNAMIC_DISPATCH(MarchTile)(f, pairs, type, voxels, nx, ny, nz, x0, y0, x1, y1, px);
+#else
+  (void)f, (void)pairs, (void)type, (void)voxels, (void)nx, (void)ny, (void)nz, (void)x0, (void)y0, (void)x1, (void)y1, (void)px;
+#endif
+}
+
+const char* packetTarget() {
+#ifdef SPACESKIP_HAVE_HWY
+  return HWY_DYNAMIC_DISPATCH(TargetName)();
+#else
+  return "none";
+#endif
+}
+
+}  // namespace spaceskip
+#endif
