@@ -1,0 +1,73 @@
+// What the CLI's commands share: volumes, transfer functions and cameras from the options.
+#include "Commands.h"
+#include "spaceskip/Generators.h"
+#include "spaceskip/TransferFunctionIO.h"
+#include "spaceskip/VolumeIO.h"
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+
+namespace spaceskip::cli {
+
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+Volume openVolume(const std::string& spec, const Options& o) {
+  const uint64_t cap = maxVolumeBytes(o);
+  std::string shape;
+  vec3l dims;
+  if (parseGeneratorSpec(spec, cap, shape, dims)) return generateVolume(shape, dims);
+  ReadLimits limits;
+  limits.maxBytes = cap;
+  return loadVolume(spec, limits);
+}
+
+TransferFunction makeTF(const Options& o, const Volume& v) {
+  double lo, hi;
+  if (!v.scalarRange(lo, hi)) lo = 0, hi = 1;
+  std::string t = o.get("--tf", "ramp");
+  // A preset name unless a file of that name exists (loadTransferFunction refuses devices).
+  std::error_code ec;
+  if (std::filesystem::exists(t, ec)) return loadTransferFunction(t, lo, hi);
+  return TransferFunction::preset(t, lo, hi);
+}
+
+Camera makeCamera(const Options& o, const Volume& v, int w, int h, double azDefault, double elDefault) {
+  double az = azDefault, el = elDefault, zoom = 1;
+  if (o.has("--camera")) {
+    parseCamera(o.get("--camera", ""), az, el, zoom);
+  }
+  double b[6];
+  v.worldBounds(b);
+  return orbitCamera(b, az, el, zoom, o.has("--perspective"), double(w) / h);
+}
+
+
+void printResidency(const ResidencyStats& r) {
+  if (!r.sparse) return;
+  std::printf("residency sparse: pool bricks of %d cells, %lld needed, %lld resident of %lld (%lld slots, %.1f MiB "
+              "pool, budget %.1f MiB)\n",
+              r.poolBrick, (long long)r.needed, (long long)r.resident, (long long)r.bricks, (long long)r.capacity,
+              double(r.poolBytes) / 1048576.0, double(r.budgetBytes) / 1048576.0);
+}
+
+
+std::string jsonEscape(const std::string& s) {
+  std::string o;
+  for (const char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) o += ' ';
+    else o += c;
+  }
+  return o;
+}
+
+std::string dimsText(vec3l d) {
+  return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+}  // namespace spaceskip::cli
