@@ -163,12 +163,10 @@ class CpuBackend final : public Backend {
     vec4f* px = out.rgba.data();
     packetPairTable(f.tf, pairs_);
     const float* pairs = pairs_.data();
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, f.height, kTile, 0, f.width, kTile),
-                      [&](const tbb::blocked_range2d<int>& r) {
-                        marchPacketTile(f, pairs, volume_.type, volume_.data, volume_.dims.x, volume_.dims.y,
-                                        volume_.dims.z, r.cols().begin(), r.rows().begin(), r.cols().end(),
-                                        r.rows().end(), px);
-                      });
+    forTiles(f, [&](const tbb::blocked_range2d<int>& r) {
+      marchPacketTile(f, pairs, volume_.type, volume_.data, volume_.dims.x, volume_.dims.y, volume_.dims.z,
+                      r.cols().begin(), r.rows().begin(), r.cols().end(), r.rows().end(), px);
+    });
   }
 
   template <class Sampler>
@@ -176,14 +174,32 @@ class CpuBackend final : public Backend {
     vec4f* px = out.rgba.data();
     // Plain frames take the integrator's composite-only code (renderPixel's Plain), as on CUDA.
     const bool plain = isPlainFrame(f);
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, f.height, kTile, 0, f.width, kTile),
-                      [&](const tbb::blocked_range2d<int>& r) {
-                        for (int y = r.rows().begin(); y != r.rows().end(); ++y)
-                          for (int x = r.cols().begin(); x != r.cols().end(); ++x)
-                            px[size_t(y) * size_t(f.width) + size_t(x)] =
-                                plain ? renderPixel<Sampler, -1, true>(f, s, x, y) : renderPixel(f, s, x, y);
-                      });
+    forTiles(f, [&](const tbb::blocked_range2d<int>& r) {
+      for (int y = r.rows().begin(); y != r.rows().end(); ++y)
+        for (int x = r.cols().begin(); x != r.cols().end(); ++x)
+          px[size_t(y) * size_t(f.width) + size_t(x)] =
+              plain ? renderPixel<Sampler, -1, true>(f, s, x, y) : renderPixel(f, s, x, y);
+    });
   }
+
+  /// Runs `tile` over the frame's tiles with oneTBB. A large frame with a progress hook goes in
+  /// kProgressBands bands of rows, the hook told after each on this thread (the cores stay busy
+  /// within a band; between bands they wait for its slowest tile).
+  template <class Tile>
+  void forTiles(const FrameView& f, const Tile& tile) {
+    const bool bands = progress_ && int64_t(f.width) * f.height >= kProgressPixels;
+    const int n = bands ? kProgressBands : 1;
+    for (int b = 0; b < n; ++b) {
+      const int y0 = int(int64_t(f.height) * b / n), y1 = int(int64_t(f.height) * (b + 1) / n);
+      tbb::parallel_for(tbb::blocked_range2d<int>(y0, y1, kTile, 0, f.width, kTile), tile);
+      if (bands) progress_(double(b + 1) / n);
+    }
+  }
+
+  void setProgress(std::function<void(double)> progress) override { progress_ = std::move(progress); }
+  static constexpr int64_t kProgressPixels = 512 * 512;  ///< smaller frames report nothing
+  static constexpr int kProgressBands = 16;
+  std::function<void(double)> progress_;
 
   static constexpr int kPoolBrick = 16;
   int poolBrick_ = kPoolBrick;

@@ -179,3 +179,29 @@ TEST(BoxPixelRect, NoRayOutsideMeetsTheBox) {
   EXPECT_EQ(rect[2], 64);
   EXPECT_EQ(rect[3], 64);
 }
+
+TEST(Engine, ProgressGoesForwardThroughTheStepsAndALargeFrame) {
+  // What a progress bar receives: value ranges, classification, build and the frame in order,
+  // fractions never going back; a large CPU frame reports in bands as it goes.
+  Volume v = generateVolume("shell", vec3l{48, 48, 48});
+  Engine e(BackendKind::CPU);
+  std::vector<std::pair<double, std::string>> seen;
+  e.setProgress([&](double f, const char* step) { seen.emplace_back(f, step); });
+  test::load(e, v, TransferFunction::preset("ramp", 0, 255), test::builder(BuilderKind::Grid));
+  Image img;
+  e.render(test::orbit(v, 30, 20), 600, 600, img);
+  ASSERT_FALSE(seen.empty());
+  for (size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i].first, seen[i - 1].first) << seen[i].second;
+  auto count = [&](const std::string& step) {
+    return std::count_if(seen.begin(), seen.end(), [&](const auto& p) { return p.second == step; });
+  };
+  EXPECT_EQ(count("value ranges"), 1);
+  EXPECT_EQ(count("classification"), 1);
+  EXPECT_EQ(count("build"), 1);
+  EXPECT_GE(count("frame"), 1 + 16);  // the start, then each of the 16 bands of a 600^2 frame
+  EXPECT_DOUBLE_EQ(seen.back().first, 1.0);
+  // A small frame: the steps, no bands.
+  seen.clear();
+  e.render(test::orbit(v, 40, 20), 64, 64, img);
+  EXPECT_EQ(count("frame"), 1);
+}
