@@ -134,7 +134,7 @@ class CudaBackend final : public Backend {
   /// Grid and DistanceGrid frames walk the parts of sparse bricks (GridParts) only where the set
   /// parts are at most this share of the occupied bricks' parts: on the H100 the part walk made
   /// the paper's stand-ins 5-26% slower where the share was 0.28 and more, and N-body
-  /// 1024^3 / 2048^3 (shares 0.11 / 0.06) 1.12x / 1.59x faster (docs/results/round9-h100).
+  /// 1024^3 / 2048^3 (shares 0.11 / 0.06) 1.12x / 1.59x faster (docs/results/h100-sub-brick-masks).
   /// Tuning::partsShare (default 0.2).
 
   void render(FrameView f, FilterMode filter, const float* depth, Image& out) override {

@@ -18,18 +18,18 @@ namespace {
 // One kernel per traversal: a kernel holding every traversal is allocated the registers of the
 // tree traversal (64 per thread, half occupancy), which the naive and grid marches do not need.
 // SPACESKIP_CUDA_HW_MIN_BLOCKS > 1 asks the hardware-filtered kernels to fit that many blocks of
-// 256 threads per SM (a register cap). Measured on the H100: in round 3, 6 (40 registers) made
-// every ESS kernel 4-11% slower than no cap; in round 14, with batches of samples (102 registers
-// for the grid kernels), 3 (85 registers) made the hardware-filtered DistanceGrid 1.06-1.17x
-// faster on five stand-ins (docs/results/round14-h100), hence the default 3.
+// 256 threads per SM (a register cap). Measured on the H100: with one sample at a time, 6 (40
+// registers) made every ESS kernel 4-11% slower than no cap; with batches of samples (102
+// registers for the grid kernels), 3 (85 registers) made the hardware-filtered DistanceGrid
+// 1.06-1.17x faster on five stand-ins (docs/results/HISTORY.md, the register cap), hence the default 3.
 constexpr int kMaxRenderThreads = 256;
 // Default launch of the hardware-filtered kernels: plain for volumes up to kLargeTextureBytes; a
 // persistent launch with kLargeTextureResident blocks of 128 threads per SM above, for Naive
-// only. Measured on the H100 (docs/results/cuda-h100-round3): naive:hw at 2048^3 (8 GiB) runs
+// only. Measured on the H100 (docs/results/HISTORY.md, persistent launch): naive:hw at 2048^3 (8 GiB) runs
 // fastest with 6 blocks per SM (more warps in flight thrash the texture path), at 1024^3 (1 GiB)
-// with all 16. The skipping kernels (iterators since round 6) run faster plain: DistanceGrid at
+// with all 16. The skipping kernels (traversals as iterators) run faster plain: DistanceGrid at
 // N-body 2048^3 789 kernel fps plain vs 730 persistent, in one process
-// (docs/results/round9-h100/before).
+// (docs/results/h100-sub-brick-masks).
 constexpr size_t kLargeTextureBytes = size_t(2) << 30;
 constexpr int kLargeTextureResident = 6;
 template <class Sampler>
@@ -205,7 +205,7 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   lastDeviceSeconds_ = -1;
   f.tf = table_;
   // Samples a GPU march fetches together (IntervalMarcher::takeBatch; batches against one sample
-  // at a time: docs/results/round14-h100).
+  // at a time: docs/results/HISTORY.md, batches of samples).
   f.sampleBatch = tuning_.sampleBatch > 0 ? std::min(tuning_.sampleBatch, kMaxSampleBatch) : kMaxSampleBatch;
   layers_ = SegmentLayersView{};  // launch() sets it for a segmented frame
   deviceImageValid_ = false;
@@ -328,7 +328,7 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
     // (segmentableFrame: composite plain frames without early ray termination). A frame takes as
     // long as its slowest tiles, and at N-body 2048^3 those are tiles whose rays cross dense
     // clusters: 0.6-0.9 ms while the median tile takes 1.3 us. Measured on the H100
-    // (docs/results/round13-h100/segments): 4 segments 1.07-1.18x kernel fps on five stand-ins
+    // (docs/results/HISTORY.md, segmented rays): 4 segments 1.07-1.18x kernel fps on five stand-ins
     // (DistanceGrid, DistanceGrid:hw, Auto), 8 less; short rays lose (N-body 128^3 in a 1024^2
     // window: kernel 0.30 -> 0.35 ms), hence raySegments. Tuning::raySegments forces a count
     // (1..16; 1: whole rays).

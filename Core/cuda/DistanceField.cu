@@ -53,7 +53,7 @@ union Bytes16 {
 // the stride a multiple of 16), `in` and `out` aligned alike. Two loads a position instead of
 // 32 single-byte ones (and no division a byte). On the H100 at N-body 2048^3 the three passes
 // took 97 / 87 / 88 us instead of 161 / 129 / 130 (Nsight Compute), the field 0.23 instead of
-// 0.34 ms (docs/results/round11-h100).
+// 0.34 ms (docs/results/h100-distance-field).
 __device__ bool vectorStaging(const uint8_t* in, const uint8_t* out, const int64_t* starts, int nl, int n, int axis,
                               int64_t stride) {
   const int64_t step = axis == 0 ? n : 1;
@@ -160,7 +160,7 @@ constexpr size_t kStagedMaxBytes = 96 * 1024;  // opted in (the default is 48 Ki
 /// staged kernel was slower than the unstaged one with one segment a line (N-body 2048^3: 0.73-1.17
 /// vs 0.62 ms a build) and on lines of 64-104 bricks (two segments: 0.07-0.10 vs 0.05-0.08 ms),
 /// faster with 4-8 segments on lines of 128-256 bricks (2048^3: 0.45 ms; 128 bricks: 0.09 vs
-/// 0.12 ms) (docs/results/round10-h100).
+/// 0.12 ms) (docs/results/HISTORY.md, distance-field segments).
 int segmentsFor(int n, int cap, int maxSegments) {
   if (n < 128) return 0;
   for (int segs = std::min(std::max(1, maxSegments), 8); segs >= 2; segs /= 2)

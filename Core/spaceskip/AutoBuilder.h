@@ -58,7 +58,7 @@ public:
   static constexpr int kMaxRepeats = 3;
   /// A candidate's build time counts as if spread over this many frames (cost()): an opacity edit
   /// about every second at 30 frames/s, as when a user drags a TF point. On the H100
-  /// (docs/results/HISTORY.md, Auto's build weight) the k-d tree drew the first, axis-aligned
+  /// (docs/results/h100-auto) the k-d tree drew the first, axis-aligned
   /// view of aneurism, stag beetle and kingsnake 3-8% faster than DistanceGrid and the orbit
   /// 5-11% slower, with builds of 0.9-2.2 ms against 0.03-0.33 ms: this weight keeps DistanceGrid
   /// there, and the k-d tree where it is 17-58% faster (Menger, Richtmyer-Meshkov).

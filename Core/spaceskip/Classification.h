@@ -195,7 +195,7 @@ SS_FUNC uint64_t subBrickMask(const T* data, vec3l dims, vec3i cellDims, int bri
 }
 
 /// Walking a brick's parts pays where few are set (particles); where many are, the walk costs
-/// more than the samples it saves (measured on the H100: docs/results/round9-h100). So each
+/// more than the samples it saves (measured on the H100: docs/results/h100-sub-brick-masks). So each
 /// occupied brick gets a state byte: kBrickWhole (march it whole) or kBrickParts (walk the set
 /// parts of its mask), the latter when at most `maxSet` of the 64 parts are set. Bit 7 marks
 /// "parts" in the state and in DistanceGrid's field alike (distances are <= kMaxSkipDistance),
@@ -239,7 +239,7 @@ SubMasks computeSubMasksCuda(const Volume& v, const TransferFunction& tf, int br
 /// Tuning::subMaskMaxSet clamped to 0..64. The default 40 of 64: on the H100 1.02-1.06x kernel
 /// fps over 24 where frames walk parts, N-body 1024^3 and 2048^3, the other stand-ins unchanged;
 /// the oneTBB frames of the 11 stand-ins at 1/8 scale 0.99-1.11x, geometric mean 1.05, in
-/// adjacent processes (docs/results/round12-h100).
+/// adjacent processes (docs/results/h100-tf-edit).
 inline int subMaskMaxSet(const Tuning& t) { return t.subMaskMaxSet < 0 ? 0 : t.subMaskMaxSet > 64 ? 64 : t.subMaskMaxSet; }
 
 }  // namespace spaceskip

@@ -13,7 +13,7 @@ namespace spaceskip {
 
 /// Largest stored distance; a brick farther from every occupied brick stores this value.
 /// The CUDA passes cut a line into segments that each start `cap` bricks early, so the cap is
-/// their cost: on the H100 (docs/results/round10-h100/cap) 32 instead of 64 built N-body 2048^3's
+/// their cost: on the H100 (docs/results/HISTORY.md, the distance cap) 32 instead of 64 built N-body 2048^3's
 /// field in 0.37-0.38 ms instead of 0.47-0.49 (Richtmyer-Meshkov 0.35 vs 0.45), and the frame
 /// rates of every builder using it on all 11 stand-ins stayed within 0.97-1.03x (two processes
 /// each, alternated): leaps of 32 bricks (256 voxels) are already long.

@@ -24,14 +24,14 @@ struct Tuning {
   int sampleBatch = 0;
   /// Grid and DistanceGrid frames walk the parts of sparse bricks only where the set parts are
   /// at most this share of the occupied bricks' parts (CudaBackend.cu; measured in
-  /// docs/results/round9-h100).
+  /// docs/results/h100-sub-brick-masks).
   double partsShare = 0.2;
 
   // --- classification (both backends) ---
   /// Sub-brick masks: without them an occupied brick is marched whole.
   bool subMasks = true;
   /// The most set parts (of 64) a brick may have to be walked part by part (subBrickState); 40
-  /// measured best over 24 on the H100 and the oneTBB backend (docs/results/round12-h100).
+  /// measured best over 24 on the H100 and the oneTBB backend (docs/results/h100-tf-edit).
   int subMaskMaxSet = 40;
   /// CUDA: part ranges stored at setVolume, so that an edit's classification computes the masks
   /// from 128 bounds a brick (BrickClassification::partRangeBytes); off: from the voxels, on the

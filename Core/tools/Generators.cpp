@@ -331,7 +331,7 @@ Volume vessels(vec3l dims, unsigned seed, double thick = 1.0) {
 
 
 // ---- The paper's other data sets (Zellmann, Fig. 1): stand-ins with its dims and occupancy ----
-// Every stand-in is uint8 with background 0, a 255 voxel and every other non-zero voxel >= 32,
+// Every stand-in is uint8 with a background of 0, a 255 voxel and every other non-zero voxel >= 32,
 // so under the "ramp" preset over the volume's range (the bench's TF: transparent below 10% of
 // the range) exactly the non-zero voxels are visible: the paper's occupancy ("percentage of
 // voxels that are visible given a certain transfer function"). Shapes are defined on the unit

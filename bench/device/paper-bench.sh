@@ -15,13 +15,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 src=$(cd "$(dirname "$0")/../.." && pwd)
 build=${BUILD_DIR:-$src/build-gpu}
-for d in "$src/../.deps/tbb" "$src/.deps/tbb"; do
-  if [ -d "$d" ]; then
-    export TBB_DIR=$(cd "$d" && pwd)/usr/lib/x86_64-linux-gnu/cmake/TBB
-    export LD_LIBRARY_PATH=$(cd "$d" && pwd)/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-    break
-  fi
-done
+. "$src/bench/device/tbb-env.sh"
 {
   echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)  host: $(hostname)  cores: $(nproc)"
   nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1

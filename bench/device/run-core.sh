@@ -27,13 +27,7 @@ build=${BUILD_DIR:-$src/build-gpu}
 frames=${BENCH_FRAMES:-8}
 status=0
 
-for d in "$src/../.deps/tbb" "$src/.deps/tbb"; do
-  if [ -d "$d" ]; then
-    export TBB_DIR=$(cd "$d" && pwd)/usr/lib/x86_64-linux-gnu/cmake/TBB
-    export LD_LIBRARY_PATH=$(cd "$d" && pwd)/usr/lib/x86_64-linux-gnu${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
-    break
-  fi
-done
+. "$src/bench/device/tbb-env.sh"
 
 log() { echo "[$(date -u +%H:%M:%S)] $*" | tee -a "$work/run.log"; }
 has() { case " $phases " in *" $1 "*) return 0 ;; *) return 1 ;; esac; }
@@ -193,15 +187,12 @@ if has bench-menger; then
     "naive:hw,kdtree-gpu-fast:shallow:hw,kdtree-cpu:shallow:hw,grid:hw,grid:brick16:hw,distance-grid:brick16:hw,kdtree-gpu-fast:deep:mls128:hw,kdtree-gpu-fast:deep:mls32:hw,hybrid:hw"
 fi
 if has profile2048; then
-  # Why naive:hw does half the samples/s at 2048^3 that it does at 1024^3: launch shape and
-  # L1/shared carveout sweeps on one generated file, then Nsight Compute sections.
+  # Why naive:hw does half the samples/s at 2048^3 that it does at 1024^3: a launch shape sweep
+  # on one generated file, then Nsight Compute sections.
   vol=$work/nbody_2048x2048x2048_uint8.raw
   [ -f "$vol" ] || "$cli" generate nbody --dims 2048 2048 2048 -o "$vol" > "$work/generate.log" 2>&1
   for bs in ${PROFILE_BLOCKS:-16x8 8x8 32x4 8x4 32x2 16x16}; do
     SPACESKIP_CUDA_BLOCK=$bs bench "p2048-block$bs" "$vol" "naive:hw,distance-grid:hw"
-  done
-  for co in ${PROFILE_CARVEOUTS:-0 100}; do
-    SPACESKIP_CUDA_CARVEOUT=$co bench "p2048-carveout$co" "$vol" "naive:hw"
   done
   sections="--section SpeedOfLight --section MemoryWorkloadAnalysis --section MemoryWorkloadAnalysis_Chart --section Occupancy --section WarpStateStats --section SchedulerStats --section LaunchStats"
   for spec in "naive:$vol" "distance-grid:$vol" "naive:gen:nbody:1024"; do

@@ -12,9 +12,8 @@
 #          bench-ert bench-hw (N-body 2048^3, the mapper's FilterMode Hardware (texture unit)
 #          against Exact: HW_ITEMS, default DistanceGrid,DistanceGrid:hw,Auto,Auto:hw)
 #          bench-frame (issue 13, the frame around the kernel: N-body 2048^3 Auto:hw with the
-#          window benchmark's switches :sync (host waits for the kernel, as before), :full (whole
-#          window blended), :float (float interop texture), alone and all together, twice in one
-#          process: FRAME_ITEMS) interop-memcheck (compute-sanitizer memcheck on the window
+#          window benchmark's switches :full (whole window blended), :float (float interop
+#          texture), alone and together, twice in one process: FRAME_ITEMS) interop-memcheck (compute-sanitizer memcheck on the window
 #          benchmark with the image kept on the GPU, 8-bit and float: memcheck.log)
 #          bench-floor (N-body FLOOR_N^3, default 128, in the 1024^2 window: the frame around a
 #          kernel of a few hundredths of a ms, CUDA blend against GL's: FLOOR_ITEMS)
@@ -23,7 +22,7 @@
 #          and an older bundle's, OLD_VTK (a vtk.tar.xz, e.g. carried to the same machine in an
 #          earlier call): OLDNEW_RUNS (default "old new old new"), OLDNEW_ITEMS, at N-body
 #          OLDNEW_N^3 (2048)) nsys-frame (Nsight Systems timeline of the window benchmark, N-body 2048^3 Auto:hw and
-#          :sync:full:float, 8 frames and 2 edits each: CUDA API and GPU work per call, OpenGL
+#          :full:float, 8 frames and 2 edits each: CUDA API and GPU work per call, OpenGL
 #          calls, waits; summaries in nsys.log, the CUDA/GL traces as CSV in logs.tgz)
 #          bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
 #          volume-only scene skips) bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
@@ -248,7 +247,7 @@ has bench-depth && ITEMS=Grid,DistanceGrid,DistanceGrid:brick4 window_bench nbod
 # exact sampling, N-body 2048^3 (issue 13's window goal: >= 700 fps, TF edit <= 3 ms).
 has bench-hw && ITEMS=${HW_ITEMS:-DistanceGrid,DistanceGrid:hw,Auto,Auto:hw} window_bench nbody 2048 "${v2[@]}"
 # The frame around the kernel (issue 13): each change against the state before it, in one process.
-has bench-frame && ITEMS=${FRAME_ITEMS:-Auto:hw,Auto:hw:sync:full:float,Auto:hw:sync,Auto:hw:full,Auto:hw:float,Auto:hw,Auto:hw:sync:full:float} \
+has bench-frame && ITEMS=${FRAME_ITEMS:-Auto:hw,Auto:hw:full:float,Auto:hw:full,Auto:hw:float,Auto:hw,Auto:hw:full:float} \
   window_bench nbody 2048 "${v2[@]}"
 # The window's floor (issue 13): the same frame around a kernel of a few hundredths of a
 # millisecond (N-body FLOOR_N^3, default 128, still drawn over the whole 1024^2 window): what
@@ -283,7 +282,7 @@ fi
 if has interop-memcheck && ! late; then
   log "interop memcheck"
   SPACESKIP_BACKEND=cuda timeout 400 compute-sanitizer --tool memcheck --error-exitcode 99 "$bench" --shape nbody \
-    --dims 128 --frames 4 --size 256 --builders Auto:hw,Auto:hw:float,Grid,Grid:sync "${v2[@]}" --edits 2 \
+    --dims 128 --frames 4 --size 256 --builders Auto:hw,Auto:hw:float,Grid,Grid:full "${v2[@]}" --edits 2 \
     > "$work/interop-memcheck.log" 2>&1
   rc=$?
   log "interop memcheck rc=$rc"
@@ -296,7 +295,7 @@ if has nsys-frame && ! late; then
     log "nsys frame profile"
     SPACESKIP_BACKEND=cuda timeout 420 nsys profile --trace=cuda,opengl,osrt --sample=none --cpuctxsw=none \
       --force-overwrite=true -o "$work/frame" "$bench" --shape nbody --dims "${BENCH_N:-2048}" --frames 8 \
-      --size 1024 --builders Auto:hw,Auto:hw:sync:full:float --edits 2 "${v2[@]}" > "$work/nsys-run.log" 2>&1
+      --size 1024 --builders Auto:hw,Auto:hw:full:float --edits 2 "${v2[@]}" > "$work/nsys-run.log" 2>&1
     log "nsys rc=$?"
     for r in cuda_api_sum cuda_gpu_sum osrt_sum opengl_khr_range_sum; do
       nsys stats --report $r --format column "$work/frame.nsys-rep" >> "$work/nsys.log" 2>&1
