@@ -43,6 +43,14 @@ struct KdDecision {
   box3i left, right;  ///< tight child boxes when split
 };
 
+/// No split: `box` stays a leaf.
+SS_FUNC KdDecision kdLeaf(const box3i& box) {
+  KdDecision d;
+  d.split = 0;
+  d.left = d.right = box;
+  return d;
+}
+
 /// The longest axis, the first one on ties.
 SS_FUNC int longestAxis(const box3i& b) {
   int lx = b.hi.x - b.lo.x, ly = b.hi.y - b.lo.y, lz = b.hi.z - b.lo.z;
@@ -115,6 +123,22 @@ SS_FUNC int64_t kdPlaneCost(const box3i& box, int axis, int pos, Tight& tight, b
   return vol - c <= vol / 1000 ? INT64_MAX : c;
 }
 
+/// `box` split at `pos` on `axis`, the children's boxes tightened by `tight`.
+#ifdef __CUDACC__
+#pragma nv_exec_check_disable
+#endif
+template <class Tight>
+SS_FUNC KdDecision kdSplitAt(const box3i& box, int axis, int pos, Tight& tight) {
+  KdDecision d;
+  box3i l = box, r = box;
+  l.hi[axis] = pos;
+  r.lo[axis] = pos;
+  d.split = 1;
+  d.left = tight(l);
+  d.right = tight(r);
+  return d;
+}
+
 /// The MLS split of a would-be leaf (d.split = 0 when MLS does not apply). Binned: the middle of
 /// the axis snapped down to the raster, at least one brick in. Sweep: KdTreeCPU's middle brick
 /// boundary, lo + (bricks / 2) bricks; the two differ only for a box clamped to the volume.
@@ -123,9 +147,7 @@ SS_FUNC int64_t kdPlaneCost(const box3i& box, int axis, int pos, Tight& tight, b
 #endif
 template <class Tight>
 SS_FUNC KdDecision kdMlsSplit(const box3i& box, int axis, const KdSplitParams& p, Tight& tight) {
-  KdDecision d;
-  d.split = 0;
-  d.left = d.right = box;
+  KdDecision d = kdLeaf(box);
   const int lo = box.lo[axis], hi = box.hi[axis], len = hi - lo;
   if (p.mls <= 0 || len <= p.mls) return d;
   int pos;
@@ -135,15 +157,7 @@ SS_FUNC KdDecision kdMlsSplit(const box3i& box, int axis, const KdSplitParams& p
     pos = (lo + len / 2) / p.brick * p.brick;
     if (pos <= lo) pos = lo + p.brick;
   }
-  if (pos > lo && pos < hi) {
-    box3i l = box, r = box;
-    l.hi[axis] = pos;
-    r.lo[axis] = pos;
-    d.split = 1;
-    d.left = tight(l);
-    d.right = tight(r);
-  }
-  return d;
+  return pos > lo && pos < hi ? kdSplitAt(box, axis, pos, tight) : d;
 }
 
 /// Leaf criterion Empty: the split of a would-be leaf (d.split = 0: it stays a leaf). See the
@@ -156,10 +170,8 @@ SS_FUNC KdDecision kdMlsSplit(const box3i& box, int axis, const KdSplitParams& p
 #endif
 template <class Tight>
 SS_FUNC KdDecision kdEmptySplit(const box3i& box, const KdSplitParams& p, Tight& tight) {
-  KdDecision d;
-  d.split = 0;
-  d.left = d.right = box;
-  if (kdHalts(box, p)) return d;  // Deep's halting holds
+  if (kdHalts(box, p)) return kdLeaf(box);  // Deep's halting holds
+  KdDecision d = kdLeaf(box);
   const int B = p.brick;
   const vec3i lo{box.lo.x / B, box.lo.y / B, box.lo.z / B};
   const vec3i hi{(box.hi.x + B - 1) / B, (box.hi.y + B - 1) / B, (box.hi.z + B - 1) / B};
@@ -194,13 +206,7 @@ SS_FUNC KdDecision kdEmptySplit(const box3i& box, const KdSplitParams& p, Tight&
     if (hi[bestAxis] - lo[bestAxis] < 2) return d;
     bestPos = lo[bestAxis] + (hi[bestAxis] - lo[bestAxis]) / 2;
   }
-  box3i l = box, r = box;
-  l.hi[bestAxis] = bestPos * B;
-  r.lo[bestAxis] = bestPos * B;
-  d.split = 1;
-  d.left = tight(l);
-  d.right = tight(r);
-  return d;
+  return kdSplitAt(box, bestAxis, bestPos * B, tight);
 }
 
 /// The split of a node the cost function leaves as a leaf: Empty's rule or MLS's.
@@ -222,9 +228,7 @@ SS_FUNC KdDecision kdLeafSplit(const box3i& box, int axis, const KdSplitParams& 
 #endif
 template <class Tight>
 SS_FUNC KdDecision decideKdSplit(const box3i& box, const KdSplitParams& p, Tight& tight) {
-  KdDecision d;
-  d.split = 0;
-  d.left = d.right = box;
+  KdDecision d = kdLeaf(box);
   const int axis = longestAxis(box);
   if (!kdHalts(box, p)) {
     int64_t best = INT64_MAX;  // a rejected plane costs INT64_MAX: it never beats this

@@ -75,20 +75,20 @@ TEST(AutoBuilder, EveryFrameEqualsNaiveAndTheFastestIsKept) {
     EXPECT_LE(compareImages(naive, img).maxAbs, 1.f / 255.f) << "frame " << frames;
   }
   ASSERT_FALSE(e.exploring());
-  // Round 1: each of the 4 CPU candidates once, in order; round 2: those within 1.5x of the
-  // cheapest (the cheapest at least) again, in the reverse order, each 1 to 3 frames in a row
-  // (until 2 ms), so at most 4 + 4 * 3 frames.
+  // The first pass: each of the 4 CPU candidates once, in order; the second: those within 1.5x
+  // of the cheapest (the cheapest at least) again, in the reverse order, each 1 to 3 frames in a
+  // row (until 2 ms), so at most 4 + 4 * 3 frames.
   ASSERT_GE(frames, 5);
   ASSERT_LE(frames, 16);
-  const std::vector<BuilderKind> round1{BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid,
+  const std::vector<BuilderKind> firstPass{BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid,
                                         BuilderKind::KdTreeCPU};
-  EXPECT_TRUE(std::equal(round1.begin(), round1.end(), used.begin()));  // Naive, the reference, first
-  auto rank = [&](BuilderKind k) { return std::find(round1.begin(), round1.end(), k) - round1.begin(); };
+  EXPECT_TRUE(std::equal(firstPass.begin(), firstPass.end(), used.begin()));  // Naive, the reference, first
+  auto rank = [&](BuilderKind k) { return std::find(firstPass.begin(), firstPass.end(), k) - firstPass.begin(); };
   int run = 1;
   for (size_t i = 5; i < used.size(); ++i) {
-    EXPECT_LE(rank(used[i]), rank(used[i - 1])) << "round 2 runs in the reverse order";
+    EXPECT_LE(rank(used[i]), rank(used[i - 1])) << "the second pass runs in the reverse order";
     run = used[i] == used[i - 1] ? run + 1 : 1;
-    EXPECT_LE(run, 3) << "at most 3 frames of a candidate in round 2";
+    EXPECT_LE(run, 3) << "at most 3 frames of a candidate in the second pass";
   }
   const std::string choice = e.buildStats().choice;
   EXPECT_EQ(choice.rfind("Auto chose ", 0), 0u) << choice;
@@ -257,15 +257,10 @@ TEST(AutoBuilder, AnEditThatOnlyEmptiesBricksDrawsWithTheStructureBuiltBeforeIt)
   // large empty volume, where the grid's DDA walks many empty bricks and a distance field or a
   // tree leaps over them (so Auto keeps a structure that is built, whatever the machine).
   const int n = 192;
-  Volume v;
-  v.allocate(vec3l{n, n, n}, VoxelType::UInt8);
-  uint8_t* d = v.mutableData();
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x) {
-        const double r = std::sqrt(double((x - 40) * (x - 40) + (y - 50) * (y - 50) + (z - 60) * (z - 60))) / 14.0;
-        d[x + n * (y + n * z)] = uint8_t(r < 1 ? 255 * (1 - r) : 0);
-      }
+  const Volume v = test::makeVolume<uint8_t>(n, n, n, VoxelType::UInt8, [](int x, int y, int z) {
+    const double r = std::sqrt(double((x - 40) * (x - 40) + (y - 50) * (y - 50) + (z - 60) * (z - 60))) / 14.0;
+    return r < 1 ? 255 * (1 - r) : 0;
+  });
   auto ramp = [](float zeroUpTo) {
     return TransferFunction::fromPoints({{0, 1, 1, 1, 0.f}, {zeroUpTo, 1, 1, 1, 0.f}, {255, 1, 0, 0, 0.8f}}, 0, 255, 256);
   };
@@ -421,7 +416,7 @@ TEST(AutoBuilder, NeverSlowerThanNaiveOnEveryShapeAt256) {
     const int size = 128;
     // No warm-up frame: a cold first Naive frame is one of the 7 and the median drops it.
     // Up to 40 measuring frames, as the CLI's bench allows: where the candidates' frames are
-    // about 1 ms (kingsnake on the H100 host's CPU), round 2 repeats each of three candidates up
+    // about 1 ms (kingsnake on the H100 host's CPU), the second pass repeats each of three candidates up
     // to 3 times, and Auto was still measuring after 10 frames there.
     for (int i = 0; i < 40 && autoE.exploring(); ++i) autoE.render(cam, size, size, img);
     EXPECT_FALSE(autoE.exploring()) << shape;
@@ -466,7 +461,7 @@ TEST(AutoBuilder, OnProbesOneFrameDecidesAndDrawsWithTheChoice) {
   EXPECT_FALSE(e.exploring());
   EXPECT_EQ(e.counters().frames, 1);
   EXPECT_EQ(e.counters().autoProbeMeasurings, 1);
-  // Round 1 (4 candidates) and round 2 (at most 3 probes each): at most 16 probes, each of
+  // The first pass (4 candidates) and the second (at most 3 probes each): at most 16 probes, each of
   // 64 x 64 pixels (1/16 of the frame).
   EXPECT_GE(e.counters().autoProbeFrames, 5);
   EXPECT_LE(e.counters().autoProbeFrames, 16);

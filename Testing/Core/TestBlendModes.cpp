@@ -46,32 +46,10 @@ std::vector<Mode> allModes(double lo, double hi) {
   return m;
 }
 
-std::vector<BuildParams> skippingBuilders() {
-  std::vector<BuildParams> v;
-  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::LBVHCPU, BuilderKind::KdTreeCPU,
-                        BuilderKind::Hybrid})
-    v.push_back(test::builder(k));
-  BuildParams mls = test::builder(BuilderKind::KdTreeCPU);
-  mls.maxLeafSize = 32;
-  mls.leaf = LeafCriterion::Shallow;
-  v.push_back(mls);
-  BuildParams small = test::builder(BuilderKind::Grid);
-  small.brick = 4;
-  v.push_back(small);
-  return v;
-}
-
 /// A w x h x d float volume filled by f(i, j, k), unit spacing.
 template <class F>
 Volume makeVolume(int w, int h, int d, F f) {
-  Volume v;
-  v.allocate(vec3l{w, h, d}, VoxelType::Float32);
-  float* p = reinterpret_cast<float*>(v.mutableData());
-  for (int k = 0; k < d; ++k)
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) p[i + int64_t(w) * (j + int64_t(h) * k)] = f(i, j, k);
-  v.data = p;
-  return v;
+  return test::makeVolume<float>(w, h, d, VoxelType::Float32, f);
 }
 
 /// Transfer function with opacity `a` and colour (r, g, b) everywhere over [lo, hi].
@@ -120,7 +98,7 @@ TEST(BlendModes, EveryBuilderEqualsNaiveInEveryMode) {
         Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Naive), cam.az, cam.el, cam.persp, 48,
                                      BackendKind::CPU, m.rp);
         ASSERT_GT(test::coverage(ref), 0.0) << c.shape << " " << m.name << " renders nothing";
-        for (const BuildParams& bp : skippingBuilders()) {
+        for (const BuildParams& bp : test::skippingBuilders(true)) {
           Image img = test::renderWith(v, tf, bp, cam.az, cam.el, cam.persp, 48, BackendKind::CPU, m.rp);
           ImageDiff d = compareImages(ref, img);
           EXPECT_LE(d.maxAbs, 1.f / 255.f) << c.shape << " " << m.name << " offset " << m.rp.firstSampleOffset << " "
@@ -304,20 +282,13 @@ TEST(BlendModes, ValueRangesSkipSamplesInMip) {
 }
 
 TEST(BlendModes, CudaEqualsCpuInEveryMode) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   Volume v = generateVolume("vessels", vec3l{64, 61, 67});
   double lo, hi;
   ASSERT_TRUE(v.scalarRange(lo, hi));
   for (const Mode& m : allModes(lo, hi)) {
     TransferFunction tf = m.rp.blend == BlendMode::MinimumIntensity ? lowTF(lo, hi)
                                                                     : TransferFunction::preset("ramp", lo, hi, 256);
-    Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 30, 20, true, 64, BackendKind::CPU, m.rp);
-    ASSERT_GT(test::coverage(ref), 0.0) << m.name;
-    for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::LBVH,
-                          BuilderKind::KdTreeGPUFast, BuilderKind::Hybrid}) {
-      Image img = test::renderWith(v, tf, test::builder(k), 30, 20, true, 64, BackendKind::CUDA, m.rp);
-      EXPECT_LE(compareImages(ref, img).maxAbs, 2.f / 255.f) << m.name << " " << builderName(k);
-    }
+    test::expectCudaBuildersEqualCpuNaive(v, tf, m.rp, m.name);
   }
 }

@@ -18,23 +18,10 @@ using namespace spaceskip;
 
 namespace {
 
-/// A w x h x d volume of type T filled by f(i, j, k).
-template <class T, class F>
-Volume makeVolume(int w, int h, int d, VoxelType type, F f) {
-  Volume v;
-  v.allocate(vec3l{w, h, d}, type);
-  T* p = reinterpret_cast<T*>(v.mutableData());
-  for (int k = 0; k < d; ++k)
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) p[i + int64_t(w) * (j + int64_t(h) * k)] = T(f(i, j, k));
-  v.data = p;
-  return v;
-}
-
 /// Blobs in an empty 160^3 uint8 volume: 5^3 pool bricks of 32 cells, a few of them occupied.
 Volume blobs() {
   const double c[4][4] = {{30, 40, 50, 9}, {110, 60, 40, 12}, {70, 120, 120, 10}, {140, 140, 30, 6}};
-  return makeVolume<uint8_t>(160, 160, 160, VoxelType::UInt8, [&](int i, int j, int k) {
+  return test::makeVolume<uint8_t>(160, 160, 160, VoxelType::UInt8, [&](int i, int j, int k) {
     double v = 0;
     for (const auto& b : c) {
       const double d2 = (i - b[0]) * (i - b[0]) + (j - b[1]) * (j - b[1]) + (k - b[2]) * (k - b[2]);
@@ -68,8 +55,8 @@ TEST(BrickPool, ResidentSamplesAreBitIdenticalToInCoreOnesAndOthersAreNaN) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0.f, 1000.f);
     Volume v = type == VoxelType::UInt16
-                   ? makeVolume<uint16_t>(37, 29, 41, type, [&](int, int, int) { return std::floor(u(rng)); })
-                   : makeVolume<float>(37, 29, 41, type, [&](int, int, int) { return u(rng); });
+                   ? test::makeVolume<uint16_t>(37, 29, 41, type, [&](int, int, int) { return std::floor(u(rng)); })
+                   : test::makeVolume<float>(37, 29, 41, type, [&](int, int, int) { return u(rng); });
     const PoolLayout L = makePoolLayout(v.dims, 4, 8);
     BrickResidency res;
     res.reset(L.count(), L.count());
@@ -219,33 +206,25 @@ struct Case {
 };
 
 std::vector<Case> modes() {
-  std::vector<Case> m;
-  RenderParams r;
-  m.push_back({"composite", r});
-  r.shade = true;
-  r.specular = 0.5;
-  m.push_back({"composite-shaded", r});
-  r = RenderParams{};
-  r.blend = BlendMode::MaximumIntensity;
-  m.push_back({"mip", r});
-  r.blend = BlendMode::AverageIntensity;
-  r.averageRange[0] = 120;
-  r.averageRange[1] = 255;
-  m.push_back({"average", r});
-  r = RenderParams{};
-  r.blend = BlendMode::Additive;
-  m.push_back({"additive", r});
-  r = RenderParams{};
-  r.blend = BlendMode::Slice;
-  r.sliceOrigin[0] = 110;
-  r.sliceOrigin[1] = 60;
-  r.sliceOrigin[2] = 40;
-  r.sliceNormal[0] = 0.3;
-  r.sliceNormal[1] = 0.2;
-  r.sliceNormal[2] = 0.93;
-  r.shade = true;
-  m.push_back({"slice-shaded", r});
-  return m;
+  auto blend = [](BlendMode b) {
+    RenderParams r;
+    r.blend = b;
+    return r;
+  };
+  RenderParams shaded;
+  shaded.shade = true;
+  shaded.specular = 0.5;
+  RenderParams average = blend(BlendMode::AverageIntensity);
+  average.averageRange[0] = 120;
+  average.averageRange[1] = 255;
+  RenderParams slice = blend(BlendMode::Slice);
+  const double origin[3] = {110, 60, 40}, normal[3] = {0.3, 0.2, 0.93};
+  std::copy(origin, origin + 3, slice.sliceOrigin);
+  std::copy(normal, normal + 3, slice.sliceNormal);
+  slice.shade = true;
+  return {{"composite", RenderParams{}}, {"composite-shaded", shaded},
+          {"mip", blend(BlendMode::MaximumIntensity)}, {"average", average},
+          {"additive", blend(BlendMode::Additive)}, {"slice-shaded", slice}};
 }
 
 Image renderBudget(const Volume& v, const TransferFunction& tf, BuilderKind b, const RenderParams& rp, int64_t budget,
@@ -413,7 +392,7 @@ TEST(BrickPool, CpuOverflowIsSaidAndRendersTheWholeVolume) {
 TEST(BrickPool, CpuShadedStepAtAPoolBrickFaceReadsTheNeighbourBrick) {
   // Opaque for x < 32, empty beyond: the shaded samples just before x = 32 take their gradient
   // from voxels of the empty pool brick next door, which must therefore be resident.
-  const Volume v = makeVolume<uint8_t>(97, 33, 33, VoxelType::UInt8, [](int i, int, int) { return i < 32 ? 200 : 0; });
+  const Volume v = test::makeVolume<uint8_t>(97, 33, 33, VoxelType::UInt8, [](int i, int, int) { return i < 32 ? 200 : 0; });
   RenderParams rp;
   rp.shade = true;
   rp.specular = 0.6;
@@ -438,8 +417,7 @@ TEST(BrickPool, CpuShadedStepAtAPoolBrickFaceReadsTheNeighbourBrick) {
 }
 
 TEST(BrickPool, CudaSparseImageEqualsInCoreForEveryBuilderAndMode) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   const Volume v = blobs();
   const TransferFunction tf = rampFrom(60);
   const int64_t budget = int64_t(v.byteSize()) * 3 / 5;
@@ -484,8 +462,7 @@ TEST(BrickPool, CudaSparseImageEqualsInCoreForEveryBuilderAndMode) {
 }
 
 TEST(BrickPool, CudaOverflowFallsBackToTheCpuWithOneMessage) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   const Volume v = blobs();
   std::vector<std::string> said;
   Engine e(BackendKind::CUDA);
@@ -505,8 +482,7 @@ TEST(BrickPool, CudaVolumeAboveTheDeviceStaysOnItSparse) {
   // The default budget follows the device's memory (here capped by
   // spaceskip::testing::setDeviceMemoryLimit, which fails allocations as a real out-of-memory does): a volume above it is kept sparse on
   // the device instead of falling back to the CPU.
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   const Volume v = blobs();
   const TransferFunction tf = rampFrom(60);
   const int64_t bricks = int64_t(20) * 20 * 20;

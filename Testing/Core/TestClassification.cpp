@@ -113,15 +113,10 @@ TEST(Classification, ExactZerosUnderParaViewsDefaultRampAreEmpty) {
   // maps onto table entry 0 exactly: opacity 0, so the brick is empty. Bricks touching a
   // non-zero voxel stay occupied, and every builder still draws the naive image.
   const int n = 48;
-  Volume v;
-  v.allocate(vec3l{n, n, n}, VoxelType::UInt8);
-  uint8_t* d = v.mutableData();
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x) {
-        const double r = std::sqrt(double((x - 20) * (x - 20) + (y - 24) * (y - 24) + (z - 26) * (z - 26)));
-        d[x + n * (y + n * z)] = r < 7 ? uint8_t(255 - r * 30) : 0;  // a ball in exact zeros
-      }
+  const Volume v = test::makeVolume<uint8_t>(n, n, n, VoxelType::UInt8, [](int x, int y, int z) {
+    const double r = std::sqrt(double((x - 20) * (x - 20) + (y - 24) * (y - 24) + (z - 26) * (z - 26)));
+    return r < 7 ? uint8_t(255 - r * 30) : uint8_t(0);  // a ball in exact zeros
+  });
   const auto tf = TransferFunction::fromPoints({{0, 0.23f, 0.3f, 0.75f, 0.f}, {255, 0.7f, 0.02f, 0.15f, 1.f}}, 0,
                                                255, 1024);
   RangeGrid g = computeRangeGrid(v, 8);

@@ -84,17 +84,6 @@ TransferFunction dependentTF() {
   return tf;
 }
 
-std::vector<BuildParams> skippingBuilders() {
-  std::vector<BuildParams> v;
-  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::LBVHCPU, BuilderKind::KdTreeCPU,
-                        BuilderKind::Hybrid})
-    v.push_back(test::builder(k));
-  BuildParams small = test::builder(BuilderKind::Grid);
-  small.brick = 4;
-  v.push_back(small);
-  return v;
-}
-
 RenderParams shaded() {
   RenderParams r;
   r.shade = true;
@@ -109,7 +98,7 @@ void expectBuildersEqualNaive(const Volume& v, BackendKind backend) {
     for (const auto& [az, el] : {std::pair{30.0, 20.0}, std::pair{-70.0, 50.0}}) {
       const Image naive = test::renderWith(v, tf, test::builder(BuilderKind::Naive), az, el, false, 80, backend, rp);
       ASSERT_GT(test::coverage(naive), 0.01) << "the blobs must be visible";
-      for (const BuildParams& p : skippingBuilders()) {
+      for (const BuildParams& p : test::skippingBuilders()) {
         const Image img = test::renderWith(v, tf, p, az, el, false, 80, backend, rp);
         EXPECT_LE(maxDiff(img, naive), kTol)
             << builderName(p.builder) << " brick " << p.brick << " shade " << rp.shade << " az " << az;
@@ -235,8 +224,7 @@ TEST(Components, OtherBlendModesWarnAndComposite) {
 
 // CUDA twin: the same per-ray code on the device: every builder equals Naive, and CUDA the CPU.
 TEST(ComponentsCuda, BuildersEqualNaiveAndCpu) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   for (const Volume& v : {twoComponents<uint8_t>(VoxelType::UInt8), fourComponents<float>(VoxelType::Float32)}) {
     expectBuildersEqualNaive(v, BackendKind::CUDA);
     for (const RenderParams& rp : {RenderParams{}, shaded()}) {

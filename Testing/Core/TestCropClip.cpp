@@ -23,14 +23,7 @@ Image render(const Volume& v, BuilderKind k, const RenderParams& rp, double az =
 }
 
 Volume scene() {
-  Volume v = generateVolume("nbody", vec3l{40, 36, 44});
-  v.origin[0] = -7.5;
-  v.origin[1] = 120;
-  v.origin[2] = 3;
-  v.spacing[0] = 0.5;
-  v.spacing[1] = 1.0;
-  v.spacing[2] = 0.75;
-  return v;
+  return test::offsetNbody();
 }
 
 // Cropping planes at fractions of the box along each axis, in the volume's coordinates.
@@ -277,8 +270,7 @@ TEST(CropClip, CroppingAndClippingTogetherStayLosslessOnPlanesAtBrickFaces) {
 }
 
 TEST(CropClip, CudaEveryBuilderEqualsNaiveWithCroppingAndClipping) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   Volume v = scene();
   RenderParams rp = cropped(v, 0x5140145);  // inverted fence
   rp.clipPlanes.push_back({0.6, -0.48, 0.64, -(0.6 * v.origin[0] - 0.48 * (v.origin[1] + 18) + 0.64 * (v.origin[2] + 16))});

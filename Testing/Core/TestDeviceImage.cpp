@@ -26,7 +26,7 @@ using namespace spaceskip;
 namespace {
 
 // The mapper's host rounding (vtkSpaceSkipCompositor::UploadHostImage).
-unsigned char round8(float s) {
+unsigned char toByte(float s) {
   const float v = std::min(std::max(s, 0.f), 1.f);
   return static_cast<unsigned char>(v * 255.f + 0.5f);
 }
@@ -57,8 +57,7 @@ struct Scene {
 }  // namespace
 
 TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   Scene s;
   const int w = 120, h = 90;
   for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid}) {
@@ -109,7 +108,7 @@ TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
           const vec4f& c = host.rgba[size_t(y0 + y) * size_t(w) + size_t(x0 + x)];
           const size_t o = (size_t(y) * size_t(rw) + size_t(x)) * texel;
           if (eightBit) {
-            const unsigned char want[4] = {round8(c.x), round8(c.y), round8(c.z), round8(c.w)};
+            const unsigned char want[4] = {toByte(c.x), toByte(c.y), toByte(c.z), toByte(c.w)};
             bad += !std::equal(want, want + 4, back.data() + o);
           } else {
             bad += std::memcmp(&c, back.data() + o, sizeof(vec4f)) != 0;
@@ -157,7 +156,7 @@ TEST(DeviceImage, StreamOrderedFrameEqualsTheHostImage) {
           const float src[4] = {c.x, c.y, c.z, c.w};
           double sv[4];
           for (int i = 0; i < 4; ++i)
-            sv[i] = eightBit ? round8(src[i]) / 255.0 : std::min(std::max(double(src[i]), 0.0), 1.0);
+            sv[i] = eightBit ? toByte(src[i]) / 255.0 : std::min(std::max(double(src[i]), 0.0), 1.0);
           covered += c.w > 0.f;
           for (int i = 0; i < 4; ++i) {
             const double want = std::min(1.0, sv[i] + background[o + i] / 255.0 * (1.0 - sv[3])) * 255.0 + 0.5;
@@ -183,8 +182,7 @@ TEST(DeviceImage, LayersBlendLikeTheFlatImage) {
   // the layers as it reads them. Both blends must write the same texels bit for bit, and the
   // flat image must equal the host image. 4 segments forced (rays this short are whole by
   // default; Tuning::raySegments), the box's rectangle with flags.
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   Scene s;
   const int w = 120, h = 90;
   Tuning segmented;

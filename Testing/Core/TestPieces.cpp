@@ -19,14 +19,7 @@ struct Part {
 };
 
 Volume whole() {
-  Volume v = generateVolume("nbody", vec3l{40, 36, 44});
-  v.origin[0] = -7.5;
-  v.origin[1] = 120;
-  v.origin[2] = 3;
-  v.spacing[0] = 0.5;
-  v.spacing[1] = 1.0;
-  v.spacing[2] = 0.75;
-  return v;
+  return test::offsetNbody();
 }
 
 /// Cells [0, n) of axis `a` split at cell s into two parts, each with `ghost` layers of the other.
@@ -104,14 +97,18 @@ bool eyeBelow(const Volume& v, double az, double el, bool persp, int a, int s) {
   return c[a] + dir[a] * dist < v.origin[a] + v.spacing[a] * s;
 }
 
-std::vector<Case> cases() {
+/// Naive, Grid and KdTreeCPU, orthographic and perspective, each with `rp` and the first sample
+/// one step in (as the VTK mapper without jitter).
+std::vector<Case> everyBuilderAndProjection(RenderParams rp) {
+  rp.firstSampleOffset = 1;
   std::vector<Case> cs;
   for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::KdTreeCPU})
-    for (bool persp : {false, true}) {
-      RenderParams rp;
-      rp.firstSampleOffset = 1;  // as the VTK mapper without jitter
-      cs.push_back({k, persp, rp});
-    }
+    for (bool persp : {false, true}) cs.push_back({k, persp, rp});
+  return cs;
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> cs = everyBuilderAndProjection(RenderParams{});
   RenderParams jit;
   jit.jitter = true;
   jit.jitterSeed = 7;
@@ -134,6 +131,26 @@ std::vector<Case> cases() {
   clip.firstSampleOffset = 1;
   cs.push_back({BuilderKind::KdTreeCPU, true, clip});
   return cs;
+}
+
+/// Early ray termination at a low threshold, so that many rays stop in the back piece.
+std::vector<Case> ertCases() {
+  RenderParams ert;
+  ert.ertThreshold = 0.3;
+  std::vector<Case> cs = everyBuilderAndProjection(ert);
+  ert.shade = true;  // and shaded, the first sample at the entry
+  cs.push_back({BuilderKind::Grid, true, ert});
+  return cs;
+}
+
+/// `v` cut in two pieces along x at cell 17: va (with its piece pa) below, vb above.
+void halves(const Volume& v, Volume& va, VolumePiece& pa, Volume& vb, VolumePiece& pb) {
+  const int pts[3] = {int(v.dims.x), int(v.dims.y), int(v.dims.z)};
+  Part all{{0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}, {0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}};
+  Part a, b;
+  split(all, 0, 17, 1, pts[0], a, b);
+  va = cut(v, a, pa);
+  vb = cut(v, b, pb);
 }
 }  // namespace
 
@@ -228,8 +245,7 @@ TEST(Pieces, AWrongOffsetIsVisible) {
 
 // The same lattice code on the device: CUDA pieces composite to the CPU's whole image.
 TEST(Pieces, CudaPiecesEqualTheWholeVolume) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   const Volume v = whole();
   const int pts[3] = {int(v.dims.x), int(v.dims.y), int(v.dims.z)};
   Part all{{0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}, {0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}};
@@ -252,12 +268,9 @@ TEST(Pieces, CudaPiecesEqualTheWholeVolume) {
 // followBias (IceT's 8-bit blend) raises the colour only where a piece lies behind along the ray.
 TEST(Pieces, FollowBiasRaisesOnlyPixelsWithAPieceBehind) {
   const Volume v = whole();
-  const int pts[3] = {int(v.dims.x), int(v.dims.y), int(v.dims.z)};
-  Part all{{0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}, {0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}};
-  Part a, b;
-  split(all, 0, 17, 1, pts[0], a, b);
   VolumePiece pa, pb;
-  const Volume va = cut(v, a, pa), vb = cut(v, b, pb);
+  Volume va, vb;
+  halves(v, va, pa, vb, pb);
   const Case c{BuilderKind::Grid, false, RenderParams{}};
   const bool aFront = eyeBelow(v, 35, 25, false, 0, 17);
   VolumePiece& front = aFront ? pa : pb;
@@ -278,12 +291,9 @@ namespace {
 /// with "over" without alphaIn.
 Image carriedPieces(const Case& c, BackendKind backend, Image* plainOver) {
   const Volume v = whole();
-  const int pts[3] = {int(v.dims.x), int(v.dims.y), int(v.dims.z)};
-  Part all{{0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}, {0, 0, 0}, {pts[0] - 1, pts[1] - 1, pts[2] - 1}};
-  Part a, b;
-  split(all, 0, 17, 1, pts[0], a, b);
   VolumePiece pa, pb;
-  const Volume va = cut(v, a, pa), vb = cut(v, b, pb);
+  Volume va, vb;
+  halves(v, va, pa, vb, pb);
   const bool aFront = eyeBelow(v, 35, 25, c.persp, 0, 17);
   const Image front = renderPiece(aFront ? va : vb, aFront ? &pa : &pb, c, 35, 25, v, backend);
   std::vector<float> alpha(front.rgba.size());
@@ -308,22 +318,6 @@ Image carriedPieces(const Case& c, BackendKind backend, Image* plainOver) {
   return sum;
 }
 
-/// Early ray termination at a low threshold, so that many rays stop in the back piece.
-std::vector<Case> ertCases() {
-  std::vector<Case> cs;
-  for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::KdTreeCPU})
-    for (bool persp : {false, true}) {
-      RenderParams rp;
-      rp.firstSampleOffset = 1;
-      rp.ertThreshold = 0.3;
-      cs.push_back({k, persp, rp});
-    }
-  RenderParams shade;
-  shade.shade = true;
-  shade.ertThreshold = 0.3;
-  cs.push_back({BuilderKind::Grid, true, shade});
-  return cs;
-}
 }  // namespace
 
 // alphaIn: the back piece's rays go on from the front piece's opacity, so early ray termination
@@ -342,8 +336,7 @@ TEST(Pieces, AlphaInCarriesEarlyRayTerminationAcrossPieces) {
 }
 
 TEST(Pieces, CudaAlphaInCarriesEarlyRayTerminationAcrossPieces) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   const Volume v = whole();
   for (const Case& c : ertCases()) {
     if (c.builder == BuilderKind::KdTreeCPU) continue;

@@ -8,6 +8,7 @@
 #include "spaceskip/Backend.h"
 
 #include <cmath>
+#include <tuple>
 
 using namespace spaceskip;
 
@@ -16,14 +17,16 @@ namespace {
 /// A w x h x d float volume filled by f(i, j, k), unit spacing.
 template <class F>
 Volume makeVolume(int w, int h, int d, F f) {
-  Volume v;
-  v.allocate(vec3l{w, h, d}, VoxelType::Float32);
-  float* p = reinterpret_cast<float*>(v.mutableData());
-  for (int k = 0; k < d; ++k)
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) p[i + int64_t(w) * (j + int64_t(h) * k)] = f(i, j, k);
-  v.data = p;
-  return v;
+  return test::makeVolume<float>(w, h, d, VoxelType::Float32, f);
+}
+
+/// Shading by the light list alone (RenderParams::useLights) with these coefficients.
+RenderParams lightsOnly(double ambient, double diffuse, double specular, std::vector<Light> lights = {}) {
+  RenderParams r;
+  r.shade = r.useLights = true;
+  std::tie(r.ambient, r.diffuse, r.specular) = std::tie(ambient, diffuse, specular);
+  r.lights = std::move(lights);
+  return r;
 }
 
 vec4f centre(const Image& img) { return img.rgba[size_t(img.height / 2) * size_t(img.width) + size_t(img.width / 2)]; }
@@ -123,17 +126,6 @@ std::vector<Mode> sliceAndLightModes(const Volume& v) {
   iso.lights = lightKit();
   m.push_back({"iso-lightkit", iso});
   return m;
-}
-
-std::vector<BuildParams> skippingBuilders() {
-  std::vector<BuildParams> v;
-  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::LBVHCPU, BuilderKind::KdTreeCPU,
-                        BuilderKind::Hybrid})
-    v.push_back(test::builder(k));
-  BuildParams small = test::builder(BuilderKind::Grid);
-  small.brick = 4;
-  v.push_back(small);
-  return v;
 }
 
 }  // namespace
@@ -243,7 +235,7 @@ TEST(Slice, EveryBuilderEqualsNaiveAndLightsToo) {
                                                                    : TransferFunction::preset("ramp", lo, hi, 256);
         Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 30, 20, p, 40, BackendKind::CPU, m.rp);
         ASSERT_GT(test::coverage(ref), 0.0) << shape << " " << m.name << " renders nothing";
-        for (const BuildParams& bp : skippingBuilders()) {
+        for (const BuildParams& bp : test::skippingBuilders()) {
           Image img = test::renderWith(v, tf, bp, 30, 20, p, 40, BackendKind::CPU, m.rp);
           EXPECT_LE(compareImages(ref, img).maxAbs, 1.f / 255.f)
               << shape << " " << m.name << " " << builderName(bp.builder) << " brick " << bp.brick;
@@ -254,21 +246,14 @@ TEST(Slice, EveryBuilderEqualsNaiveAndLightsToo) {
 }
 
 TEST(Slice, CudaEqualsCpu) {
-  std::string why;
-  if (!cudaAvailable(&why)) GTEST_SKIP() << why;
+  SKIP_WITHOUT_CUDA();
   Volume v = generateVolume("vessels", vec3l{64, 61, 67});
   double lo, hi;
   ASSERT_TRUE(v.scalarRange(lo, hi));
   for (const Mode& m : sliceAndLightModes(v)) {
     const TransferFunction tf = m.rp.blend == BlendMode::Slice ? sliceTF(lo, hi)
                                                                : TransferFunction::preset("ramp", lo, hi, 256);
-    Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 30, 20, true, 64, BackendKind::CPU, m.rp);
-    ASSERT_GT(test::coverage(ref), 0.0) << m.name;
-    for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::LBVH,
-                          BuilderKind::KdTreeGPUFast, BuilderKind::Hybrid}) {
-      Image img = test::renderWith(v, tf, test::builder(k), 30, 20, true, 64, BackendKind::CUDA, m.rp);
-      EXPECT_LE(compareImages(ref, img).maxAbs, 2.f / 255.f) << m.name << " " << builderName(k);
-    }
+    test::expectCudaBuildersEqualCpuNaive(v, tf, m.rp, m.name);
   }
 }
 
@@ -284,13 +269,7 @@ TEST(Lights, DirectionalLightsTwoSidedColouredAndSummed) {
   };
   const Image plain = render(RenderParams{});
   ASSERT_GT(test::coverage(plain), 0.1);
-  RenderParams lit;
-  lit.shade = true;
-  lit.ambient = 0;
-  lit.diffuse = 1;
-  lit.specular = 0;
-  lit.useLights = true;
-  lit.lights = {directional(-1, 0, 0)};
+  RenderParams lit = lightsOnly(0, 1, 0, {directional(-1, 0, 0)});
   EXPECT_LE(compareImages(plain, render(lit)).maxAbs, 2e-3f);
   lit.twoSidedLighting = false;
   const vec4f dark = centre(render(lit));
@@ -332,13 +311,7 @@ TEST(Lights, SpecularFollowsTheReflection) {
   // light at 90 degrees to the normal gives none.
   Volume v = makeVolume(24, 24, 24, [](int i, int, int) { return float(23 - i) * 10.f; });
   TransferFunction tf = TransferFunction::fromPoints({{0, 0.f, 0.f, 0.f, 0.3f}, {230, 0.f, 0.f, 0.f, 0.3f}}, 0, 230, 256);
-  RenderParams lit;
-  lit.shade = true;
-  lit.ambient = 0;
-  lit.diffuse = 0;
-  lit.specular = 1;
-  lit.useLights = true;
-  lit.lights = {directional(-1, 0, 0)};
+  RenderParams lit = lightsOnly(0, 0, 1, {directional(-1, 0, 0)});
   const vec4f s = centre(test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 32, BackendKind::CPU, lit));
   EXPECT_NEAR(s.x / s.w, 1.f, 2e-3f);
   lit.lights = {directional(0, 1, 0)};
@@ -354,12 +327,7 @@ TEST(Lights, PositionalLightsAttenuateAndConeOut) {
   auto render = [&](const RenderParams& r) {
     return test::renderWith(v, tf, test::builder(BuilderKind::Grid), 90, 0, false, 32, BackendKind::CPU, r);
   };
-  RenderParams lit;
-  lit.shade = true;
-  lit.ambient = 0;
-  lit.diffuse = 1;
-  lit.specular = 0;
-  lit.useLights = true;
+  RenderParams lit = lightsOnly(0, 1, 0);
   Light p;
   p.positional = true;
   p.position[0] = 1e5;

@@ -1,13 +1,23 @@
 // Helpers shared by the Core tests.
 #pragma once
+#include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
 #include "spaceskip/Generators.h"
 #include "spaceskip/ImageIO.h"
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <string>
 #include <vector>
+
+/// Skips the test (GTEST_SKIP, saying why) where no CUDA device is usable.
+#define SKIP_WITHOUT_CUDA()                                               \
+  do {                                                                    \
+    std::string whyNoCuda;                                                \
+    if (!spaceskip::cudaAvailable(&whyNoCuda)) GTEST_SKIP() << whyNoCuda; \
+  } while (0)
 
 namespace spaceskip::test {
 
@@ -49,6 +59,43 @@ inline BuildParams builder(BuilderKind k, LeafCriterion leaf = LeafCriterion::De
   return p;
 }
 
+/// The CPU backend's skipping builders (test defaults), then Grid on bricks of 4 cells (many
+/// bricks, each with its own range) and, with `shallowMls`, a shallow k-d tree of MLS 32.
+inline std::vector<BuildParams> skippingBuilders(bool shallowMls = false) {
+  std::vector<BuildParams> v;
+  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::LBVHCPU, BuilderKind::KdTreeCPU,
+                        BuilderKind::Hybrid})
+    v.push_back(builder(k));
+  if (shallowMls) v.push_back(builder(BuilderKind::KdTreeCPU, LeafCriterion::Shallow, 32));
+  v.push_back(builder(BuilderKind::Grid, LeafCriterion::Deep, 0, 4, 4));
+  return v;
+}
+
+/// N-body 40x36x44 away from the origin with anisotropic spacing: index and world space differ.
+inline Volume offsetNbody() {
+  Volume v = generateVolume("nbody", vec3l{40, 36, 44});
+  v.origin[0] = -7.5;
+  v.origin[1] = 120;
+  v.origin[2] = 3;
+  v.spacing[0] = 0.5;
+  v.spacing[1] = 1.0;
+  v.spacing[2] = 0.75;
+  return v;
+}
+
+/// A w x h x d volume of T (voxel type `type`) filled by f(i, j, k), unit spacing.
+template <class T, class F>
+Volume makeVolume(int w, int h, int d, VoxelType type, F f) {
+  Volume v;
+  v.allocate(vec3l{w, h, d}, type);
+  T* p = reinterpret_cast<T*>(v.mutableData());
+  for (int k = 0; k < d; ++k)
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i) p[i + int64_t(w) * (j + int64_t(h) * k)] = T(f(i, j, k));
+  v.data = p;
+  return v;
+}
+
 inline double coverage(const Image& img) {
   double s = 0;
   for (const auto& p : img.rgba) s += p.w;
@@ -56,6 +103,19 @@ inline double coverage(const Image& img) {
 }
 
 /// Random piecewise-linear TF over [0, 255] (256 entries): about half its points transparent.
+/// Every CUDA builder draws the CPU Naive image of `v` (perspective orbit 30, 20; 64^2) within
+/// 2/255 under `tf` and `rp`; `name` labels the failures.
+inline void expectCudaBuildersEqualCpuNaive(const Volume& v, const TransferFunction& tf, const RenderParams& rp,
+                                            const std::string& name) {
+  const Image ref = renderWith(v, tf, builder(BuilderKind::Naive), 30, 20, true, 64, BackendKind::CPU, rp);
+  ASSERT_GT(coverage(ref), 0.0) << name;
+  for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::LBVH,
+                        BuilderKind::KdTreeGPUFast, BuilderKind::Hybrid}) {
+    const Image img = renderWith(v, tf, builder(k), 30, 20, true, 64, BackendKind::CUDA, rp);
+    EXPECT_LE(compareImages(ref, img).maxAbs, 2.f / 255.f) << name << " " << builderName(k);
+  }
+}
+
 inline TransferFunction randomTF(unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.f, 1.f);
