@@ -103,7 +103,7 @@ class CpuBackend final : public Backend {
     // On a CPU core a sample costs far more than a step of the part walk: Grid and DistanceGrid
     // frames walk the parts of sparse bricks wherever there are masks (GridParts; 1.06-1.53x
     // on seven of the paper's stand-ins at 1/4 scale, item by item in one process against the
-    // `:whole` bench suffix: docs/results/round9-cpu-parts).
+    // `:whole` bench suffix: docs/results/cpu-sub-brick-masks).
     const bool parts = traversal_ == TraversalKind::Grid && !sub_.mask.empty();
     if (parts) f.traversal = TraversalKind::GridParts;
     f.grid = GridView{parts ? sub_.state.data() : g.occ.data(), g.dims, g.brick, dist_.empty() ? nullptr : dist_.data(),

@@ -83,9 +83,9 @@ SS_FUNC bool isPlainFrame(const FrameView& f) {
 }
 
 /// Samples a GPU march fetches per step with a sampler (IntervalMarcher::takeBatch): the
-/// sampler's kBatch, else 1. Measured on the H100 (docs/results/round14-h100): with the hardware
-/// filter 4 a step is 1.04-1.22x faster, with exact trilinear sampling (8 loads and their index
-/// arithmetic per sample, 4 times over) 0.90-0.95x.
+/// sampler's kBatch, else 1. Measured on the H100 (docs/results/HISTORY.md, batches of
+/// samples): with the hardware filter 4 a step is 1.04-1.22x faster, with exact trilinear
+/// sampling (8 loads and their index arithmetic per sample, 4 times over) 0.90-0.95x.
 template <class S, class = void>
 struct SamplerBatch {
   static constexpr int value = 1;
@@ -316,7 +316,8 @@ struct IntervalMarcher {
   /// their voxel fetches are all issued before the first value is used, then their table
   /// lookups: on a GPU a run of samples otherwise waits for one memory latency per sample, one
   /// after another, which is what the rays crossing N-body's dense clusters spend their time on
-  /// (round 14). Other modes and dependent components call take() n times. false: terminate.
+  /// (batches of samples). Other modes and dependent components call take() n times. false:
+  /// terminate.
   SS_FUNC bool takeBatch(int64_t k, int n) {
     constexpr int kBatch = SamplerBatch<Sampler>::value;
     if constexpr (IsChannelSampler<Sampler>::value || !Plain || kBatch == 1) {
@@ -593,7 +594,7 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py, 
     } else {
       // One call of `march` for whole rays and segments alike: each call site is a copy of the
       // traversal and the batch of samples, and a GPU kernel twice that size ran several times
-      // slower on sparse data (its instructions no longer cached: round 14).
+      // slower on sparse data (its instructions no longer cached).
       float sa = a, sb = b;
       if (segments > 1) {
         m.t0 = a + lead;

@@ -5,7 +5,7 @@
 // stay together: a lane whose interval is used up takes one traversal step while its neighbours
 // take one sample, instead of the whole warp waiting for one lane's march of a long run (the
 // callback form this replaced ran at 49% SIMT efficiency on the Menger sponge, 97% for Naive:
-// docs/results/round6-h100/profile-dense-before). Written once for host and device.
+// docs/results/HISTORY.md, traversals as iterators). Written once for host and device.
 #pragma once
 #include "FrameShared.h"
 
@@ -28,7 +28,7 @@ struct GridIterT {
   // The DDA's per-axis state is vec3 (axisOf/setAxis, Math.h), never an array indexed by the
   // axis the ray steps along: that index is known at run time only, and such an array would put
   // the whole iterator in local memory on a GPU (152 bytes a thread, loaded and stored at every
-  // step of every ray: round 14).
+  // step of every ray: measured with the grid DDA's state in registers).
   const GridView* g;
   vec3f org, dir, inv;
   float t, tmax, B;
