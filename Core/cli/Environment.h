@@ -1,4 +1,4 @@
-// The one place that reads SPACESKIP_* environment variables for the tools: the CLI (main.cpp)
+// The one place that reads SPACESKIP_* environment variables for the tools: the CLI (Options.cpp)
 // and the window benchmark (VTKModule/Testing/Cxx/SpaceSkipWindowBench.cxx). The libraries read
 // none of these; they take a spaceskip::Tuning (Tuning.h). docs/tuning.md lists every variable.
 #pragma once

@@ -1,5 +1,6 @@
 // Command-line parsing for the spaceskip CLI: strict values, range checks, clear messages.
-// Separate from main.cpp so the option fuzzer (Testing/Fuzz) and the tests can call it.
+// Separate from the commands (Commands.h) so the option fuzzer (Testing/Fuzz) and the tests
+// can call it.
 #pragma once
 #include "spaceskip/Engine.h"
 #include "spaceskip/Tuning.h"
