@@ -1,11 +1,15 @@
 // vtkSpaceSkipInputConverter: the mapper's vtkImageData and scalar array -> a spaceskip::Volume.
 #include "vtkSpaceSkipInputConverter.h"
 
+#include "vtkCellData.h"
 #include "vtkDataArray.h"
+#include "vtkDataSetAttributes.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
 #include "vtkSMPTools.h"
 #include "vtkScalarsToColors.h"
+#include "vtkStructuredData.h"
+#include "vtkUnsignedCharArray.h"
 
 #include "spaceskip/Engine.h"
 
@@ -256,4 +260,104 @@ void vtkSpaceSkipInputConverter::Reset()
   this->InputMTime = this->ScalarsMTime = 0;
   this->HaveVolume = false;
   this->Borrowed = nullptr;
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipInputConverter::UnmarkedCells(vtkImageData* image, int cells[6])
+{
+  vtkUnsignedCharArray* g = image->GetCellData()->GetGhostArray();
+  if (!g || g->GetNumberOfTuples() == 0)
+  {
+    return 2;
+  }
+  // The first and the last cell that is not a duplicate bound the owned cells, as ParaView's
+  // volume representation does.
+  const vtkIdType n = g->GetNumberOfTuples();
+  const unsigned char* v = g->GetPointer(0);
+  const unsigned char dup = vtkDataSetAttributes::DUPLICATECELL;
+  vtkIdType first = 0, last = n - 1;
+  while (first < n && (v[first] & dup))
+  {
+    ++first;
+  }
+  while (last >= 0 && (v[last] & dup))
+  {
+    --last;
+  }
+  if (first > last)
+  {
+    return 0;
+  }
+  if (first == 0 && last == n - 1)
+  {
+    return 2;
+  }
+  int ext[6], ijk[3], ijk1[3];
+  image->GetExtent(ext);
+  vtkStructuredData::ComputeCellStructuredCoordsForExtent(first, ext, ijk);
+  vtkStructuredData::ComputeCellStructuredCoordsForExtent(last, ext, ijk1);
+  for (int a = 0; a < 3; ++a)
+  {
+    cells[2 * a] = ijk[a];
+    cells[2 * a + 1] = ijk1[a] + 1;
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+spaceskip::VolumePiece vtkSpaceSkipInputConverter::PieceOf(vtkImageData* input, const int whole[6],
+  const int* owned, bool exact, double bias, const WarnFunction& warn)
+{
+  spaceskip::VolumePiece piece;
+  int ext[6], w[6];
+  input->GetExtent(ext);
+  std::copy(whole, whole + 6, w);
+  bool haveWhole = w[0] <= w[1] && w[2] <= w[3] && w[4] <= w[5];
+  if (haveWhole &&
+    !(w[0] <= ext[0] && ext[1] <= w[1] && w[2] <= ext[2] && ext[3] <= w[3] && w[4] <= ext[4] &&
+      ext[5] <= w[5]))
+  {
+    warn("WholeExtent does not contain the input's extent: ignored (the input is drawn as a "
+         "whole image)");
+    haveWhole = false;
+  }
+  if (!haveWhole)
+  {
+    std::copy(ext, ext + 6, w);
+  }
+  // The cells of the input, [lo, hi) per axis (an axis of one point has one cell), then those
+  // it owns.
+  int all[6], own[6];
+  for (int a = 0; a < 3; ++a)
+  {
+    all[2 * a] = ext[2 * a];
+    all[2 * a + 1] = std::max(ext[2 * a + 1] - 1, ext[2 * a]) + 1;
+  }
+  std::copy(all, all + 6, own);
+  if (owned)
+  {
+    std::copy(owned, owned + 6, own);
+  }
+  else if (UnmarkedCells(input, own) == 0)
+  {
+    own[1] = own[0]; // all ghost: nothing owned
+  }
+  bool same = std::equal(own, own + 6, all);
+  for (int i = 0; i < 6; ++i)
+  {
+    same = same && w[i] == ext[i];
+  }
+  if (same)
+  {
+    return piece;
+  }
+  input->TransformIndexToPhysicalPoint(w[0], w[2], w[4], piece.wholeOrigin);
+  piece.wholeDims = spaceskip::vec3l{ w[1] - w[0] + 1, w[3] - w[2] + 1, w[5] - w[4] + 1 };
+  piece.offset = spaceskip::vec3l{ ext[0] - w[0], ext[2] - w[2], ext[4] - w[4] };
+  piece.ownedLo = spaceskip::vec3l{ own[0] - w[0], own[2] - w[2], own[4] - w[4] };
+  piece.ownedHi = spaceskip::vec3l{ own[1] - w[0], own[3] - w[2], own[5] - w[4] };
+  // The window and IceT hold 8 bits: a piece in front rounds up by half a unit what IceT's
+  // blend truncates (docs/paraview.md).
+  piece.followBias = exact ? 0.f : static_cast<float>(bias / 255.0);
+  return piece;
 }

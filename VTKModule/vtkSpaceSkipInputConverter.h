@@ -15,6 +15,7 @@ class vtkImageData;
 namespace spaceskip
 {
 class Engine;
+struct VolumePiece;
 }
 
 class vtkSpaceSkipInputConverter
@@ -52,6 +53,24 @@ public:
   const double* GetOpacityRange() const { return this->Dependent ? this->OpacityRange : nullptr; }
   /// Dependent components: the opacity component's index (its unit distance is used, as VTK's).
   int GetOpacityComponent() const { return this->Dependent ? this->NumberOfComponents - 1 : 0; }
+
+  /**
+   * The cells of `image` its vtkGhostType cell array does not mark as duplicates of another
+   * piece's (the ghost layers on an image piece's faces), [lo, hi) per axis in its extent's
+   * indices: 1 with `cells` set from the array, 2 when nothing is marked (`cells` left as given),
+   * 0 when every cell is.
+   */
+  static int UnmarkedCells(vtkImageData* image, int cells[6]);
+
+  /**
+   * The input as a piece of the image of extent `whole` (an empty `whole`: its own extent), and
+   * the cells it draws: its unmarked cells (UnmarkedCells), or `owned` ([lo, hi) per axis,
+   * whole-extent indices) when given (a block of a composite input). Inactive (the serial path)
+   * when the input is the whole image without ghosts. `exact`: no rounding bias (a piece
+   * composited in float); else `bias` (Tuning::pieceBias, in 1/255).
+   */
+  static spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
+    bool exact, double bias, const WarnFunction& warn);
 
   /// Forgets what the engine was given (a new engine): the next Update hands the volume again.
   void Reset();

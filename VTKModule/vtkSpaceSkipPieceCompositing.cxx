@@ -1,6 +1,9 @@
 #include "vtkSpaceSkipPieceCompositing.h"
 
 #include "vtkCamera.h"
+#include "vtkCellData.h"
+#include "vtkFloatArray.h"
+#include "vtkPointData.h"
 #include "vtkImageData.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNew.h"
@@ -9,8 +12,10 @@
 
 #include "spaceskip/PieceOrder.h"
 #include "spaceskip/Types.h"
+#include "spaceskip/VolumePiece.h"
 
 #include <algorithm>
+#include <string>
 
 namespace vtkSpaceSkipPieceCompositing
 {
@@ -119,5 +124,47 @@ void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const dou
       }
     }
   }
+}
+
+//------------------------------------------------------------------------------
+PieceImage CropPiece(const float* image, int width, int height, const spaceskip::VolumePiece& p,
+  vtkImageData* input, const int wholeExtent[6])
+{
+  int ext[6], owned[6];
+  input->GetExtent(ext);
+  const int shift[3] = { wholeExtent[0], wholeExtent[2], wholeExtent[4] };
+  for (int a = 0; a < 3; ++a)
+  {
+    owned[2 * a] = p.active() ? static_cast<int>(p.ownedLo[a]) : ext[2 * a] - shift[a];
+    owned[2 * a + 1] = p.active() ? static_cast<int>(p.ownedHi[a])
+                                  : std::max(ext[2 * a + 1], ext[2 * a] + 1) - shift[a];
+  }
+  return Crop(image, width, height, owned);
+}
+
+//------------------------------------------------------------------------------
+vtkImageData* EmptyPiece(const char* arrayName, int arrayId, vtkSmartPointer<vtkImageData>& cache,
+  std::string& cacheName)
+{
+  const std::string name = arrayName ? arrayName : "";
+  if (cache && cacheName == name)
+  {
+    return cache;
+  }
+  cacheName = name;
+  cache = vtkSmartPointer<vtkImageData>::New();
+  for (vtkDataSetAttributes* attributes :
+    { static_cast<vtkDataSetAttributes*>(cache->GetPointData()),
+      static_cast<vtkDataSetAttributes*>(cache->GetCellData()) })
+  {
+    for (int i = 0; i <= std::max(arrayId, 0) && i < 16; ++i)
+    {
+      vtkNew<vtkFloatArray> array;
+      array->SetName(i == 0 && !name.empty() ? name.c_str() : ("empty piece " + std::to_string(i)).c_str());
+      attributes->AddArray(array);
+    }
+    attributes->SetActiveScalars(attributes->GetAbstractArray(0)->GetName());
+  }
+  return cache;
 }
 }

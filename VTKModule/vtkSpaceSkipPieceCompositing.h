@@ -4,8 +4,11 @@
 #ifndef vtkSpaceSkipPieceCompositing_h
 #define vtkSpaceSkipPieceCompositing_h
 
-#include "vtkSpaceSkippingVolumeMapper.h" // For PieceImage
+#include "vtkSpaceSkipPieceExchange.h" // For vtkSpaceSkipPieceImage
 
+#include "vtkSmartPointer.h" // For EmptyPiece
+
+#include <string> // For EmptyPiece
 #include <vector> // For the pieces
 
 class vtkImageData;
@@ -14,15 +17,28 @@ class vtkVolume;
 namespace spaceskip
 {
 struct Image;
+struct VolumePiece;
 }
 
 namespace vtkSpaceSkipPieceCompositing
 {
-using PieceImage = vtkSpaceSkippingVolumeMapper::PieceImage;
+using PieceImage = vtkSpaceSkipPieceImage;
 
 /// The rectangle of the pixels `image` (`width` x `height` premultiplied RGBA floats, row 0 at
 /// the bottom) drew, as a piece with the cells `owned`; empty when it drew none.
 PieceImage Crop(const float* image, int width, int height, const int owned[6]);
+
+/// Crop() for an image piece: the cells it drew (`piece`, or when inactive its whole extent)
+/// in the index space of `wholeExtent` (less its first index).
+PieceImage CropPiece(const float* image, int width, int height, const spaceskip::VolumePiece& piece,
+  vtkImageData* input, const int wholeExtent[6]);
+
+/// What a process with an empty piece hands ParaView's vtkPVLODVolume as the mapper's input
+/// (it draws a mapper only when GetInput() has the selected scalars): an empty image with empty
+/// arrays, the first named `arrayName` (point and cell data, up to `arrayId`); `cache` keeps it
+/// (made again when `cacheName`, the name it was made for, differs).
+vtkImageData* EmptyPiece(const char* arrayName, int arrayId, vtkSmartPointer<vtkImageData>& cache,
+  std::string& cacheName);
 
 /// The camera in the index space of `lattice`, less `shift` per axis: the eye, the direction of
 /// projection, and whether the projection is parallel.

@@ -15,8 +15,9 @@
 #include "vtkPlane.h"
 #include "vtkPlaneCollection.h"
 #include "vtkRenderer.h"
-#include "vtkSpaceSkippingVolumeMapper.h"
+#include "vtkSpaceSkipSettings.h"
 #include "vtkVolume.h"
+#include "vtkVolumeMapper.h"
 #include "vtkVolumeProperty.h"
 
 #include "spaceskip/Engine.h"
@@ -30,10 +31,6 @@ namespace
 // Table resolution of the transfer function, sampled over the data's scalar range (what
 // vtkGPUVolumeRayCastMapper does by default, ColorRangeType == SCALAR).
 constexpr int kTableSize = 1024;
-// BuilderTypes are cast to spaceskip::BuilderKind: the two enums must stay in the same order.
-static_assert(static_cast<int>(spaceskip::BuilderKind::Hybrid) == vtkSpaceSkippingVolumeMapper::Hybrid &&
-    static_cast<int>(spaceskip::BuilderKind::DistanceGrid) == vtkSpaceSkippingVolumeMapper::DistanceGrid,
-  "vtkSpaceSkippingVolumeMapper::BuilderTypes out of step with spaceskip::BuilderKind");
 // Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
 constexpr double kErtThreshold = 0.99;
 
@@ -149,9 +146,10 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& e
 
 //------------------------------------------------------------------------------
 void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
-  vtkSpaceSkippingVolumeMapper* mapper, int blendMode, vtkRenderer* ren, vtkVolume* vol,
-  const double scalarRange[2], const WarnFunction& warnOnce)
+  const vtkSpaceSkipSettings& s, vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
+  const WarnFunction& warnOnce)
 {
+  const int blendMode = s.EffectiveBlendMode();
   // Features of vtkVolumeProperty/vtkVolumeMapper the engine does not have: said once each.
   auto unsupported = [&](bool used, bool& warned, const char* what) {
     if (used && !warned)
@@ -167,31 +165,30 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
     this->WarnedBlend, "unknown blend mode; rendering with composite blending");
 
   spaceskip::BuildParams bp;
-  bp.builder = static_cast<spaceskip::BuilderKind>(mapper->GetBuilder());
-  bp.leaf = static_cast<spaceskip::LeafCriterion>(mapper->GetLeafCriterion());
-  bp.maxLeafSize = mapper->GetMaxLeafSize();
-  bp.bins = mapper->GetBinCount();
+  bp.builder = static_cast<spaceskip::BuilderKind>(s.Builder);
+  bp.leaf = static_cast<spaceskip::LeafCriterion>(s.LeafCriterion);
+  bp.maxLeafSize = s.MaxLeafSize;
+  bp.bins = s.BinCount;
   // A new size makes the engine recompute the value ranges, re-classify and rebuild.
-  bp.brick = mapper->GetMacroCellSize();
+  bp.brick = s.MacroCellSize;
   engine.setBuildParams(bp);
   spaceskip::RenderParams rp = engine.renderParams();
-  rp.sampleDistance = mapper->GetSampleDistance();
-  rp.ertThreshold = mapper->GetEarlyRayTermination() ? kErtThreshold : 2.0;
-  rp.jitter = mapper->GetUseJittering() != 0;
-  // The engine's own values (vtkSpaceSkippingVolumeMapper::FilterModeTypes); the CPU backend
-  // samples exactly whatever this says.
-  rp.filter = mapper->GetFilterMode() == vtkSpaceSkippingVolumeMapper::HardwareFilter
+  rp.sampleDistance = s.SampleDistance;
+  rp.ertThreshold = s.EarlyRayTermination ? kErtThreshold : 2.0;
+  rp.jitter = s.UseJittering;
+  // The engine's own values (vtkSpaceSkippingVolumeMapper::FilterModeTypes, 1: HardwareFilter);
+  // the CPU backend samples exactly whatever this says.
+  rp.filter = s.FilterMode == static_cast<int>(spaceskip::FilterMode::Hardware)
     ? spaceskip::FilterMode::Hardware
     : spaceskip::FilterMode::Exact;
   // Cropping: the planes are in the data's coordinates, as the engine's.
-  rp.cropping = mapper->GetCropping() != 0;
-  const double* crop = mapper->GetCroppingRegionPlanes();
-  std::copy(crop, crop + 6, rp.croppingPlanes);
-  rp.croppingFlags = mapper->GetCroppingRegionFlags();
+  rp.cropping = s.Cropping;
+  std::copy(s.CroppingRegionPlanes, s.CroppingRegionPlanes + 6, rp.croppingPlanes);
+  rp.croppingFlags = s.CroppingRegionFlags;
   // Clipping planes are in world coordinates; the engine works in the data's, so each plane
   // n.X + d >= 0 becomes (A^T n).x + (n.t + d) >= 0 for X = A x + t, A the volume's matrix.
   rp.clipPlanes.clear();
-  if (vtkPlaneCollection* planes = mapper->GetClippingPlanes())
+  if (vtkPlaneCollection* planes = s.ClippingPlanes)
   {
     vtkMatrix4x4* A = vol->GetMatrix();
     planes->InitTraversal();
@@ -211,18 +208,19 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
     }
   }
   // Where vtkGPUVolumeRayCastMapper samples first: one step in, or the jitter alone.
-  rp.firstSampleOffset = mapper->GetUseJittering() ? 0.0 : 1.0;
-  this->SetBlendAndShading(rp, mapper, blendMode, ren, vol, scalarRange, warnOnce);
+  rp.firstSampleOffset = s.UseJittering ? 0.0 : 1.0;
+  this->SetBlendAndShading(rp, s, ren, vol, scalarRange, warnOnce);
   engine.setRenderParams(rp);
 }
 
 //------------------------------------------------------------------------------
-// Blend mode, iso values, the slice plane and shading from the mapper, the volume property and
+// Blend mode, iso values, the slice plane and shading from the settings, the volume property and
 // the renderer's lights, as vtkGPUVolumeRayCastMapper reads them.
 void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams& rp,
-  vtkSpaceSkippingVolumeMapper* mapper, int mode, vtkRenderer* ren, vtkVolume* vol,
-  const double scalarRange[2], const WarnFunction& warnOnce)
+  const vtkSpaceSkipSettings& s, vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
+  const WarnFunction& warnOnce)
 {
+  const int mode = s.EffectiveBlendMode();
   rp.blend = mode >= vtkVolumeMapper::COMPOSITE_BLEND && mode <= vtkVolumeMapper::SLICE_BLEND
     ? static_cast<spaceskip::BlendMode>(mode)
     : spaceskip::BlendMode::Composite; // warned above
@@ -238,13 +236,12 @@ void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams&
   }
   rp.scalarRange[0] = scalarRange[0];
   rp.scalarRange[1] = scalarRange[1];
-  const double* avg = mapper->GetAverageIPScalarRange();
-  rp.averageRange[0] = avg[0];
-  rp.averageRange[1] = avg[1];
+  rp.averageRange[0] = s.AverageIPScalarRange[0];
+  rp.averageRange[1] = s.AverageIPScalarRange[1];
 
   if (rp.blend == spaceskip::BlendMode::Slice)
   {
-    this->SetSlicePlane(rp, mapper, vol, warnOnce);
+    this->SetSlicePlane(rp, s, vol, warnOnce);
   }
 
   rp.shade = prop->GetShade(0) != 0;
@@ -327,7 +324,7 @@ void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams&
 // coordinates (as vtkGPUVolumeRayCastMapper reads its origin and normal), into the volume's
 // physical frame; anything else: one warning and the plane through the data's centre, normal z.
 void vtkSpaceSkipPropertyTranslator::SetSlicePlane(spaceskip::RenderParams& rp,
-  vtkSpaceSkippingVolumeMapper* mapper, vtkVolume* vol, const WarnFunction& warnOnce)
+  const vtkSpaceSkipSettings& s, vtkVolume* vol, const WarnFunction& warnOnce)
 {
   vtkImplicitFunction* func = vol->GetProperty()->GetSliceFunction();
   vtkPlane* plane = vtkPlane::SafeDownCast(func);
@@ -341,7 +338,7 @@ void vtkSpaceSkipPropertyTranslator::SetSlicePlane(spaceskip::RenderParams& rp,
         "; slicing through the centre of the volume, normal to z");
       this->WarnedSlice = true;
     }
-    const double* b = mapper->GetBounds();
+    const double* b = s.Bounds;
     for (int k = 0; k < 3; ++k)
     {
       rp.sliceOrigin[k] = 0.5 * (b[2 * k] + b[2 * k + 1]);

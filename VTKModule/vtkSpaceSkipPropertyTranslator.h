@@ -1,5 +1,5 @@
-// vtkSpaceSkipPropertyTranslator: vtkVolumeProperty, the mapper's settings, the renderer's
-// lights and camera -> Core's TransferFunction, BuildParams, RenderParams and Camera.
+// vtkSpaceSkipPropertyTranslator: vtkVolumeProperty, the mapper's settings (vtkSpaceSkipSettings,
+// values), the renderer's lights and camera -> Core's TransferFunction, BuildParams, RenderParams and Camera.
 // Internal to the module (not wrapped, not installed).
 #ifndef vtkSpaceSkipPropertyTranslator_h
 #define vtkSpaceSkipPropertyTranslator_h
@@ -12,9 +12,9 @@
 
 class vtkOpenGLCamera;
 class vtkRenderer;
-class vtkSpaceSkippingVolumeMapper;
 class vtkVolume;
 class vtkVolumeProperty;
+struct vtkSpaceSkipSettings;
 namespace spaceskip
 {
 class Engine;
@@ -41,15 +41,14 @@ public:
     const double scalarRange[2], const double* opacityRange = nullptr, int opacityComponent = 0);
 
   /**
-   * Gives the engine the mapper's build parameters and its render parameters (blend mode
-   * `blendMode`, iso values, shading and lights, cropping, clipping planes, jitter, early ray
+   * Gives the engine the build parameters and the render parameters of `settings` (its
+   * effective blend mode, iso values, shading and lights, cropping, clipping planes, jitter, early ray
    * termination, the slice plane). What it lacks or cuts (nearest interpolation, more than
    * spaceskip::kMaxLights lights, a slice function that is not a vtkPlane) is said once each
    * through `warnOnce`.
    */
-  void UpdateParameters(spaceskip::Engine& engine, vtkSpaceSkippingVolumeMapper* mapper,
-    int blendMode, vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
-    const WarnFunction& warnOnce);
+  void UpdateParameters(spaceskip::Engine& engine, const vtkSpaceSkipSettings& settings,
+    vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2], const WarnFunction& warnOnce);
 
   /**
    * The engine's camera: the volume's matrix is folded into the view, so the engine marches in
@@ -65,10 +64,10 @@ public:
   int GetOpacityTableSamples() const { return this->OpacitySamples; }
 
 private:
-  void SetBlendAndShading(spaceskip::RenderParams& rp, vtkSpaceSkippingVolumeMapper* mapper,
-    int mode, vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
+  void SetBlendAndShading(spaceskip::RenderParams& rp, const vtkSpaceSkipSettings& settings,
+    vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2],
     const WarnFunction& warnOnce);
-  void SetSlicePlane(spaceskip::RenderParams& rp, vtkSpaceSkippingVolumeMapper* mapper,
+  void SetSlicePlane(spaceskip::RenderParams& rp, const vtkSpaceSkipSettings& settings,
     vtkVolume* vol, const WarnFunction& warnOnce);
 
   // What the engine was last given; compared by identity and MTime to redo only what changed.

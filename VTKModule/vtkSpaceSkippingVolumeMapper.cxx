@@ -2,46 +2,41 @@
 // window. Render() is the sequence of steps; the work is in vtkSpaceSkipInputConverter (the
 // input -> a Core Volume), vtkSpaceSkipPropertyTranslator (property, settings, lights, camera ->
 // Core parameters) and vtkSpaceSkipCompositor (depth readback, upload or interop, blending).
+// Composite input goes to the vtkSpaceSkipMultiBlockVolumeMapper this mapper owns.
 #include "vtkSpaceSkippingVolumeMapper.h"
 
-#include "vtkCellData.h"
-#include "vtkDataSetAttributes.h"
-#include "vtkFloatArray.h"
-#include "vtkPointData.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
-#include "vtkStructuredData.h"
-#include "vtkCamera.h"
-#include "vtkMatrix4x4.h"
-#include "vtkNew.h"
-#include "vtkUnsignedCharArray.h"
-#include "vtkLogger.h"
 #include "vtkMath.h"
+#include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkRenderer.h"
-#include "vtkSpaceSkipBlockRenderer.h"
-#include "vtkSpaceSkipCompositor.h"
-#include "vtkSpaceSkipInputConverter.h"
+#include "vtkSpaceSkipImageRenderer.h"
+#include "vtkSpaceSkipMultiBlockVolumeMapper.h"
 #include "vtkSpaceSkipPieceCompositing.h"
-#include "vtkSpaceSkipPropertyTranslator.h"
+#include "vtkSpaceSkipSettings.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
-#include "vtk_glew.h"
 
 #include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <functional>
-#include <iostream>
 #include <set>
 #include <string>
+
+// BuilderTypes and FilterModeTypes are cast to Core's enums: they must stay in the same order.
+static_assert(static_cast<int>(spaceskip::BuilderKind::Hybrid) == vtkSpaceSkippingVolumeMapper::Hybrid &&
+    static_cast<int>(spaceskip::BuilderKind::DistanceGrid) == vtkSpaceSkippingVolumeMapper::DistanceGrid,
+  "vtkSpaceSkippingVolumeMapper::BuilderTypes out of step with spaceskip::BuilderKind");
+static_assert(static_cast<int>(spaceskip::FilterMode::Hardware) == vtkSpaceSkippingVolumeMapper::HardwareFilter,
+  "vtkSpaceSkippingVolumeMapper::FilterModeTypes out of step with spaceskip::FilterMode");
 
 namespace
 {
@@ -62,18 +57,10 @@ const EnvironmentOverrides& Overrides()
     EnvironmentOverrides r;
     const char* e = std::getenv("SPACESKIP_BACKEND");
     const std::string v = e ? e : "";
-    if (v == "cpu" || v == "CPU")
-    {
-      r.Backend = vtkSpaceSkippingVolumeMapper::CPU;
-    }
-    else if (v == "cuda" || v == "CUDA")
-    {
-      r.Backend = vtkSpaceSkippingVolumeMapper::CUDA;
-    }
-    else if (v == "auto" || v == "Auto")
-    {
-      r.Backend = vtkSpaceSkippingVolumeMapper::Auto;
-    }
+    r.Backend = v == "cpu" || v == "CPU" ? vtkSpaceSkippingVolumeMapper::CPU
+      : v == "cuda" || v == "CUDA"       ? vtkSpaceSkippingVolumeMapper::CUDA
+      : v == "auto" || v == "Auto"       ? vtkSpaceSkippingVolumeMapper::Auto
+                                         : -1;
     if (r.Backend >= 0)
     {
       vtkGenericWarningMacro("SPACESKIP_BACKEND=" << v << " in the environment overrides the "
@@ -85,105 +72,24 @@ const EnvironmentOverrides& Overrides()
   return o;
 }
 
-// The input as a piece of the image of extent `whole` (an empty `whole`: its own extent), and
-// the cells it draws: those its vtkGhostType cell array does not mark as duplicates of another
-// piece's, or `owned` ([lo, hi) cells per axis, whole-extent indices) when given (a block of a
-// composite input: drawn exactly, composited in float). Inactive (the serial path, untouched)
-// when the input is the whole image without ghosts.
-spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
-  bool exact, double bias, const std::function<void(const std::string&)>& warn)
-{
-  spaceskip::VolumePiece piece;
-  int ext[6], w[6];
-  input->GetExtent(ext);
-  std::copy(whole, whole + 6, w);
-  bool haveWhole = w[0] <= w[1] && w[2] <= w[3] && w[4] <= w[5];
-  if (haveWhole &&
-    !(w[0] <= ext[0] && ext[1] <= w[1] && w[2] <= ext[2] && ext[3] <= w[3] && w[4] <= ext[4] &&
-      ext[5] <= w[5]))
-  {
-    warn("WholeExtent does not contain the input's extent: ignored (the input is drawn as a "
-         "whole image)");
-    haveWhole = false;
-  }
-  if (!haveWhole)
-  {
-    std::copy(ext, ext + 6, w);
-  }
-  // Owned cells, [lo, hi] inclusive in cell indices (an axis of one point has one cell).
-  int own[6];
-  for (int a = 0; a < 3; ++a)
-  {
-    own[2 * a] = ext[2 * a];
-    own[2 * a + 1] = std::max(ext[2 * a + 1] - 1, ext[2 * a]);
-  }
-  bool ghosts = false;
-  if (owned)
-  {
-    for (int a = 0; a < 3; ++a)
-    {
-      own[2 * a] = owned[2 * a];
-      own[2 * a + 1] = owned[2 * a + 1] - 1;
-      ghosts = ghosts || own[2 * a] != ext[2 * a] || own[2 * a + 1] != std::max(ext[2 * a + 1] - 1, ext[2 * a]);
-    }
-  }
-  else if (vtkUnsignedCharArray* g = input->GetCellData()->GetGhostArray())
-  {
-    // The first and the last cell that is not a duplicate bound the owned cells (an image
-    // piece's ghost cells are layers on its faces), as ParaView's volume representation does.
-    const vtkIdType n = g->GetNumberOfTuples();
-    const unsigned char* v = g->GetPointer(0);
-    const unsigned char dup = vtkDataSetAttributes::DUPLICATECELL;
-    vtkIdType first = 0, last = n - 1;
-    while (first < n && (v[first] & dup))
-    {
-      ++first;
-    }
-    while (last >= 0 && (v[last] & dup))
-    {
-      --last;
-    }
-    ghosts = first > 0 || last < n - 1;
-    if (first > last)
-    {
-      own[1] = own[0] - 1; // all ghost: nothing owned
-    }
-    else if (ghosts)
-    {
-      int ijk[3], ijk1[3];
-      vtkStructuredData::ComputeCellStructuredCoordsForExtent(first, ext, ijk);
-      vtkStructuredData::ComputeCellStructuredCoordsForExtent(last, ext, ijk1);
-      for (int a = 0; a < 3; ++a)
-      {
-        own[2 * a] = ijk[a];
-        own[2 * a + 1] = ijk1[a];
-      }
-    }
-  }
-  bool same = !ghosts;
-  for (int i = 0; i < 6; ++i)
-  {
-    same = same && w[i] == ext[i];
-  }
-  if (same)
-  {
-    return piece;
-  }
-  input->TransformIndexToPhysicalPoint(w[0], w[2], w[4], piece.wholeOrigin);
-  piece.wholeDims = spaceskip::vec3l{ w[1] - w[0] + 1, w[3] - w[2] + 1, w[5] - w[4] + 1 };
-  piece.offset = spaceskip::vec3l{ ext[0] - w[0], ext[2] - w[2], ext[4] - w[4] };
-  piece.ownedLo = spaceskip::vec3l{ own[0] - w[0], own[2] - w[2], own[4] - w[4] };
-  piece.ownedHi = spaceskip::vec3l{ own[1] + 1 - w[0], own[3] + 1 - w[2], own[5] + 1 - w[4] };
-  // The window and IceT hold 8 bits: a piece in front rounds up by half a unit what IceT's
-  // blend truncates (README, Parallel). `bias`: Tuning::pieceBias (in 1/255).
-  piece.followBias = exact ? 0.f : static_cast<float>(bias / 255.0);
-  return piece;
-}
-
 double SecondsSince(std::chrono::steady_clock::time_point t0)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+#define vtkStatisticGetterMacro(type, name, field, deviceTimes)                                    \
+  type vtkSpaceSkippingVolumeMapper::Get##name() { return this->Internals->Statistics(deviceTimes).field; }
+
+bool IsComposite(vtkDataObject* input)
+{
+  return vtkCompositeDataSet::SafeDownCast(input) != nullptr;
+}
+
+bool HasExtent(const int e[6])
+{
+  return e[0] <= e[1] && e[2] <= e[3] && e[4] <= e[5];
+}
+
 } // namespace
 
 struct vtkSpaceSkippingVolumeMapper::vtkInternals
@@ -191,62 +97,48 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   explicit vtkInternals(vtkSpaceSkippingVolumeMapper* self)
     : Self(self)
     , Warn([self](const std::string& m) { self->WarnOnce(m); })
+    , Image(this->Warn, [this](const std::string& m) { this->Fail(m); },
+        // The engine's steps as the algorithm's progress (ParaView's progress bar): the text
+        // names the step, the fraction runs over the update and frame together.
+        [self](double fraction, const char* step) {
+          const std::string text = std::string("Space Skipping Volume: ") + step;
+          if (!self->GetProgressText() || text != self->GetProgressText())
+          {
+            self->SetProgressText(text.c_str());
+          }
+          self->UpdateProgress(fraction);
+        })
   {
+    this->Image.SetReport(Overrides().Report);
   }
 
   vtkSpaceSkippingVolumeMapper* Self;
   // The mapper's WarnOnce, for the engine and the helpers below.
   const std::function<void(const std::string&)> Warn;
-
-  std::unique_ptr<spaceskip::Engine> Engine;
-  int EngineBackend = -1;
-  spaceskip::Counters CountOffset; // stages run by engines replaced after a Backend change
-
-  vtkSpaceSkipInputConverter Input;
-  vtkSpaceSkipPropertyTranslator Properties;
-
   // One message per distinct problem, not one per frame.
   std::string LastProblem;
   // Warnings (engine fallbacks, clamps) already said by this mapper: each cause once, also
   // across the engines that backend switches create.
   std::set<std::string> Said;
-  double SampleDistanceUsed = 0;
-  std::string BuilderChoice;
-  std::string Residency = "none";
-  vtkIdType ResidentBricks = 0;
-
-  std::string BackendUsed = "none";
-  std::string BuilderUsed = "none";
-  // SPACESKIP_REPORT set: one stdout line per mapper whenever backend or builder changes.
-  bool Report = Overrides().Report;
   spaceskip::Tuning Tuning; // SetTuning
-  std::string Reported;
+  vtkSpaceSkipStatistics Asked; // the last statistics asked for (the getters' strings live here)
 
-  // Where the last Render() spent its time (seconds; see the getters).
-  double RangeSeconds = 0;
-  double UpdateSeconds = 0;
-  double DepthSeconds = 0;
-  bool DepthRead = false; // the last frame read the window's depth (SceneHasDepth)
-  double EngineSeconds = 0;
-  double CompositeSeconds = 0;
-  double MapperSeconds = 0;
-  int CompositeRect[4] = { 0, 0, 0, 0 }; // the viewport rectangle the last frame blended
-
-  spaceskip::Image Image;
-  bool DeferredReady = false; // DeferDraw: Image holds this Render()'s frame
-  spaceskip::VolumePiece LastPiece; // the piece the last frame drew (inactive: the whole input)
   // Float compositing across processes (SetPieceExchange), and the image it hands back.
-  std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange> Exchange;
+  std::shared_ptr<vtkSpaceSkipPieceExchange> Exchange;
   double WholeBounds[6] = { 1, -1, 1, -1, 1, -1 };
   // GetInput() of a process with an empty piece (see there), and the array name it carries.
   vtkSmartPointer<vtkImageData> EmptyPiece;
   std::string EmptyPieceArray;
   spaceskip::Image Exchanged;
-  const float* FrameDepth = nullptr; // this frame's depth (the compositor's buffer), or null
-  // Last, so that it goes (with its CUDA-GL interop registration) before the engine.
-  vtkSpaceSkipCompositor Compositor;
-  // Composite input: one mapper per image block (each with its engine and compositor).
-  vtkSpaceSkipBlockRenderer Blocks;
+  // Image input: the engine and the window (vtkSpaceSkipImageRenderer); composite input: the
+  // composite mapper that draws it with one mapper per image block (vtkBlock).
+  vtkSpaceSkipImageRenderer Image;
+  vtkSmartPointer<vtkSpaceSkipMultiBlockVolumeMapper> Composite;
+  // How a frame is drawn: a block of composite input (set by vtkBlock) or a piece for the
+  // exchange keeps its float image, with the table range of all blocks and its own cells.
+  vtkSpaceSkipImageRenderer::FrameMode Mode;
+  double TableRange[2] = { 0, 1 };
+  int Owned[6] = { 0, 0, 0, 0, 0, 0 };
 
   // Reports a problem once (until the next different one); the caller then draws nothing.
   void Fail(const std::string& msg)
@@ -258,232 +150,114 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
     }
   }
 
-  bool SelectInput(vtkVolume* vol);
-  bool UpdateEngine();
-  void RenderFrame(vtkOpenGLRenderWindow* renWin, bool sceneHasDepth, const spaceskip::Camera& camera, int x0, int y0,
-    int width, int height);
-  bool Composite(vtkOpenGLRenderWindow* renWin, vtkImageData* input,
-    const spaceskip::Camera& camera, int width, int height);
-  void ReportPaths();
-
-  spaceskip::Counters Counts() const
+  void RenderImage(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam);
+  void RenderComposite(vtkRenderer* ren, vtkVolume* vol, vtkDataObject* input);
+  vtkSpaceSkipMultiBlockVolumeMapper* CompositeMapper();
+  const vtkSpaceSkipStatistics& Statistics(bool deviceTimes)
   {
-    spaceskip::Counters c = this->CountOffset;
-    if (this->Engine)
+    this->Asked = this->Composite ? this->Composite->GetStatistics(deviceTimes)
+                                  : this->Image.Statistics(deviceTimes);
+    return this->Asked;
+  }
+};
+
+// A block of composite input as the composite mapper drives it: a mapper of this class.
+struct vtkSpaceSkippingVolumeMapper::vtkBlock : public vtkSpaceSkipMultiBlockVolumeMapper::BlockMapper
+{
+  vtkNew<vtkSpaceSkippingVolumeMapper> Mapper;
+  vtkInternals& D = *this->Mapper->Internals;
+
+  void SetInput(vtkImageData* image) override
+  {
+    if (this->Mapper->GetInputDataObject(0, 0) != image)
     {
-      const spaceskip::Counters& e = this->Engine->counters();
-      c.rangeGrids += e.rangeGrids;
-      c.classifications += e.classifications;
-      c.builds += e.builds;
-      c.colorUpdates += e.colorUpdates;
-      c.frames += e.frames;
-      c.colorCompares += e.colorCompares;
-      c.opacityCompares += e.opacityCompares;
+      this->Mapper->SetInputData(image);
     }
-    return c;
+  }
+  void Configure(const vtkSpaceSkipSettings& s, bool padded, const double range[2],
+    const int* whole, const int* owned) override
+  {
+    s.ApplyTo(this->Mapper.GetPointer(), padded);
+    const int none[6] = { 0, -1, 0, -1, 0, -1 };
+    this->Mapper->SetWholeExtent(whole ? whole : none);
+    std::copy_n(range, 2, this->D.TableRange);
+    std::copy_n(owned ? owned : none, 6, this->D.Owned);
+    this->D.Mode.TableRange = this->D.TableRange;
+    this->D.Mode.Owned = owned ? this->D.Owned : nullptr;
+    this->D.Mode.Defer = true;
+  }
+  const float* Render(vtkRenderer* ren, vtkVolume* vol, const float* incomingAlpha, int& width,
+    int& height) override
+  {
+    this->D.Mode.IncomingAlpha = incomingAlpha;
+    this->Mapper->Render(ren, vol);
+    this->D.Mode.IncomingAlpha = nullptr;
+    return this->D.Image.DeferredImage(width, height);
+  }
+  vtkSpaceSkipStatistics GetStatistics(bool deviceTimes) override
+  {
+    return this->D.Statistics(deviceTimes);
+  }
+  void ReleaseGraphicsResources(vtkWindow* win) override
+  {
+    this->Mapper->ReleaseGraphicsResources(win);
   }
 };
 
 //------------------------------------------------------------------------------
-// Input conversion, first half: updates the input and picks its scalars; false (said) when
-// nothing can be drawn.
-bool vtkSpaceSkippingVolumeMapper::vtkInternals::SelectInput(vtkVolume* vol)
+// One image through vtkSpaceSkipImageRenderer; SPACESKIP_BACKEND overrides the backend.
+void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(
+  vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam)
 {
   vtkSpaceSkippingVolumeMapper* self = this->Self;
-  if (self->GetNumberOfInputConnections(0) > 0 && self->GetInputAlgorithm())
-  {
-    self->GetInputAlgorithm()->Update();
-  }
+  const auto t0 = std::chrono::steady_clock::now();
+  this->Image.ResetFrameTimes();
+  vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(self);
+  s.Backend = Overrides().Backend >= 0 ? Overrides().Backend : s.Backend;
   vtkImageData* input = vtkImageData::SafeDownCast(self->GetInput());
   int cellFlag = 0;
   vtkDataArray* scalars = input ? vtkAbstractMapper::GetScalars(input, self->ScalarMode,
                                     self->ArrayAccessMode, self->ArrayId, self->ArrayName, cellFlag)
                                 : nullptr;
-  std::string problem;
-  if (!this->Input.Select(input, scalars, cellFlag, self->VectorMode, self->VectorComponent,
-        vol->GetProperty()->GetIndependentComponents() != 0,
-        self->EffectiveBlendMode() == vtkVolumeMapper::COMPOSITE_BLEND, this->Warn, problem))
+  if (this->Image.Render(ren, vol, renWin, cam, input, scalars, cellFlag, s, this->Mode))
+  {
+    this->Image.SetMapperSeconds(SecondsSince(t0));
+    this->LastProblem.clear();
+  }
+}
+
+//------------------------------------------------------------------------------
+// Composite input: every image block through a mapper of its own (the composite mapper).
+void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderComposite(
+  vtkRenderer* ren, vtkVolume* vol, vtkDataObject* input)
+{
+  if (this->CompositeMapper()->GetInputDataObject(0, 0) != input)
+  {
+    this->Composite->SetInputDataObject(input);
+  }
+  this->Composite->SetSettings(vtkSpaceSkipSettings::From(this->Self));
+  this->Composite->Render(ren, vol);
+  const std::string& problem = this->Composite->GetLastProblem();
+  if (problem.empty())
+  {
+    this->LastProblem.clear();
+  }
+  else
   {
     this->Fail(problem);
-    return false;
   }
-  return true;
 }
 
 //------------------------------------------------------------------------------
-// (Re)creates the engine when the backend changes (counts are carried over); false (said) when
-// it cannot be created.
-bool vtkSpaceSkippingVolumeMapper::vtkInternals::UpdateEngine()
+vtkSpaceSkipMultiBlockVolumeMapper* vtkSpaceSkippingVolumeMapper::vtkInternals::CompositeMapper()
 {
-  const int forced = Overrides().Backend;
-  const int backend = forced >= 0 ? forced : this->Self->Backend;
-  if (this->Engine && this->EngineBackend == backend)
+  if (!this->Composite)
   {
-    return true;
+    this->Composite = vtkSmartPointer<vtkSpaceSkipMultiBlockVolumeMapper>::New();
+    this->Composite->SetBlockFactory([]() { return std::unique_ptr<vtkBlock>(new vtkBlock); });
+    this->Composite->SetWarnFunction(this->Warn);
   }
-  this->CountOffset = this->Counts();
-  this->Engine.reset();
-  try
-  {
-    // Auto, not CUDA: the mapper says a missing device below in its own words (Engine(CUDA)
-    // would say it in the engine's); Auto makes the same choice silently.
-    const spaceskip::BackendKind kind =
-      backend == CPU ? spaceskip::BackendKind::CPU : spaceskip::BackendKind::Auto;
-    this->Engine.reset(new spaceskip::Engine(kind, this->Warn));
-    this->Engine->setTuning(this->Tuning);
-    // The engine's steps as the algorithm's progress (ParaView's progress bar): the text names
-    // the step, the fraction runs over the update and frame together.
-    vtkSpaceSkippingVolumeMapper* self = this->Self;
-    this->Engine->setProgress([self](double fraction, const char* step) {
-      const std::string text = std::string("Space Skipping Volume: ") + step;
-      if (!self->GetProgressText() || text != self->GetProgressText())
-      {
-        self->SetProgressText(text.c_str());
-      }
-      self->UpdateProgress(fraction);
-    });
-  }
-  catch (const std::exception& e)
-  {
-    this->Fail(std::string("cannot create the SpaceSkip engine: ") + e.what());
-    return false;
-  }
-  this->EngineBackend = backend;
-  if (backend == CUDA && this->Engine->backendKind() != spaceskip::BackendKind::CUDA)
-  {
-    this->Warn("CUDA backend unavailable (no usable CUDA device, or SpaceSkip built "
-               "without CUDA); using the CPU backend");
-  }
-  this->Input.Reset();
-  this->Properties.Reset();
-  return true;
-}
-
-//------------------------------------------------------------------------------
-// The engine's work: whatever the changes left to do (ranges, upload, classification, build),
-// the depth of what is drawn, the frame; then the statistics of the frame.
-void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderFrame(vtkOpenGLRenderWindow* renWin,
-  bool sceneHasDepth, const spaceskip::Camera& camera, int x0, int y0, int width, int height)
-{
-  spaceskip::Engine& engine = *this->Engine;
-  auto t0 = std::chrono::steady_clock::now();
-  if (engine.backendKind() == spaceskip::BackendKind::CUDA)  // the CPU backend keeps the volume in host memory
-  {
-    engine.setMemoryBudget(static_cast<int64_t>(this->Self->DeviceMemoryBudget) << 20);
-  }
-  engine.update();
-  this->UpdateSeconds = SecondsSince(t0);
-
-  // Depth of the opaque geometry already drawn, read from the framebuffer being rendered (not
-  // when the scene has nothing but volumes: the buffer holds the far plane only).
-  t0 = std::chrono::steady_clock::now();
-  this->DepthRead = sceneHasDepth;
-  this->FrameDepth = sceneHasDepth ? this->Compositor.ReadDepth(renWin, x0, y0, width, height) : nullptr;
-  if (sceneHasDepth && !this->FrameDepth)
-  {
-    this->Warn("could not read the depth buffer: the volume ignores opaque geometry");
-  }
-  this->DepthSeconds = SecondsSince(t0);
-
-  const int buildsBefore = engine.counters().builds;
-  // GPUComposite: the CUDA backend leaves the image on the device for the interop copy.
-  engine.setImageOnDevice(!this->Self->DeferDraw &&
-    this->Compositor.CanUseDeviceImage(this->Self->GPUComposite != 0) &&
-    engine.backendKind() == spaceskip::BackendKind::CUDA);
-  t0 = std::chrono::steady_clock::now();
-  engine.render(camera, width, height, this->Image, this->FrameDepth,
-    this->Self->DeferDraw ? this->Self->IncomingAlpha : nullptr);
-  this->EngineSeconds = SecondsSince(t0);
-  if (engine.counters().builds != buildsBefore)
-  {
-    const spaceskip::BuildStats& bs = engine.buildStats();
-    vtkVLogF(vtkLogger::VERBOSITY_TRACE,
-      "vtkSpaceSkippingVolumeMapper: built %s on %s in %.6f s (classify %.6f s): %lld nodes, "
-      "height %d, %lld leaves, occupancy %.4f",
-      spaceskip::builderName(bs.builder), bs.builtOn.c_str(), bs.seconds, bs.classifySeconds,
-      static_cast<long long>(bs.nodes), bs.height, static_cast<long long>(bs.leaves),
-      bs.occupancy);
-  }
-  // frameStats(false): a frame left on the device is not waited for (its kernel time is read
-  // when asked for, GetLastKernelSeconds).
-  const spaceskip::FrameStats& fs = engine.frameStats(false);
-  vtkVLogF(vtkLogger::VERBOSITY_TRACE, "vtkSpaceSkippingVolumeMapper: %dx%d frame in %.6f s on %s",
-    width, height, fs.seconds, fs.backend.c_str());
-  this->BackendUsed = fs.backend;
-  this->BuilderUsed = spaceskip::builderName(engine.buildStats().builder);
-  this->SampleDistanceUsed = engine.sampleDistance();
-  this->BuilderChoice = engine.buildStats().choice;
-  const spaceskip::ResidencyStats& rs = fs.residency;
-  this->ResidentBricks = rs.sparse ? static_cast<vtkIdType>(rs.resident) : 0;
-  char text[160];
-  std::snprintf(text, sizeof text, "sparse: %lld of %lld bricks resident (%.0f MiB pool)",
-    static_cast<long long>(rs.resident), static_cast<long long>(rs.bricks), double(rs.poolBytes) / 1048576.0);
-  this->Residency = rs.sparse ? text : "in core";
-}
-
-//------------------------------------------------------------------------------
-// The image into the window: through CUDA-GL interop when it stayed on the device (else this
-// frame again through host memory), blended over what is drawn; false (said) when it cannot.
-bool vtkSpaceSkippingVolumeMapper::vtkInternals::Composite(vtkOpenGLRenderWindow* renWin,
-  vtkImageData* input, const spaceskip::Camera& camera, int width, int height)
-{
-  const auto t0 = std::chrono::steady_clock::now();
-  spaceskip::Engine& engine = *this->Engine;
-  // The pixels the rays can colour: the box grown by a sample step and two voxels (a ray's last
-  // sample may lie up to a step past the box, clamped onto it).
-  int rect[4];
-  const double* spacing = input ? input->GetSpacing() : nullptr;
-  const double minSpacing = spacing
-    ? std::min({ std::fabs(spacing[0]), std::fabs(spacing[1]), std::fabs(spacing[2]) })
-    : 0.0;
-  vtkSpaceSkipCompositor::VisibleRect(camera,
-    minSpacing > 0 && !this->Tuning.compositeFull ? input : nullptr,
-    2.0 + engine.sampleDistance() / std::max(minSpacing, 1e-300), width, height, rect);
-  std::copy(rect, rect + 4, this->CompositeRect);
-  const bool eightBit = this->Self->EightBitComposite != 0;
-  const spaceskip::DeviceImageView deviceImage = engine.deviceImageView();
-  if (deviceImage.image)
-  {
-    // The flat image only if the CUDA blend cannot read the layers (the texture path).
-    if (!this->Compositor.CopyDeviceImage(renWin, deviceImage,
-          [&engine]() { return engine.deviceImage(); }, engine.deviceImageStream(), width, height,
-          rect, eightBit))
-    {
-      engine.setImageOnDevice(false);
-      engine.render(camera, width, height, this->Image, this->FrameDepth);
-    }
-  }
-  this->ReportPaths();
-  if (!this->Compositor.Draw(renWin, this->Image, width, height, eightBit, rect))
-  {
-    this->Fail("could not compile the compositing shader: nothing drawn");
-    return false;
-  }
-  this->CompositeSeconds = SecondsSince(t0);
-  return true;
-}
-
-//------------------------------------------------------------------------------
-// SPACESKIP_REPORT: what actually ran, for logs of test and benchmark runs on other machines.
-void vtkSpaceSkippingVolumeMapper::vtkInternals::ReportPaths()
-{
-  const vtkSpaceSkipCompositor& c = this->Compositor;
-  if (!this->Report ||
-    this->Reported == this->BackendUsed + this->BuilderUsed + c.GetCompositePath() + c.GetBlendPath())
-  {
-    return;
-  }
-  const GLubyte* glRenderer = glGetString(GL_RENDERER);
-  const GLubyte* glVendor = glGetString(GL_VENDOR);
-  std::cout << "SpaceSkip: backend " << this->BackendUsed << ", builder " << this->BuilderUsed
-            << ", GL_RENDERER " << (glRenderer ? reinterpret_cast<const char*>(glRenderer) : "?")
-            << ", GL_VENDOR " << (glVendor ? reinterpret_cast<const char*>(glVendor) : "?")
-            << ", image "
-            << (c.HasDeviceImage() ? "on the GPU (CUDA-GL interop, blended by " + c.GetBlendPath() + ")"
-                                   : std::string("through host memory"))
-            << (c.GetInteropFailed() ? " (interop: " + c.GetInteropProblem() + ")" : std::string())
-            << std::endl;
-  this->Reported = this->BackendUsed + this->BuilderUsed + c.GetCompositePath() + c.GetBlendPath();
+  return this->Composite;
 }
 
 vtkStandardNewMacro(vtkSpaceSkippingVolumeMapper);
@@ -493,8 +267,6 @@ vtkSpaceSkippingVolumeMapper::vtkSpaceSkippingVolumeMapper()
   : Internals(new vtkInternals(this))
 {
 }
-
-//------------------------------------------------------------------------------
 vtkSpaceSkippingVolumeMapper::~vtkSpaceSkippingVolumeMapper() = default;
 
 //------------------------------------------------------------------------------
@@ -503,210 +275,51 @@ const char* vtkSpaceSkippingVolumeMapper::GetBuilderAsString()
   return spaceskip::builderName(static_cast<spaceskip::BuilderKind>(this->Builder));
 }
 
-//------------------------------------------------------------------------------
 const char* vtkSpaceSkippingVolumeMapper::GetFilterModeAsString()
 {
   return this->FilterMode == HardwareFilter ? "Hardware" : "Exact";
 }
 
 //------------------------------------------------------------------------------
-double vtkSpaceSkippingVolumeMapper::GetLastBuildSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastBuildSeconds);
-  }
-  return this->Internals->Engine ? this->Internals->Engine->buildStats().seconds : 0.0;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastClassifySeconds);
-  }
-  return this->Internals->Engine ? this->Internals->Engine->buildStats().classifySeconds : 0.0;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastRenderSeconds);
-  }
-  spaceskip::Engine* engine = this->Internals->Engine.get();
-  if (!engine)
-  {
-    return 0.0;
-  }
-  // With the image kept on the GPU the engine returns once the kernel is launched: the pass is
-  // the kernel's time (this waits for it).
-  if (engine->deviceImageStream())
-  {
-    const spaceskip::FrameStats& f = engine->frameStats();
-    return f.deviceSeconds > 0 ? f.deviceSeconds : f.seconds;
-  }
-  return engine->frameStats(false).seconds;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastKernelSeconds);
-  }
-  if (!this->Internals->Engine)
-  {
-    return 0.0;
-  }
-  const spaceskip::FrameStats& f = this->Internals->Engine->frameStats();
-  return f.deviceSeconds >= 0 ? f.deviceSeconds : f.seconds;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastScalarRangeSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastScalarRangeSeconds);
-  }
-  return this->Internals->RangeSeconds;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastUpdateSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastUpdateSeconds);
-  }
-  return this->Internals->UpdateSeconds;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastDepthReadSeconds);
-  }
-  return this->Internals->DepthSeconds;
-}
-bool vtkSpaceSkippingVolumeMapper::GetLastFrameReadDepth()
-{
-  return this->Internals->DepthRead;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastEngineRenderSeconds);
-  }
-  return this->Internals->EngineSeconds;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastCompositeSeconds()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLastCompositeSeconds);
-  }
-  return this->Internals->CompositeSeconds;
-}
-double vtkSpaceSkippingVolumeMapper::GetLastMapperSeconds()
-{
-  return this->Internals->MapperSeconds;
-}
-vtkIdType vtkSpaceSkippingVolumeMapper::GetNodeCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetNodeCount);
-  }
-  return this->Internals->Engine ? this->Internals->Engine->buildStats().nodes : 0;
-}
-int vtkSpaceSkippingVolumeMapper::GetTreeHeight()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Max(&vtkSpaceSkippingVolumeMapper::GetTreeHeight);
-  }
-  return this->Internals->Engine ? this->Internals->Engine->buildStats().height : 0;
-}
-vtkIdType vtkSpaceSkippingVolumeMapper::GetLeafCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetLeafCount);
-  }
-  return this->Internals->Engine ? this->Internals->Engine->buildStats().leaves : 0;
-}
-double vtkSpaceSkippingVolumeMapper::GetOccupancy()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Occupancy();
-  }
-  return this->Internals->Engine ? this->Internals->Engine->buildStats().occupancy : 0.0;
-}
-const char* vtkSpaceSkippingVolumeMapper::GetBackendUsed()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBackendUsed);
-  }
-  return this->Internals->BackendUsed.c_str();
-}
-const char* vtkSpaceSkippingVolumeMapper::GetBuilderUsed()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBuilderUsed);
-  }
-  return this->Internals->BuilderUsed.c_str();
-}
-const char* vtkSpaceSkippingVolumeMapper::GetCompositePathUsed()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.GetCompositePath(); // the blended blocks' way to the window
-  }
-  return this->Internals->Compositor.GetCompositePath().c_str();
-}
-const char* vtkSpaceSkippingVolumeMapper::GetCompositeBlendUsed()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return "gl"; // the blocks' images are drawn by GL
-  }
-  return this->Internals->Compositor.GetBlendPath().c_str();
-}
+// Statistics (of the blocks together for composite input: vtkSpaceSkipStatistics::Combine).
+vtkStatisticGetterMacro(double, LastBuildSeconds, BuildSeconds, false);
+vtkStatisticGetterMacro(double, LastClassifySeconds, ClassifySeconds, false);
+vtkStatisticGetterMacro(double, LastRenderSeconds, RenderSeconds, true);
+vtkStatisticGetterMacro(double, LastKernelSeconds, KernelSeconds, true);
+vtkStatisticGetterMacro(double, LastScalarRangeSeconds, ScalarRangeSeconds, false);
+vtkStatisticGetterMacro(double, LastUpdateSeconds, UpdateSeconds, false);
+vtkStatisticGetterMacro(double, LastDepthReadSeconds, DepthReadSeconds, false);
+vtkStatisticGetterMacro(bool, LastFrameReadDepth, DepthRead, false);
+vtkStatisticGetterMacro(double, LastEngineRenderSeconds, EngineRenderSeconds, false);
+vtkStatisticGetterMacro(double, LastCompositeSeconds, CompositeSeconds, false);
+vtkStatisticGetterMacro(double, LastMapperSeconds, MapperSeconds, false);
+vtkStatisticGetterMacro(vtkIdType, NodeCount, Nodes, false);
+vtkStatisticGetterMacro(int, TreeHeight, TreeHeight, false);
+vtkStatisticGetterMacro(vtkIdType, LeafCount, Leaves, false);
+vtkStatisticGetterMacro(double, Occupancy, Occupancy, false);
+vtkStatisticGetterMacro(const char*, BackendUsed, BackendUsed.c_str(), false);
+vtkStatisticGetterMacro(const char*, BuilderUsed, BuilderUsed.c_str(), false);
+vtkStatisticGetterMacro(const char*, CompositePathUsed, CompositePath.c_str(), false);
+vtkStatisticGetterMacro(const char*, CompositeBlendUsed, CompositeBlend.c_str(), false);
+vtkStatisticGetterMacro(const char*, BuilderChoice, BuilderChoice.c_str(), false);
+vtkStatisticGetterMacro(double, SampleDistanceUsed, SampleDistanceUsed, false);
+vtkStatisticGetterMacro(const char*, Residency, Residency.c_str(), false);
+vtkStatisticGetterMacro(vtkIdType, ResidentBricks, ResidentBricks, false);
+vtkStatisticGetterMacro(int, BuildCount, Builds, false);
+vtkStatisticGetterMacro(int, ClassifyCount, Classifications, false);
+vtkStatisticGetterMacro(int, ColorUpdateCount, ColorUpdates, false);
+vtkStatisticGetterMacro(int, FrameCount, Frames, false);
+vtkStatisticGetterMacro(int, ColorTableSampleCount, ColorTableSamples, false);
+vtkStatisticGetterMacro(int, OpacityTableSampleCount, OpacityTableSamples, false);
 void vtkSpaceSkippingVolumeMapper::GetLastCompositeRect(int rect[4])
 {
-  std::copy(this->Internals->CompositeRect, this->Internals->CompositeRect + 4, rect);
-}
-const char* vtkSpaceSkippingVolumeMapper::GetBuilderChoice()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetBuilderChoice);
-  }
-  return this->Internals->BuilderChoice.c_str();
-}
-double vtkSpaceSkippingVolumeMapper::GetSampleDistanceUsed()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.MinSampleDistance();
-  }
-  return this->Internals->SampleDistanceUsed;
-}
-const char* vtkSpaceSkippingVolumeMapper::GetResidency()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Names(&vtkSpaceSkippingVolumeMapper::GetResidency);
-  }
-  return this->Internals->Residency.c_str();
-}
-vtkIdType vtkSpaceSkippingVolumeMapper::GetResidentBricks()
-{
-  return this->Internals->ResidentBricks;
+  std::copy_n(this->Internals->Statistics(false).CompositeRect, 4, rect);
 }
 vtkIdType vtkSpaceSkippingVolumeMapper::GetDeviceBytesInUse()
 {
   return static_cast<vtkIdType>(spaceskip::cudaDeviceBytesInUse());
 }
+
 void vtkSpaceSkippingVolumeMapper::WarnOnce(const std::string& message)
 {
   if (this->Internals->Said.insert(message).second)
@@ -714,92 +327,30 @@ void vtkSpaceSkippingVolumeMapper::WarnOnce(const std::string& message)
     vtkWarningMacro(<< message);
   }
 }
-int vtkSpaceSkippingVolumeMapper::GetBuildCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetBuildCount);
-  }
-  return this->Internals->Counts().builds;
-}
-int vtkSpaceSkippingVolumeMapper::GetClassifyCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetClassifyCount);
-  }
-  return this->Internals->Counts().classifications;
-}
-int vtkSpaceSkippingVolumeMapper::GetColorUpdateCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetColorUpdateCount);
-  }
-  return this->Internals->Counts().colorUpdates;
-}
-int vtkSpaceSkippingVolumeMapper::GetColorTableSampleCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetColorTableSampleCount);
-  }
-  return this->Internals->Properties.GetColorTableSamples();
-}
-int vtkSpaceSkippingVolumeMapper::GetOpacityTableSampleCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.Sum(&vtkSpaceSkippingVolumeMapper::GetOpacityTableSampleCount);
-  }
-  return this->Internals->Properties.GetOpacityTableSamples();
-}
-int vtkSpaceSkippingVolumeMapper::GetFrameCount()
-{
-  if (this->Internals->Blocks.IsActive())
-  {
-    return this->Internals->Blocks.GetFrameCount();
-  }
-  return this->Internals->Counts().frames;
-}
-
-//------------------------------------------------------------------------------
-const float* vtkSpaceSkippingVolumeMapper::GetDeferredImage(int& width, int& height)
-{
-  vtkInternals& d = *this->Internals;
-  if (!d.DeferredReady || d.Image.rgba.empty())
-  {
-    return nullptr;
-  }
-  width = d.Image.width;
-  height = d.Image.height;
-  return &d.Image.rgba[0].x;
-}
 
 //------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::ReleaseGraphicsResources(vtkWindow* win)
 {
-  this->Internals->Blocks.ReleaseGraphicsResources(win);
-  this->Internals->Compositor.ReleaseGraphicsResources(win);
+  if (this->Internals->Composite)
+  {
+    this->Internals->Composite->ReleaseGraphicsResources(win);
+  }
+  this->Internals->Image.ReleaseGraphicsResources(win);
   this->Superclass::ReleaseGraphicsResources(win);
 }
 
 //------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::SetTuning(const spaceskip::Tuning& tuning)
 {
-  vtkInternals& d = *this->Internals;
-  d.Tuning = tuning;
-  d.Compositor.SetCudaBlend(tuning.cudaBlend);
-  if (d.Engine)
-  {
-    d.Engine->setTuning(tuning);
-  }
+  this->Internals->Tuning = tuning;
+  this->Internals->Image.SetTuning(tuning);
 }
 const spaceskip::Tuning& vtkSpaceSkippingVolumeMapper::GetTuning() const
 {
   return this->Internals->Tuning;
 }
 
+//------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange)
 {
   if (this->Internals->Exchange != exchange)
@@ -822,17 +373,53 @@ vtkSpaceSkippingVolumeMapper::GetPieceExchange() const
   return this->Internals->Exchange;
 }
 
-namespace
+//------------------------------------------------------------------------------
+// With a piece exchange (MPI) and a piece of a larger image, RenderExchanged(); else the input
+// drawn here.
+void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
-// Whether the mapper draws a piece of a larger image (WholeExtent given): a vtkImageData piece
-// (`blocks` false) or composite input whose blocks lie on its lattice (`blocks` true).
-bool IsPiece(vtkSpaceSkippingVolumeMapper* self, const int whole[6], bool& blocks)
-{
-  vtkDataObject* input =
-    self->GetNumberOfInputConnections(0) > 0 ? self->GetInputDataObject(0, 0) : nullptr;
-  blocks = vtkSpaceSkipBlockRenderer::IsComposite(input);
-  return whole[0] <= whole[1] && whole[2] <= whole[3] && whole[4] <= whole[5];
+  if (this->Internals->Exchange && ren && HasExtent(this->WholeExtent))
+  {
+    this->RenderExchanged(ren, vol);
+    return;
+  }
+  this->RenderLocal(ren, vol);
 }
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
+{
+  vtkInternals& d = *this->Internals;
+  d.Image.ResetFrameTimes(); // and no deferred frame until this one is drawn
+  vtkOpenGLRenderWindow* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
+  vtkOpenGLCamera* cam = vtkOpenGLCamera::SafeDownCast(ren->GetActiveCamera());
+  if (!renWin || !cam || !vol || !vol->GetProperty())
+  {
+    d.Fail("needs an OpenGL render window, an OpenGL camera and a volume with a property");
+    return;
+  }
+  if (this->GetNumberOfInputConnections(0) > 0 && this->GetInputAlgorithm())
+  {
+    this->GetInputAlgorithm()->Update();
+  }
+  vtkDataObject* input = this->GetInputDataObject(0, 0);
+  if (IsComposite(input))
+  {
+    d.RenderComposite(ren, vol, input);
+    return;
+  }
+  if (d.Composite)
+  {
+    d.Composite->ReleaseGraphicsResources(renWin); // back to an image: the blocks go
+    d.Composite = nullptr;
+  }
+  if (input && input->IsA("vtkRectilinearGrid"))
+  {
+    d.Fail("vtkRectilinearGrid input is not drawn: vtkSpaceSkippingVolumeMapper draws "
+           "vtkImageData (resample the grid to an image first, e.g. vtkResampleToImage)");
+    return;
+  }
+  d.RenderImage(ren, vol, renWin, cam);
 }
 
 //------------------------------------------------------------------------------
@@ -840,61 +427,44 @@ bool IsPiece(vtkSpaceSkippingVolumeMapper* self, const int whole[6], bool& block
 // into a float image, the exchange composites them all in float on one process, which draws the
 // sum; the others draw nothing. Every call reaches Finish(), whatever the piece drew (the
 // others wait for it).
-void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
+void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* vol)
 {
+  namespace pc = vtkSpaceSkipPieceCompositing;
   vtkInternals& d = *this->Internals;
   const std::shared_ptr<PieceExchange> exchange = d.Exchange;
-  bool blocks = false;
-  if (!exchange || !ren || !IsPiece(this, this->WholeExtent, blocks))
-  {
-    this->RenderLocal(ren, vol);
-    return;
-  }
-  namespace pc = vtkSpaceSkipPieceCompositing;
   exchange->Begin();
   std::vector<PieceImage> mine;
   double eye[3] = { 0, 0, 0 }, dir[3] = { 0, 0, 1 };
   bool parallel = false;
   const float* image = nullptr; // an image piece's own frame (drawn if the exchange is off)
+  const bool blocks = IsComposite(this->GetInputDataObject(0, 0));
   if (blocks)
   {
-    // The block renderer leaves its blocks' images (on the whole image's lattice) to us.
-    d.Blocks.SetExchangePieces(&mine);
+    // The composite mapper leaves its blocks' images (on the whole image's lattice) to us.
+    d.CompositeMapper()->SetExchangePieces(&mine);
     this->RenderLocal(ren, vol);
-    d.Blocks.SetExchangePieces(nullptr);
-    d.Blocks.ExchangeCamera(ren, vol, eye, dir, parallel);
+    d.Composite->SetExchangePieces(nullptr);
+    d.Composite->ExchangeCamera(ren, vol, eye, dir, parallel);
   }
   else
   {
-    const bool defer = this->DeferDraw;
-    this->DeferDraw = true;
-    this->ExactPiece = true;
-    d.LastPiece = spaceskip::VolumePiece();
-    d.DeferredReady = false;
+    const vtkSpaceSkipImageRenderer::FrameMode mode = d.Mode;
+    d.Mode.Defer = d.Mode.Exact = true;
     auto* data = vtkDataSet::SafeDownCast(this->GetInputDataObject(0, 0));
+    d.Image.ResetFrameTimes();
     if (data && data->GetNumberOfPoints() > 0)
     {
       this->RenderLocal(ren, vol); // an empty piece draws nothing (and says nothing)
     }
-    this->DeferDraw = defer;
-    this->ExactPiece = false;
+    d.Mode = mode;
     int w = 0, h = 0;
-    image = this->GetDeferredImage(w, h);
+    image = d.Image.DeferredImage(w, h);
     auto* input = vtkImageData::SafeDownCast(this->GetInput());
-    if (image && input && vol && ren->GetActiveCamera())
+    if (image && input && ren->GetActiveCamera())
     {
-      // The cells drawn and the camera, in the whole extent's index space (less its first index).
-      const spaceskip::VolumePiece& p = d.LastPiece;
-      int ext[6], owned[6];
-      input->GetExtent(ext);
-      const int shift[3] = { this->WholeExtent[0], this->WholeExtent[2], this->WholeExtent[4] };
-      for (int a = 0; a < 3; ++a)
-      {
-        owned[2 * a] = p.active() ? static_cast<int>(p.ownedLo[a]) : ext[2 * a] - shift[a];
-        owned[2 * a + 1] = p.active() ? static_cast<int>(p.ownedHi[a])
-                                      : std::max(ext[2 * a + 1], ext[2 * a] + 1) - shift[a];
-      }
-      mine.push_back(pc::Crop(image, w, h, owned));
+      const int* whole = this->WholeExtent;
+      const int shift[3] = { whole[0], whole[2], whole[4] };
+      mine.push_back(pc::CropPiece(image, w, h, d.Image.LastPiece(), input, whole));
       pc::CameraInIndexSpace(ren, vol, input, shift, eye, dir, parallel);
     }
     else
@@ -912,132 +482,27 @@ void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
     return;
   }
   const bool eightBit = this->EightBitComposite != 0;
+  vtkSpaceSkipCompositor& compositor = d.Image.GetCompositor();
   bool drawn = true;
-  if (draw == -1 && blocks)
+  if (draw == -1 && blocks) // the exchange is off: this process's own blocks
   {
-    drawn = d.Blocks.DrawSum(ren, eightBit); // the exchange is off: this process's own blocks
+    drawn = !d.Composite || d.Composite->DrawSum(ren, eightBit);
   }
-  else if (draw == -1)
+  else if (draw == -1) // the exchange is off: this process's own frame, as without it
   {
-    // The exchange is off: this process's own frame (d.Image, kept by DeferDraw), as without it.
-    drawn = !image || d.Compositor.Draw(renWin, d.Image, width, height, eightBit);
+    drawn = !image || compositor.Draw(renWin, d.Image.GetImage(), width, height, eightBit);
   }
   else
   {
     // Every piece front to back in the order the rays meet them, blended in float: one
     // rounding to 8 bits, as the serial image.
-    for (PieceImage& p : mine)
-    {
-      others.push_back(std::move(p));
-    }
+    std::move(mine.begin(), mine.end(), std::back_inserter(others));
     pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged);
-    drawn = d.Compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
+    drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
   }
   if (!drawn)
   {
     d.Fail("could not compile the compositing shader: nothing drawn");
-  }
-}
-
-//------------------------------------------------------------------------------
-void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
-{
-  vtkInternals& d = *this->Internals;
-  d.DeferredReady = false;
-  vtkOpenGLRenderWindow* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
-  vtkOpenGLCamera* cam = vtkOpenGLCamera::SafeDownCast(ren->GetActiveCamera());
-  if (!renWin || !cam || !vol || !vol->GetProperty())
-  {
-    d.Fail("needs an OpenGL render window, an OpenGL camera and a volume with a property");
-    return;
-  }
-  // Composite input: every image block through a mapper of its own (vtkSpaceSkipBlockRenderer).
-  if (this->GetNumberOfInputConnections(0) > 0 && this->GetInputAlgorithm())
-  {
-    this->GetInputAlgorithm()->Update();
-  }
-  vtkDataObject* input = this->GetInputDataObject(0, 0);
-  if (vtkSpaceSkipBlockRenderer::IsComposite(input))
-  {
-    std::string problem;
-    if (d.Blocks.Render(this, input, ren, vol, d.Warn, problem))
-    {
-      d.LastProblem.clear();
-    }
-    else
-    {
-      d.Fail(problem);
-    }
-    return;
-  }
-  if (d.Blocks.IsActive())
-  {
-    d.Blocks.ReleaseGraphicsResources(renWin);
-    d.Blocks.Clear();
-  }
-  if (input && input->IsA("vtkRectilinearGrid"))
-  {
-    d.Fail("vtkRectilinearGrid input is not drawn: vtkSpaceSkippingVolumeMapper draws "
-           "vtkImageData (resample the grid to an image first, e.g. vtkResampleToImage)");
-    return;
-  }
-  // Input conversion, first half: what to draw, or why nothing.
-  if (!d.SelectInput(vol))
-  {
-    return;
-  }
-  const auto tRender = std::chrono::steady_clock::now();
-  d.RangeSeconds = d.UpdateSeconds = d.DepthSeconds = d.EngineSeconds = d.CompositeSeconds = 0;
-  if (!d.UpdateEngine())
-  {
-    return;
-  }
-  try
-  {
-    // Only what changed reaches the engine: the volume (and its scalar range), the transfer
-    // function, the build and render parameters.
-    spaceskip::Engine& engine = *d.Engine;
-    d.RangeSeconds = d.Input.Update(engine, d.Warn);
-    // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
-    // composite input uses the range of all blocks (vtkSpaceSkipBlockRenderer).
-    d.LastPiece = PieceOf(vtkImageData::SafeDownCast(this->GetInput()), this->WholeExtent,
-      this->UseBlockOwned ? this->BlockOwned : nullptr, this->UseBlockOwned || this->ExactPiece,
-      d.Tuning.pieceBias, d.Warn);
-    engine.setPiece(d.LastPiece);
-    const double* range = this->UseTableRange ? this->TableRange
-      : this->WholeScalarRange[0] <= this->WholeScalarRange[1] ? this->WholeScalarRange
-                                                               : d.Input.GetScalarRange();
-    d.Properties.UpdateTransferFunction(engine, vol->GetProperty(), range,
-      d.Input.GetOpacityRange(), d.Input.GetOpacityComponent());
-    d.Properties.UpdateParameters(
-      engine, this, this->EffectiveBlendMode(), ren, vol, range, d.Warn);
-    const spaceskip::Camera camera = vtkSpaceSkipPropertyTranslator::ToCamera(ren, cam, vol);
-
-    int width, height, x0, y0;
-    ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
-    if (width <= 0 || height <= 0)
-    {
-      return;
-    }
-    d.RenderFrame(renWin, vtkSpaceSkipCompositor::SceneHasDepth(ren), camera, x0, y0, width, height);
-    if (this->DeferDraw)
-    {
-      // A block of a composite input: the block renderer composites the float images.
-      d.DeferredReady = true;
-      d.MapperSeconds = SecondsSince(tRender);
-      d.LastProblem.clear();
-      return;
-    }
-    if (!d.Composite(renWin, vtkImageData::SafeDownCast(this->GetInput()), camera, width, height))
-    {
-      return;
-    }
-    d.MapperSeconds = SecondsSince(tRender);
-    d.LastProblem.clear();
-  }
-  catch (const std::exception& e)
-  {
-    d.Fail(std::string("SpaceSkip engine error: ") + e.what() + ": nothing drawn");
   }
 }
 
@@ -1056,20 +521,18 @@ double* vtkSpaceSkippingVolumeMapper::GetBounds()
   // Exchanging pieces, every process must draw every frame: its volume reports the whole
   // image's bounds, so that no renderer culls a piece that is out of view (or empty) while the
   // others wait for it.
-  bool blocks = false;
-  if (this->Internals->Exchange && IsPiece(this, this->WholeExtent, blocks) &&
-    vtkMath::AreBoundsInitialized(this->Internals->WholeBounds))
+  const double* whole = this->Internals->WholeBounds;
+  if (this->Internals->Exchange && HasExtent(this->WholeExtent) && vtkMath::AreBoundsInitialized(whole))
   {
-    std::copy(this->Internals->WholeBounds, this->Internals->WholeBounds + 6, this->Bounds);
+    std::copy(whole, whole + 6, this->Bounds);
     return this->Bounds;
   }
-  if (this->GetNumberOfInputConnections(0) == 0 ||
-    !vtkSpaceSkipBlockRenderer::IsComposite(this->GetInputDataObject(0, 0)))
+  if (this->GetNumberOfInputConnections(0) == 0 || !IsComposite(this->GetInputDataObject(0, 0)))
   {
     return this->Superclass::GetBounds();
   }
   this->Update();
-  vtkSpaceSkipBlockRenderer::ComputeBounds(this->GetInputDataObject(0, 0), this->Bounds);
+  vtkSpaceSkipMultiBlockVolumeMapper::ComputeBounds(this->GetInputDataObject(0, 0), this->Bounds);
   return this->Bounds;
 }
 
@@ -1078,42 +541,19 @@ vtkDataSet* vtkSpaceSkippingVolumeMapper::GetInput()
 {
   vtkDataObject* input =
     this->GetNumberOfInputConnections(0) > 0 ? this->GetInputDataObject(0, 0) : nullptr;
-  vtkDataSet* data = vtkSpaceSkipBlockRenderer::IsComposite(input)
-    ? vtkSpaceSkipBlockRenderer::FirstImage(input)
-    : this->Superclass::GetInput();
-  bool blocks = false;
-  if (!this->Internals->Exchange || !IsPiece(this, this->WholeExtent, blocks))
+  vtkDataSet* data = IsComposite(input) ? vtkSpaceSkipMultiBlockVolumeMapper::FirstImage(input)
+                                        : this->Superclass::GetInput();
+  int unused = 0;
+  if (!this->Internals->Exchange || !HasExtent(this->WholeExtent) ||
+    (data && vtkAbstractMapper::GetScalars(data, this->ScalarMode, this->ArrayAccessMode,
+               this->ArrayId, this->ArrayName, unused)))
   {
     return data;
   }
   // Exchanging pieces, a process with an empty piece must still draw every frame (the others
-  // wait for it), and ParaView's vtkPVLODVolume draws a mapper only when GetInput() has the
-  // selected scalars: an empty image with an empty array of that name stands in.
-  int unused = 0;
-  if (data && vtkAbstractMapper::GetScalars(data, this->ScalarMode, this->ArrayAccessMode,
-                this->ArrayId, this->ArrayName, unused))
-  {
-    return data;
-  }
+  // wait for it): an empty image with an empty array of the selected name stands in.
   vtkInternals& d = *this->Internals;
-  const std::string name = this->ArrayName ? this->ArrayName : "";
-  if (!d.EmptyPiece || d.EmptyPieceArray != name)
-  {
-    d.EmptyPiece = vtkSmartPointer<vtkImageData>::New();
-    for (vtkDataSetAttributes* attributes : { static_cast<vtkDataSetAttributes*>(d.EmptyPiece->GetPointData()),
-           static_cast<vtkDataSetAttributes*>(d.EmptyPiece->GetCellData()) })
-    {
-      for (int i = 0; i <= std::max(this->ArrayId, 0) && i < 16; ++i)
-      {
-        vtkNew<vtkFloatArray> array;
-        array->SetName(i == 0 && !name.empty() ? name.c_str() : ("empty piece " + std::to_string(i)).c_str());
-        attributes->AddArray(array);
-      }
-      attributes->SetActiveScalars(attributes->GetAbstractArray(0)->GetName());
-    }
-    d.EmptyPieceArray = name;
-  }
-  return d.EmptyPiece;
+  return vtkSpaceSkipPieceCompositing::EmptyPiece(this->ArrayName, this->ArrayId, d.EmptyPiece, d.EmptyPieceArray);
 }
 
 //------------------------------------------------------------------------------
@@ -1145,21 +585,10 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EarlyRayTermination: " << (this->EarlyRayTermination ? "On" : "Off") << "\n";
   os << indent << "EightBitComposite: " << (this->EightBitComposite ? "On" : "Off") << "\n";
   os << indent << "GPUComposite: " << (this->GPUComposite ? "On" : "Off") << "\n";
-  os << indent << "CompositePathUsed: " << this->Internals->Compositor.GetCompositePath() << "\n";
-  os << indent << "CompositeBlendUsed: " << this->Internals->Compositor.GetBlendPath() << "\n";
   os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
   os << indent << "DeviceMemoryBudget: " << this->DeviceMemoryBudget << " MiB\n";
   os << indent << "VectorMode: " << this->VectorMode << "\n";
   os << indent << "VectorComponent: " << this->VectorComponent << "\n";
   os << indent << "BlendModeOverride: " << this->BlendModeOverride << "\n";
-  os << indent << "BackendUsed: " << this->Internals->BackendUsed << "\n";
-  os << indent << "BuilderUsed: " << this->Internals->BuilderUsed << "\n";
-  os << indent << "LastBuildSeconds: " << this->GetLastBuildSeconds() << "\n";
-  os << indent << "LastRenderSeconds: " << this->GetLastRenderSeconds() << "\n";
-  os << indent << "NodeCount: " << this->GetNodeCount() << "\n";
-  os << indent << "TreeHeight: " << this->GetTreeHeight() << "\n";
-  os << indent << "LeafCount: " << this->GetLeafCount() << "\n";
-  os << indent << "BuildCount: " << this->GetBuildCount() << "\n";
-  os << indent << "ClassifyCount: " << this->GetClassifyCount() << "\n";
-  os << indent << "ColorUpdateCount: " << this->GetColorUpdateCount() << "\n";
+  this->Internals->Statistics(true).Print(os, indent);
 }

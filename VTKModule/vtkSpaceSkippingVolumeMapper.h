@@ -27,12 +27,12 @@
 #ifndef vtkSpaceSkippingVolumeMapper_h
 #define vtkSpaceSkippingVolumeMapper_h
 
-#include "vtkSpaceSkipModule.h" // For export macro
+#include "vtkSpaceSkipModule.h"        // For export macro
+#include "vtkSpaceSkipPieceExchange.h" // For PieceImage, PieceExchange
 #include "vtkVolumeMapper.h"
 
 #include <memory> // For std::unique_ptr
 #include <string> // For WarnOnce
-#include <vector> // For PieceExchange
 
 class vtkRenderer;
 class vtkVolume;
@@ -420,30 +420,9 @@ public:
    * in float on one of them, nothing on the others, so that the 8-bit compositing that follows
    * (IceT) only adds empty images to one exact image.
    */
-  /// A process's piece image: the rectangle of pixels it drew (premultiplied RGBA floats, rows
-  /// bottom up, at X, Y in the viewport) and the cells it drew, [lo, hi) per axis in the index
-  /// space of WholeExtent (lo == hi: none).
-  struct PieceImage
-  {
-    int Owned[6] = { 0, 0, 0, 0, 0, 0 };
-    int X = 0, Y = 0, Width = 0, Height = 0;
-    std::vector<float> Pixels;
-  };
-  class PieceExchange
-  {
-  public:
-    virtual ~PieceExchange() = default;
-    /// At the start of Render(), before the piece is drawn.
-    virtual void Begin() = 0;
-    /**
-     * Hands over this process's pieces (one for an image piece, one per block for partitioned
-     * input) of a `width` x `height` viewport. Returns 1 with the other processes' pieces in
-     * `others` (this process composites and draws them all), 0 (draw nothing here: another
-     * process draws these pieces), or -1 (the exchange is off: draw them here, the 8-bit path).
-     */
-    virtual int Finish(int width, int height, std::vector<PieceImage>& mine,
-      std::vector<PieceImage>& others) = 0;
-  };
+  /// A process's piece image and the exchange (vtkSpaceSkipPieceExchange.h).
+  using PieceImage = vtkSpaceSkipPieceImage;
+  using PieceExchange = vtkSpaceSkipPieceExchange;
   void SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange);
   /// The whole image's bounds, the same on every process: while a PieceExchange is set the
   /// volume reports them (GetBounds()), so that no renderer culls a piece that is out of view
@@ -455,7 +434,8 @@ public:
   /**
    * Composite input (vtkMultiBlockDataSet, vtkPartitionedDataSet,
    * vtkPartitionedDataSetCollection of vtkImageData): the union of the image blocks' bounds.
-   * Each image block is drawn by a mapper of its own (its own hierarchy), back to front, as
+   * Each image block is drawn by a mapper of its own (its own hierarchy), front to back, by the
+   * vtkSpaceSkipMultiBlockVolumeMapper this mapper hands composite input to, as
    * vtkMultiBlockVolumeMapper does; other blocks are skipped with one warning. The statistics
    * then add up the blocks (times, nodes, leaves, stage counts; the tree height is the largest,
    * the occupancy the voxel-weighted mean, names one per distinct value joined by '/').
@@ -505,50 +485,15 @@ private:
   // Says a warning once per distinct message for the life of the mapper.
   void WarnOnce(const std::string& message);
 
-  /// BlendModeOverride when set, else BlendMode.
-  int EffectiveBlendMode() const
-  {
-    return this->BlendModeOverride >= 0 ? this->BlendModeOverride : this->BlendMode;
-  }
+  // Render() without the piece exchange: draws this input (or keeps it for the composite
+  // mapper); with it (MPI), the pieces of all processes composited in float.
+  void RenderLocal(vtkRenderer* ren, vtkVolume* vol);
+  void RenderExchanged(vtkRenderer* ren, vtkVolume* vol);
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;
-
-  // Composite input: the block mappers sample the transfer function over the range of all
-  // blocks, not over their own (vtkSpaceSkipBlockRenderer sets it).
-  friend class vtkSpaceSkipBlockRenderer;
-  void SetTableRange(const double range[2])
-  {
-    this->UseTableRange = true;
-    this->TableRange[0] = range[0];
-    this->TableRange[1] = range[1];
-  }
-  bool UseTableRange = false;
-  double TableRange[2] = { 0, 1 };
-  // Composite input on one lattice (vtkSpaceSkipBlockRenderer): the block's own cells, [lo, hi)
-  // per axis in the index space of WholeExtent (instead of its ghost array), drawn exactly (no
-  // 8-bit rounding bias), and the frame kept as a float image for the block renderer to
-  // composite instead of drawn.
-  void SetBlockOwnedCells(const int owned[6])
-  {
-    this->UseBlockOwned = owned != nullptr;
-    for (int i = 0; owned && i < 6; ++i)
-    {
-      this->BlockOwned[i] = owned[i];
-    }
-  }
-  bool UseBlockOwned = false;
-  int BlockOwned[6] = { 0, 0, 0, 0, 0, 0 };
-  bool DeferDraw = false;
-  // With DeferDraw: the opacity each pixel's ray brings from the blocks in front (width x height
-  // of the renderer's tiled viewport, row 0 at the bottom), or null (spaceskip::Engine::render).
-  const float* IncomingAlpha = nullptr;
-  /// The last Render()'s premultiplied RGBA floats (row 0 at the bottom) when DeferDraw, else null.
-  const float* GetDeferredImage(int& width, int& height);
-  // Render() without the piece exchange: draws this input (or keeps it, DeferDraw).
-  void RenderLocal(vtkRenderer* ren, vtkVolume* vol);
-  // Set while Render() draws a piece for the exchange: no 8-bit rounding bias.
-  bool ExactPiece = false;
+  // A block of composite input as vtkSpaceSkipMultiBlockVolumeMapper drives it.
+  struct vtkBlock;
 };
 
 #endif
