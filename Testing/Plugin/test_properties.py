@@ -68,7 +68,7 @@ for i, name in enumerate(names):
         p = min(p, ssptest.psnr(naive, img))
         s = ssptest.stats(disp)
         ok.check(p >= 40.0, "Builder Auto: every measuring frame == Naive image (PSNR %.2f dB)" % p)
-        ok.check(s["BuilderChoice"].startswith("Auto: " + s["BuilderUsed"]),
+        ok.check(s["BuilderChoice"].startswith("Auto chose " + s["BuilderUsed"] + ":"),
                  "Builder Auto: kept %s and says why (%s)" % (s["BuilderUsed"], s["BuilderChoice"]))
         ok.check(s["BuildCount"] >= before["BuildCount"] + 4,
                  "Builder Auto: built each candidate (%d -> %d)" % (before["BuildCount"], s["BuildCount"]))
