@@ -130,6 +130,12 @@ public:
                        const std::function<void(double)>& progress, const std::function<double()>& occupied,
                        bool& decided);
   /// The Builder Choice line ("Auto chose Grid: 0.19 s a frame, ...", or "Auto: measuring ...").
+  /// After the user's frame that follows a measuring on probes, drawn with the kept structure in
+  /// `seconds`: the probes' times are scaled by that frame over the kept one's probe (the ratio
+  /// of a probe to a frame differs by structure only as much as their probes do; pixel counts
+  /// alone overstate SIMD frames, whose packets gain more on full frames). True when the choice
+  /// line changed.
+  bool keptFrameDrawn(double seconds);
   const std::string& choice() const { return choice_; }
 
 private:
@@ -168,6 +174,8 @@ private:
   int switches_ = 0;                  ///< changes of the kept structure by a re-check
   int fullWidth_ = 0, fullHeight_ = 0;  ///< the user's frame size (probes: width_ is the probe's)
   double timeScale_ = 1;              ///< probes: the user's frame pixels over a probe's
+  bool calibrate_ = false;            ///< probes: timeScale_ awaits the kept structure's frame
+  bool calibrated_ = false;           ///< timeScale_ comes from the kept structure's frame
   std::string choice_;
 };
 

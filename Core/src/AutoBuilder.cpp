@@ -301,6 +301,7 @@ bool AutoBuilder::measureOnProbes(int width, int height, const ViewKey& view,
   int pw = 0, ph = 0;
   probeSize(width, height, pw, ph);
   timeScale_ = double(width) * double(height) / (double(pw) * double(ph));
+  calibrated_ = false;
   // Each candidate at most 1 + 1 + kMaxRepeats probes (a re-check: 2 + 2): a bound, not a rule.
   const int bound = 8 * int(candidates_.size());
   for (int guard = 0; exploring_ && guard < bound; ++guard) {
@@ -309,6 +310,18 @@ bool AutoBuilder::measureOnProbes(int width, int height, const ViewKey& view,
     if (frameDone([t] { return t; }, pw, ph, view, occupied)) decided = true;
   }
   if (exploring_) cancelRecheck();  // the bound was hit: keep the cheapest measured so far
+  calibrate_ = true;
+  return true;
+}
+
+bool AutoBuilder::keptFrameDrawn(double seconds) {
+  if (!calibrate_ || exploring_ || standIn_ || kept_ < 0 || built_ != kept_) return false;
+  calibrate_ = false;
+  const double probe = seconds_[size_t(kept_)];
+  if (!(seconds > 0) || !(probe > 0)) return false;
+  timeScale_ = seconds / probe;
+  calibrated_ = true;
+  describeChoice();
   return true;
 }
 
@@ -341,7 +354,8 @@ void AutoBuilder::describeChoice() {
     // A build term under 1% of the frame is left out: it changes nothing.
     if (b / kFramesPerBuild > 0.01 * seconds_[i] * timeScale_) line += " + " + readableSeconds(b / kFramesPerBuild);
   }
-  if (timeScale_ > 1) {
+  if (calibrated_) line += " (measured on probes, scaled by the kept structure's own frame)";
+  else if (timeScale_ > 1) {
     std::snprintf(buf, sizeof buf, " (from probes of 1/%.0f of the frame's pixels)", timeScale_);
     line += buf;
   }

@@ -715,6 +715,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   if (d.frame.residency.overflow)
     d.warn("the bricks this view needs exceed the memory budget: sampled from the whole volume in host memory");
   ++d.counters.frames;
+  if (autoProbes && d.autoBuilder.keptFrameDrawn(d.frame.seconds)) d.stats.choice = d.autoBuilder.choice();
   if (d.build.builder == BuilderKind::Auto && !autoProbes)
     if (d.autoBuilder.frameDone([&d] { return d.frameDeviceSeconds() > 0 ? d.frame.deviceSeconds : d.frame.seconds; },
                                 width, height, d.viewKey(cam), d.occupied()))
