@@ -23,6 +23,7 @@ parser.add_argument("--size", type=int, default=512)
 parser.add_argument("--view", type=int, nargs=2, default=[800, 600])
 parser.add_argument("--out", default="")
 parser.add_argument("--limit", type=float, default=2.0, help="seconds an interaction may take")
+parser.add_argument("--dense", action="store_true", help="ParaView's Wavelet source (dense) instead of the sparse file")
 args = parser.parse_args()
 N = args.size
 
@@ -59,12 +60,18 @@ def step(name, action):
 
 
 ssptest.load_plugin()
-path = ssptest.temp_path("interactions_%d.vti" % N)
-t0 = time.perf_counter()
-nonzero = ssptest.write_sparse_vti(path, N) if not os.path.exists(path) else -1
-print("volume %d^3 written in %.1f s (%s non-zero)" % (N, time.perf_counter() - t0,
-                                                       "%.1f%%" % (100 * nonzero) if nonzero >= 0 else "cached"))
-reader = XMLImageDataReader(FileName=[path])
+if args.dense:
+    reader = Wavelet(WholeExtent=[-(N // 2), N - N // 2 - 1] * 3)
+    ARRAY = "RTData"
+    print("volume: Wavelet %d^3 (dense)" % N)
+else:
+    path = ssptest.temp_path("interactions_%d.vti" % N)
+    t0 = time.perf_counter()
+    nonzero = ssptest.write_sparse_vti(path, N) if not os.path.exists(path) else -1
+    print("volume %d^3 written in %.1f s (%s non-zero)" % (N, time.perf_counter() - t0,
+                                                           "%.1f%%" % (100 * nonzero) if nonzero >= 0 else "cached"))
+    reader = XMLImageDataReader(FileName=[path])
+    ARRAY = "density"
 view = CreateView("RenderView")
 view.ViewSize = args.view
 view.EnableRenderOnInteraction = 0
@@ -90,17 +97,18 @@ def drag():
 
 
 step("drag the camera", drag)
-pwf = GetOpacityTransferFunction("density")
+pwf = GetOpacityTransferFunction(ARRAY)
 
 
 def opacity_edit():
     pts = list(pwf.Points)
-    pwf.Points = pts[:4] + [128.0, 0.2, 0.5, 0.0] + pts[4:]
+    mid = 0.5 * (pts[0] + pts[-4])
+    pwf.Points = pts[:4] + [mid, 0.2, 0.5, 0.0] + pts[4:]
     Render(view)
 
 
 step("opacity edit", opacity_edit)
-lut = GetColorTransferFunction("density")
+lut = GetColorTransferFunction(ARRAY)
 
 
 def colour_edit():
@@ -120,9 +128,9 @@ print("longest interaction: %s %.3f s (limit %.1f s); steps over 0.5 s with a ga
 if args.out:
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     with open(args.out, "w") as f:
-        f.write("# Interactions on a sparse %d^3 volume, CPU backend (pvpython)\n\n" % N)
-        f.write("Command: `pvpython bench/cpu/interactions.py --size %d --out %s` (PYTHONPATH=Testing/Plugin, "
-                "SPACESKIP_PLUGIN, SPACESKIP_TEMP set)\n\n" % (N, args.out))
+        f.write("# Interactions on a %s %d^3 volume, CPU backend (pvpython)\n\n" % ("dense" if args.dense else "sparse", N))
+        f.write("Command: `pvpython bench/cpu/interactions.py --size %d%s --out %s` (PYTHONPATH=Testing/Plugin, "
+                "SPACESKIP_PLUGIN, SPACESKIP_TEMP set)\n\n" % (N, " --dense" if args.dense else "", args.out))
         f.write("Machine: %s, %d cores, no GPU; %s; commit %s; view %dx%d\n\n"
                 % (platform.node() or "?", os.cpu_count(), time.strftime("%Y-%m-%d"), commit, *args.view))
         f.write("| step | seconds | progress events (ours) | longest wait between progress updates (s) |\n")
