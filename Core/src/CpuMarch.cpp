@@ -253,166 +253,207 @@ HWY_INLINE void Axis(VF p, VF hiF, VI hiI, VI& i0, VF& fr) {
   fr = hn::Sub(x, hn::ConvertTo(df, i0));
 }
 
+constexpr size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
+
+/// A packet's lanes: each one's ray, lattice anchor t0, current run of samples [kc, ke), its
+/// traversal, and where its pixel goes (outAt, -1: nowhere).
+template <class Iter>
+struct PacketLanes {
+  HWY_ALIGN float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes], dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes],
+      t0[kMaxLanes];
+  HWY_ALIGN int32_t kc[kMaxLanes], ke[kMaxLanes];
+  int64_t outAt[kMaxLanes];
+  march_detail::LaneRuns<Iter> runs[kMaxLanes];
+};
+
+/// Sets up the packet of pixels from (bx, by) (bw wide, clipped to x1, y1), lane by lane. Empty
+/// pixels and those left to renderPixel are written at once. false: no lane marches.
 template <class T, class Iter>
-void MarchTileT(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny, int64_t nz, int x0,
-                int y0, int x1, int y1, vec4f* px) {
+HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_t ny, int64_t nz, int bx, int by,
+                            int bw, int x1, int y1, vec4f* px, PacketLanes<Iter>& P) {
   using march_detail::LaneSetup;
+  const size_t N = hn::Lanes(DF());
+  bool any = false;
+  for (size_t l = 0; l < N; ++l) {
+    const int x = bx + int(l) % bw, y = by + int(l) / bw;
+    P.kc[l] = P.ke[l] = 0;
+    P.ox[l] = P.oy[l] = P.oz[l] = P.dx[l] = P.dy[l] = P.dz[l] = P.t0[l] = 0.f;
+    P.outAt[l] = -1;
+    if (x >= x1 || y >= y1) continue;
+    const int64_t at = int64_t(y) * f.width + x;
+    const LaneSetup s = march_detail::setupLane(f, x, y);
+    if (s.kind == LaneSetup::Empty) {
+      px[at] = vec4f{0, 0, 0, 0};
+      continue;
+    }
+    if (s.kind == LaneSetup::Scalar) {
+      px[at] = march_detail::scalarPixel(f, vox, nx, ny, nz, x, y);
+      continue;
+    }
+    P.outAt[l] = at;
+    P.ox[l] = s.r.org.x;
+    P.oy[l] = s.r.org.y;
+    P.oz[l] = s.r.org.z;
+    P.dx[l] = s.r.dir.x;
+    P.dy[l] = s.r.dir.y;
+    P.dz[l] = s.r.dir.z;
+    P.t0[l] = s.t0;
+    P.runs[l] = march_detail::LaneRuns<Iter>{};
+    march_detail::initIter(P.runs[l].it, f, s);
+    int64_t kb = 0, kEnd = 0;
+    if (P.runs[l].next(s.t0, f.dt, kb, kEnd)) {
+      P.kc[l] = int32_t(kb);
+      P.ke[l] = int32_t(kEnd);
+    }
+    any = true;
+  }
+  return any;
+}
+
+/// Lanes whose run is used up (and that have not stopped) take their next run
+/// (IntervalMarcher::marchRuns, lane by lane); lanes with none left stop.
+template <class Iter>
+HWY_INLINE void NextRuns(const FrameView& f, PacketLanes<Iter>& P, VI& k, VI& kEnd, MF& stopped) {
   const DF df;
   const DI di;
   const size_t N = hn::Lanes(df);
-  constexpr size_t kMax = HWY_MAX_BYTES / sizeof(float);
-  // A packet is a block of pixels (4x4 for 16 lanes, 4x2 for 8, 2x2 for 4): neighbouring rays
-  // have similar lengths and fetch neighbouring voxels.
-  const int bw = N >= 8 ? 4 : (N >= 4 ? 2 : int(N));
-  const int bh = int(N) / bw;
+  hn::Store(k, di, P.kc);
+  hn::Store(kEnd, di, P.ke);
+  HWY_ALIGN int32_t stop[kMaxLanes];
+  hn::Store(hn::VecFromMask(di, hn::RebindMask(di, stopped)), di, stop);
+  for (size_t l = 0; l < N; ++l) {
+    if (stop[l] || P.kc[l] < P.ke[l]) continue;
+    int64_t kb = 0, kx = 0;
+    if (P.runs[l].next(P.t0[l], f.dt, kb, kx)) {
+      P.kc[l] = int32_t(kb);
+      P.ke[l] = int32_t(kx);
+    } else {
+      P.kc[l] = P.ke[l] = 0;
+    }
+  }
+  k = hn::Load(di, P.kc);
+  kEnd = hn::Load(di, P.ke);
+  stopped = hn::Or(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
+}
 
-  HWY_ALIGN float ox[kMax], oy[kMax], oz[kMax], dx[kMax], dy[kMax], dz[kMax], t0[kMax];
-  HWY_ALIGN int32_t kc[kMax], ke[kMax];
-  HWY_ALIGN float rx[kMax], ry[kMax], rz[kMax], rw[kMax];
-  int64_t outAt[kMax];
-  march_detail::LaneRuns<Iter> runs[kMax];
-
+/// ArraySampler::sample at points (x, y, z) of the index space: trilinear between the eight
+/// voxels around each point.
+template <class T>
+HWY_INLINE VF Sample(const T* vox, int64_t nx, int64_t ny, int64_t nz, VF x, VF y, VF z) {
+  const DF df;
+  const DI di;
   const VF hx = hn::Set(df, float(nx - 1)), hy = hn::Set(df, float(ny - 1)), hz = hn::Set(df, float(nz - 1));
   const VI mx = hn::Set(di, int32_t(nx - 2)), my = hn::Set(di, int32_t(ny - 2)), mz = hn::Set(di, int32_t(nz - 2));
   const VI sy = hn::Set(di, int32_t(nx)), sz = hn::Set(di, int32_t(nx * ny));
   const VI sxy = hn::Set(di, int32_t(nx + nx * ny));
   const VI nyv = hn::Set(di, int32_t(ny));
-  const VI one = hn::Set(di, 1);
-  const VF dtv = hn::Set(df, f.dt), onef = hn::Set(df, 1.f), ert = hn::Set(df, f.ertThreshold);
+  VI ix, iy, iz;
+  VF fx, fy, fz;
+  Axis(x, hx, mx, ix, fx);
+  Axis(y, hy, my, iy, fy);
+  Axis(z, hz, mz, iz, fz);
+  const VI base = hn::Add(ix, hn::Mul(sy, hn::Add(iy, hn::Mul(nyv, iz))));
+  VF v000, v100, v010, v110, v001, v101, v011, v111;
+  FetchPair(vox, base, v000, v100);
+  FetchPair(vox, hn::Add(base, sy), v010, v110);
+  FetchPair(vox, hn::Add(base, sz), v001, v101);
+  FetchPair(vox, hn::Add(base, sxy), v011, v111);
+  const VF c00 = hn::Add(v000, hn::Mul(hn::Sub(v100, v000), fx));
+  const VF c10 = hn::Add(v010, hn::Mul(hn::Sub(v110, v010), fx));
+  const VF c01 = hn::Add(v001, hn::Mul(hn::Sub(v101, v001), fx));
+  const VF c11 = hn::Add(v011, hn::Mul(hn::Sub(v111, v011), fx));
+  const VF c0 = hn::Add(c00, hn::Mul(hn::Sub(c10, c00), fy));
+  const VF c1 = hn::Add(c01, hn::Mul(hn::Sub(c11, c01), fy));
+  return hn::Add(c0, hn::Mul(hn::Sub(c1, c0), fz));
+}
+
+/// lookup() of samples v and IntervalMarcher::composite into (ax, ay, az, aw) for the live
+/// lanes: NaN is transparent; opacity first, colour only where a lane composites; a lane that
+/// composites and reaches the threshold stops.
+HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF live, VF& ax, VF& ay, VF& az,
+                                VF& aw, MF& stopped) {
+  const DF df;
+  const DI di;
+  const VF onef = hn::Set(df, 1.f), ert = hn::Set(df, f.ertThreshold);
   const VF tfLo = hn::Set(df, f.tf.lo), tfScale = hn::Set(df, f.tf.scale), tfHi = hn::Set(df, float(f.tf.size - 1));
   const int64_t pairStride = 2 * int64_t(f.tf.size);  // floats per channel in `pairs`
+  VF xt = hn::Mul(hn::Sub(v, tfLo), tfScale);
+  const MF nan = hn::IsNaN(xt);
+  xt = Clamp(hn::IfThenZeroElse(nan, xt), hn::Zero(df), tfHi);
+  const VI e0 = hn::ConvertTo(di, xt);
+  const VF fr = hn::Sub(xt, hn::ConvertTo(df, e0));
+  // Entry e0 and the next one (e1 = min(e0 + 1, size - 1)) side by side in the pair table.
+  const VI q = hn::ShiftLeft<1>(e0);
+  VF a0, a1;
+  GatherPairs(pairs + 3 * pairStride, q, a0, a1);
+  const VF cw = hn::Add(a0, hn::Mul(hn::Sub(a1, a0), fr));
+  const MF comp = hn::And(live, hn::AndNot(nan, hn::Gt(cw, hn::Zero(df))));
+  if (hn::AllFalse(df, comp)) return;
+  VF r0, r1, g0, g1, b0, b1;
+  GatherPairs(pairs, q, r0, r1);
+  GatherPairs(pairs + pairStride, q, g0, g1);
+  GatherPairs(pairs + 2 * pairStride, q, b0, b1);
+  const VF cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
+  const VF cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
+  const VF cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
+  // IntervalMarcher::composite, front-to-back "over".
+  const VF w = hn::Mul(hn::Sub(onef, aw), cw);
+  ax = hn::IfThenElse(comp, hn::Add(ax, hn::Mul(w, cx)), ax);
+  ay = hn::IfThenElse(comp, hn::Add(ay, hn::Mul(w, cy)), ay);
+  az = hn::IfThenElse(comp, hn::Add(az, hn::Mul(w, cz)), az);
+  aw = hn::IfThenElse(comp, hn::Add(aw, w), aw);
+  // Early ray termination after a composited sample: !(acc.w < threshold).
+  stopped = hn::Or(stopped, hn::AndNot(hn::Lt(aw, ert), comp));
+}
 
+/// Marches the set-up packet P to the end (all lanes stopped) and writes its pixels.
+template <class T, class Iter>
+HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny, int64_t nz,
+                            PacketLanes<Iter>& P, vec4f* px) {
+  const DF df;
+  const DI di;
+  const size_t N = hn::Lanes(df);
+  const VI one = hn::Set(di, 1);
+  const VF dtv = hn::Set(df, f.dt);
+  const VF vox_ = hn::Load(df, P.ox), voy = hn::Load(df, P.oy), voz = hn::Load(df, P.oz);
+  const VF vdx = hn::Load(df, P.dx), vdy = hn::Load(df, P.dy), vdz = hn::Load(df, P.dz);
+  const VF vt0 = hn::Load(df, P.t0);
+  VI k = hn::Load(di, P.kc), kEnd = hn::Load(di, P.ke);
+  VF ax = hn::Zero(df), ay = hn::Zero(df), az = hn::Zero(df), aw = hn::Zero(df);
+  MF stopped = hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd)));  // no samples, or terminated
+  for (;;) {
+    const MF spent = hn::AndNot(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
+    if (!hn::AllFalse(df, spent)) NextRuns(f, P, k, kEnd, stopped);
+    const MF live = hn::Not(stopped);
+    if (hn::AllFalse(df, live)) break;
+    // IntervalMarcher::take(k): t = t0 + float(k) * dt, p = org + dir * t.
+    const VF t = hn::Add(vt0, hn::Mul(hn::ConvertTo(df, k), dtv));
+    const VF v = Sample(vox, nx, ny, nz, hn::Add(vox_, hn::Mul(vdx, t)), hn::Add(voy, hn::Mul(vdy, t)),
+                        hn::Add(voz, hn::Mul(vdz, t)));
+    LookupComposite(f, pairs, v, live, ax, ay, az, aw, stopped);
+    k = hn::Add(k, one);
+  }
+  HWY_ALIGN float rx[kMaxLanes], ry[kMaxLanes], rz[kMaxLanes], rw[kMaxLanes];
+  hn::Store(ax, df, rx);
+  hn::Store(ay, df, ry);
+  hn::Store(az, df, rz);
+  hn::Store(aw, df, rw);
+  for (size_t l = 0; l < N; ++l)
+    if (P.outAt[l] >= 0) px[P.outAt[l]] = vec4f{rx[l], ry[l], rz[l], rw[l]};
+}
+
+template <class T, class Iter>
+void MarchTileT(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny, int64_t nz, int x0,
+                int y0, int x1, int y1, vec4f* px) {
+  const size_t N = hn::Lanes(DF());
+  // A packet is a block of pixels (4x4 for 16 lanes, 4x2 for 8, 2x2 for 4): neighbouring rays
+  // have similar lengths and fetch neighbouring voxels.
+  const int bw = N >= 8 ? 4 : (N >= 4 ? 2 : int(N));
+  const int bh = int(N) / bw;
+  PacketLanes<Iter> P;
   for (int by = y0; by < y1; by += bh)
-    for (int bx = x0; bx < x1; bx += bw) {
-      bool any = false;
-      for (size_t l = 0; l < N; ++l) {
-        const int x = bx + int(l) % bw, y = by + int(l) / bw;
-        kc[l] = ke[l] = 0;
-        ox[l] = oy[l] = oz[l] = dx[l] = dy[l] = dz[l] = t0[l] = 0.f;
-        outAt[l] = -1;
-        if (x >= x1 || y >= y1) continue;
-        const int64_t at = int64_t(y) * f.width + x;
-        const LaneSetup s = march_detail::setupLane(f, x, y);
-        if (s.kind == LaneSetup::Empty) {
-          px[at] = vec4f{0, 0, 0, 0};
-          continue;
-        }
-        if (s.kind == LaneSetup::Scalar) {
-          px[at] = march_detail::scalarPixel(f, vox, nx, ny, nz, x, y);
-          continue;
-        }
-        outAt[l] = at;
-        ox[l] = s.r.org.x;
-        oy[l] = s.r.org.y;
-        oz[l] = s.r.org.z;
-        dx[l] = s.r.dir.x;
-        dy[l] = s.r.dir.y;
-        dz[l] = s.r.dir.z;
-        t0[l] = s.t0;
-        runs[l] = march_detail::LaneRuns<Iter>{};
-        march_detail::initIter(runs[l].it, f, s);
-        int64_t kb = 0, kEnd = 0;
-        if (runs[l].next(s.t0, f.dt, kb, kEnd)) {
-          kc[l] = int32_t(kb);
-          ke[l] = int32_t(kEnd);
-        }
-        any = true;
-      }
-      if (!any) continue;
-
-      const VF vox_ = hn::Load(df, ox), voy = hn::Load(df, oy), voz = hn::Load(df, oz);
-      const VF vdx = hn::Load(df, dx), vdy = hn::Load(df, dy), vdz = hn::Load(df, dz);
-      const VF vt0 = hn::Load(df, t0);
-      VI k = hn::Load(di, kc), kEnd = hn::Load(di, ke);
-      VF ax = hn::Zero(df), ay = hn::Zero(df), az = hn::Zero(df), aw = hn::Zero(df);
-      MF stopped = hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd)));  // no samples, or terminated
-      for (;;) {
-        MF live = hn::Not(stopped);
-        // Lanes whose run is used up take their next run (IntervalMarcher::marchRuns, lane by lane).
-        const MF spent = hn::AndNot(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
-        if (!hn::AllFalse(df, spent)) {
-          hn::Store(k, di, kc);
-          hn::Store(kEnd, di, ke);
-          HWY_ALIGN int32_t stop[kMax];
-          hn::Store(hn::VecFromMask(di, hn::RebindMask(di, stopped)), di, stop);
-          for (size_t l = 0; l < N; ++l) {
-            if (stop[l] || kc[l] < ke[l]) continue;
-            int64_t kb = 0, kx = 0;
-            if (runs[l].next(t0[l], f.dt, kb, kx)) {
-              kc[l] = int32_t(kb);
-              ke[l] = int32_t(kx);
-            } else {
-              kc[l] = ke[l] = 0;
-            }
-          }
-          k = hn::Load(di, kc);
-          kEnd = hn::Load(di, ke);
-          stopped = hn::Or(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
-          live = hn::Not(stopped);
-        }
-        if (hn::AllFalse(df, live)) break;
-        // IntervalMarcher::take(k): t = t0 + float(k) * dt, p = org + dir * t.
-        const VF t = hn::Add(vt0, hn::Mul(hn::ConvertTo(df, k), dtv));
-        const VF px_ = hn::Add(vox_, hn::Mul(vdx, t));
-        const VF py_ = hn::Add(voy, hn::Mul(vdy, t));
-        const VF pz_ = hn::Add(voz, hn::Mul(vdz, t));
-        // ArraySampler::sample.
-        VI ix, iy, iz;
-        VF fx, fy, fz;
-        Axis(px_, hx, mx, ix, fx);
-        Axis(py_, hy, my, iy, fy);
-        Axis(pz_, hz, mz, iz, fz);
-        const VI base = hn::Add(ix, hn::Mul(sy, hn::Add(iy, hn::Mul(nyv, iz))));
-        VF v000, v100, v010, v110, v001, v101, v011, v111;
-        FetchPair(vox, base, v000, v100);
-        FetchPair(vox, hn::Add(base, sy), v010, v110);
-        FetchPair(vox, hn::Add(base, sz), v001, v101);
-        FetchPair(vox, hn::Add(base, sxy), v011, v111);
-        const VF c00 = hn::Add(v000, hn::Mul(hn::Sub(v100, v000), fx));
-        const VF c10 = hn::Add(v010, hn::Mul(hn::Sub(v110, v010), fx));
-        const VF c01 = hn::Add(v001, hn::Mul(hn::Sub(v101, v001), fx));
-        const VF c11 = hn::Add(v011, hn::Mul(hn::Sub(v111, v011), fx));
-        const VF c0 = hn::Add(c00, hn::Mul(hn::Sub(c10, c00), fy));
-        const VF c1 = hn::Add(c01, hn::Mul(hn::Sub(c11, c01), fy));
-        const VF v = hn::Add(c0, hn::Mul(hn::Sub(c1, c0), fz));
-        // lookup(): NaN is transparent; opacity first, colour only where a lane composites.
-        VF xt = hn::Mul(hn::Sub(v, tfLo), tfScale);
-        const MF nan = hn::IsNaN(xt);
-        xt = Clamp(hn::IfThenZeroElse(nan, xt), hn::Zero(df), tfHi);
-        const VI e0 = hn::ConvertTo(di, xt);
-        const VF fr = hn::Sub(xt, hn::ConvertTo(df, e0));
-        // Entry e0 and the next one (e1 = min(e0 + 1, size - 1)) side by side in the pair table.
-        const VI q = hn::ShiftLeft<1>(e0);
-        VF a0, a1;
-        GatherPairs(pairs + 3 * pairStride, q, a0, a1);
-        const VF cw = hn::Add(a0, hn::Mul(hn::Sub(a1, a0), fr));
-        const MF comp = hn::And(live, hn::AndNot(nan, hn::Gt(cw, hn::Zero(df))));
-        if (!hn::AllFalse(df, comp)) {
-          VF r0, r1, g0, g1, b0, b1;
-          GatherPairs(pairs, q, r0, r1);
-          GatherPairs(pairs + pairStride, q, g0, g1);
-          GatherPairs(pairs + 2 * pairStride, q, b0, b1);
-          const VF cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
-          const VF cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
-          const VF cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
-          // IntervalMarcher::composite, front-to-back "over".
-          const VF w = hn::Mul(hn::Sub(onef, aw), cw);
-          ax = hn::IfThenElse(comp, hn::Add(ax, hn::Mul(w, cx)), ax);
-          ay = hn::IfThenElse(comp, hn::Add(ay, hn::Mul(w, cy)), ay);
-          az = hn::IfThenElse(comp, hn::Add(az, hn::Mul(w, cz)), az);
-          aw = hn::IfThenElse(comp, hn::Add(aw, w), aw);
-          // Early ray termination after a composited sample: !(acc.w < threshold).
-          stopped = hn::Or(stopped, hn::AndNot(hn::Lt(aw, ert), comp));
-        }
-        k = hn::Add(k, one);
-      }
-      hn::Store(ax, df, rx);
-      hn::Store(ay, df, ry);
-      hn::Store(az, df, rz);
-      hn::Store(aw, df, rw);
-      for (size_t l = 0; l < N; ++l)
-        if (outAt[l] >= 0) px[outAt[l]] = vec4f{rx[l], ry[l], rz[l], rw[l]};
-    }
+    for (int bx = x0; bx < x1; bx += bw)
+      if (SetupPacket(f, vox, nx, ny, nz, bx, by, bw, x1, y1, px, P)) MarchPacket(f, pairs, vox, nx, ny, nz, P, px);
 }
 
 template <class T>
