@@ -108,6 +108,57 @@ inline vtkSmartPointer<vtkImageData> Capture(vtkRenderWindow* win)
   return img;
 }
 
+// nx x ny x nz points whose scalars (array type A, named `name`) are value(x, y, z) at point
+// indices (x, y, z).
+template <class A, class F>
+inline vtkSmartPointer<vtkImageData> MakePointField(int nx, int ny, int nz, const char* name, F value)
+{
+  auto img = vtkSmartPointer<vtkImageData>::New();
+  img->SetDimensions(nx, ny, nz);
+  vtkNew<A> a;
+  a->SetName(name);
+  a->SetNumberOfTuples(vtkIdType(nx) * ny * nz);
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x)
+      {
+        a->SetValue((vtkIdType(z) * ny + y) * nx + x, value(x, y, z));
+      }
+  img->GetPointData()->SetScalars(a);
+  return img;
+}
+
+// Gaussian blobs in uint8 ("blobs") on nx x ny x nz points: the largest of `peak` *
+// exp(-d^2 / (2 s^2)) over the blobs {x, y, z, s} (point indices), values below `cut` set to 0.
+inline vtkSmartPointer<vtkImageData> MakeBlobs(
+  int nx, int ny, int nz, std::initializer_list<std::array<double, 4>> blobs, double peak, double cut = 0)
+{
+  return MakePointField<vtkUnsignedCharArray>(nx, ny, nz, "blobs", [&](int x, int y, int z) {
+    double v = 0;
+    for (const auto& b : blobs)
+    {
+      const double d2 = (x - b[0]) * (x - b[0]) + (y - b[1]) * (y - b[1]) + (z - b[2]) * (z - b[2]);
+      v = std::max(v, peak * std::exp(-d2 / (2 * b[3] * b[3])));
+    }
+    return static_cast<unsigned char>(v < cut ? 0 : v);
+  });
+}
+
+// `mapper` on the CUDA backend renders `win`; false (printing "no usable CUDA device (backend used:
+// ..): <skipped>") where the frame was not drawn by CUDA.
+inline bool RenderOnCUDA(vtkSpaceSkippingVolumeMapper* mapper, vtkRenderWindow* win, const char* skipped)
+{
+  mapper->SetBackendToCUDA();
+  win->Render();
+  if (std::string(mapper->GetBackendUsed()) != "cuda")
+  {
+    std::cout << "no usable CUDA device (backend used: " << mapper->GetBackendUsed()
+              << "): " << skipped << "\n";
+    return false;
+  }
+  return true;
+}
+
 // Points `volume` at `mapper`, renders the window and captures it.
 inline vtkSmartPointer<vtkImageData> RenderWith(
   vtkRenderWindow* win, vtkVolume* volume, vtkAbstractVolumeMapper* mapper)
@@ -307,6 +358,29 @@ inline double PrintComparison(const std::string& name, vtkImageData* reference, 
 constexpr double kNavy[3] = { 0.1, 0.1, 0.2 };
 constexpr double kBlack[3] = { 0, 0, 0 };
 
+// One case of a test against vtkGPUVolumeRayCastMapper on kNavy: `volume` drawn by `gpu`, then by
+// `ours`; prints the comparison, writes both images as <dir>/<test>-<name>-gpu.png and -ours.png,
+// and counts a failure (printing FAILED) where the PSNR is below `minPSNR` or ours drew fewer
+// than 5000 pixels. Returns ours' image.
+inline vtkSmartPointer<vtkImageData> CompareWithGPU(vtkRenderWindow* win, vtkVolume* volume,
+  vtkAbstractVolumeMapper* gpu, vtkAbstractVolumeMapper* ours, const std::string& dir,
+  const std::string& test, const std::string& name, double minPSNR, int& failures)
+{
+  auto a = RenderWith(win, volume, gpu);
+  auto b = RenderWith(win, volume, ours);
+  const double psnr = PrintComparison(name, a, b);
+  std::cout << "\n";
+  WritePNG(a, dir + "/" + test + "-" + name + "-gpu.png");
+  WritePNG(b, dir + "/" + test + "-" + name + "-ours.png");
+  if (psnr < minPSNR || CountNonBackground(b, kNavy) < 5000)
+  {
+    std::cout << "  FAILED (threshold " << minPSNR << " dB)\n";
+    ++failures;
+  }
+  return b;
+}
+
+
 // What every test draws in: `mapper` with `Property` as `Volume`, in one renderer with background
 // `bg`, in a `width` x `height` window without multisampling (the baselines are made without).
 // `interactive` gives the window an interactor before its first frame (the image tests: their -I
@@ -435,6 +509,31 @@ struct ImageTest
     SS_CHECK(drawn > 5000 && drawn < 300 * 300);
     SS_CHECK(std::string(this->Mapper->GetBackendUsed()) != "none");
     return this->Stage.Regression(argc, argv);
+  }
+
+  // Every builder's image (Naive to DistanceGrid) against Naive's, each printed as "<label>builder
+  // .. -> ..: max |diff| vs Naive ../255"; how many differ by more than 1/255.
+  int BuildersAgainstNaive(const std::string& label)
+  {
+    int failures = 0;
+    vtkSmartPointer<vtkImageData> naive;
+    for (int b = vtkSpaceSkippingVolumeMapper::Naive; b <= vtkSpaceSkippingVolumeMapper::DistanceGrid; ++b)
+    {
+      this->Mapper->SetBuilder(b);
+      auto shot = this->Stage.Shot();
+      if (!naive)
+      {
+        naive = shot;
+      }
+      const int d = MaxDiff(naive, shot);
+      std::cout << label << "builder " << this->Mapper->GetBuilderAsString() << " -> "
+                << this->Mapper->GetBuilderUsed() << ": max |diff| vs Naive " << d << "/255\n";
+      if (d > 1)
+      {
+        ++failures;
+      }
+    }
+    return failures;
   }
 
   vtkSmartPointer<vtkImageData> Image;

@@ -74,9 +74,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <initializer_list>
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 // GLEW's glewInit() ends with its GLX part, which fails without a current GLX context's display
@@ -398,6 +400,23 @@ double StreamedRender(vtkRenderWindow* win, vtkRenderer* ren, const double b[6],
   glFinish();
   return Since(t0);
 }
+
+// `out` set to the value that `names` gives `m`; false (printing "unknown <what> <m><hint>")
+// where m is none of the names.
+bool Named(const std::string& m, std::initializer_list<std::pair<const char*, int>> names, int& out,
+  const char* what, const char* hint = "")
+{
+  for (const auto& n : names)
+  {
+    if (m == n.first)
+    {
+      out = n.second;
+      return true;
+    }
+  }
+  std::cerr << "unknown " << what << " " << m << hint << "\n";
+  return false;
+}
 } // namespace
 
 int main(int argc, char* argv[])
@@ -410,6 +429,20 @@ int main(int argc, char* argv[])
   bool shade = false, depthActor = false;
   int blend = vtkVolumeMapper::COMPOSITE_BLEND;
   int filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
+  // The on/off options.
+  const std::pair<const char*, bool*> flags[] = { { "--vtk-gpu", &vtkGpu }, { "--egl", &egl },
+    { "--float-composite", &floatComposite }, { "--ert", &ert }, { "--host-composite", &hostComposite },
+    { "--shade", &shade }, { "--depth-actor", &depthActor } };
+  auto Flag = [&](const std::string& a) -> bool* {
+    for (const auto& f : flags)
+    {
+      if (a == f.first)
+      {
+        return f.second;
+      }
+    }
+    return nullptr;
+  };
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -428,49 +461,29 @@ int main(int argc, char* argv[])
       edits = std::max(0, std::atoi(next().c_str()));
     else if (a == "--edit-cut")
       editCut = std::atof(next().c_str());
-    else if (a == "--vtk-gpu")
-      vtkGpu = true;
-    else if (a == "--egl")
-      egl = true;
-    else if (a == "--float-composite")
-      floatComposite = true;
-    else if (a == "--ert")
-      ert = true;
-    else if (a == "--host-composite")
-      hostComposite = true;
-    else if (a == "--shade")
-      shade = true;
-    else if (a == "--depth-actor")
-      depthActor = true;
+    else if (bool* flag = Flag(a))
+      *flag = true;
     else if (a == "--blend")
     {
-      const std::string m = next();
-      if (m == "composite")
-        blend = vtkVolumeMapper::COMPOSITE_BLEND;
-      else if (m == "mip")
-        blend = vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND;
-      else if (m == "minip")
-        blend = vtkVolumeMapper::MINIMUM_INTENSITY_BLEND;
-      else if (m == "average")
-        blend = vtkVolumeMapper::AVERAGE_INTENSITY_BLEND;
-      else if (m == "additive")
-        blend = vtkVolumeMapper::ADDITIVE_BLEND;
-      else
+      if (!Named(next(),
+            { { "composite", vtkVolumeMapper::COMPOSITE_BLEND },
+              { "mip", vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND },
+              { "minip", vtkVolumeMapper::MINIMUM_INTENSITY_BLEND },
+              { "average", vtkVolumeMapper::AVERAGE_INTENSITY_BLEND },
+              { "additive", vtkVolumeMapper::ADDITIVE_BLEND } },
+            blend, "blend mode"))
       {
-        std::cerr << "unknown blend mode " << m << "\n";
         return 2;
       }
     }
     else if (a == "--filter")
     {
-      const std::string m = next();
-      if (m == "hw" || m == "hardware")
-        filter = vtkSpaceSkippingVolumeMapper::HardwareFilter;
-      else if (m == "exact")
-        filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
-      else
+      if (!Named(next(),
+            { { "hw", vtkSpaceSkippingVolumeMapper::HardwareFilter },
+              { "hardware", vtkSpaceSkippingVolumeMapper::HardwareFilter },
+              { "exact", vtkSpaceSkippingVolumeMapper::ExactFilter } },
+            filter, "filter", " (hw or exact)"))
       {
-        std::cerr << "unknown filter " << m << " (hw or exact)\n";
         return 2;
       }
     }

@@ -20,26 +20,13 @@ int TestSpaceSkippingVolumeFilterMode(int, char*[])
 {
   // This test chooses the backend itself: no override from the environment.
   unsetenv("SPACESKIP_BACKEND");
-  vtkNew<vtkRenderer> ren;
-  const double bg[3] = { 0.1, 0.1, 0.2 };
-  ren->SetBackground(bg[0], bg[1], bg[2]);
-  vtkNew<vtkRenderWindow> win;
-  win->SetMultiSamples(0);
-  win->SetSize(200, 200);
-  win->AddRenderer(ren);
   auto image = sstest::MakeWavelet(64);
   vtkNew<vtkSpaceSkippingVolumeMapper> mapper;
   mapper->SetInputData(image);
-  vtkNew<vtkVolumeProperty> prop;
-  sstest::SetupProperty(prop, image, 0.8);
-  vtkNew<vtkVolume> volume;
-  volume->SetMapper(mapper);
-  volume->SetProperty(prop);
-  ren->AddVolume(volume);
-  ren->ResetCamera();
-  ren->GetActiveCamera()->Azimuth(30);
-  ren->GetActiveCamera()->Elevation(20);
-  ren->ResetCameraClippingRange();
+  sstest::Scene scene(mapper, 200, 200, sstest::kNavy);
+  vtkRenderWindow* win = scene.Window;
+  sstest::SetupProperty(scene.Property, image, 0.8);
+  scene.View(30, 20);
 
   // The property: default Exact, clamped, named.
   SS_CHECK(mapper->GetFilterMode() == vtkSpaceSkippingVolumeMapper::ExactFilter);
@@ -61,7 +48,7 @@ int TestSpaceSkippingVolumeFilterMode(int, char*[])
   mapper->SetFilterModeToHardware();
   win->Render();
   auto hw = sstest::Capture(win);
-  const vtkIdType drawn = sstest::CountNonBackground(hw, bg);
+  const vtkIdType drawn = sstest::CountNonBackground(hw, sstest::kNavy);
   std::cout << "CPU backend: Hardware vs Exact max diff " << sstest::MaxDiff(exact, hw)
             << "/255, drawn " << drawn << " pixels; builds " << builds << " -> "
             << mapper->GetBuildCount() << ", classifications " << classifications << " -> "
@@ -72,14 +59,10 @@ int TestSpaceSkippingVolumeFilterMode(int, char*[])
   SS_CHECK(mapper->GetClassifyCount() == classifications);
 
   // CUDA backend, when there is a usable device.
-  mapper->SetBackendToCUDA();
   mapper->SetBuilderToNaive();
   mapper->SetFilterModeToExact();
-  win->Render();
-  if (std::string(mapper->GetBackendUsed()) != "cuda")
+  if (!sstest::RenderOnCUDA(mapper, win, "CUDA part skipped"))
   {
-    std::cout << "no usable CUDA device (backend used: " << mapper->GetBackendUsed()
-              << "): CUDA part skipped\n";
     return EXIT_SUCCESS;
   }
   auto cudaExact = sstest::Capture(win);

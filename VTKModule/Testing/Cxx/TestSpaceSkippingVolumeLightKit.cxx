@@ -109,17 +109,8 @@ int TestSpaceSkippingVolumeLightKit(int argc, char* argv[])
     cam->SetParallelProjection(c.perspective ? 0 : 1);
     gpu->SetBlendMode(c.blend);
     t.Mapper->SetBlendMode(c.blend);
-    auto a = sstest::RenderWith(win, volume, gpu);
-    auto b = sstest::RenderWith(win, volume, t.Mapper);
-    const double psnr = sstest::PrintComparison(c.name, a, b);
-    std::cout << "\n";
-    sstest::WritePNG(a, dir + "/TestSpaceSkippingVolumeLightKit-" + c.name + "-gpu.png");
-    sstest::WritePNG(b, dir + "/TestSpaceSkippingVolumeLightKit-" + c.name + "-ours.png");
-    if (psnr < kMinPSNR || sstest::CountNonBackground(b, sstest::kNavy) < 5000)
-    {
-      std::cout << "  FAILED (threshold " << kMinPSNR << " dB)\n";
-      ++failures;
-    }
+    auto b = sstest::CompareWithGPU(
+      win, volume, gpu, t.Mapper, dir, "TestSpaceSkippingVolumeLightKit", c.name, kMinPSNR, failures);
     if (!first)
     {
       first = b;
@@ -136,23 +127,7 @@ int TestSpaceSkippingVolumeLightKit(int argc, char* argv[])
   useKit();
 
   // Every builder equals Naive with the light kit.
-  vtkSmartPointer<vtkImageData> naive;
-  for (int b = vtkSpaceSkippingVolumeMapper::Naive; b <= vtkSpaceSkippingVolumeMapper::DistanceGrid; ++b)
-  {
-    t.Mapper->SetBuilder(b);
-    auto shot = t.Stage.Shot();
-    if (!naive)
-    {
-      naive = shot;
-    }
-    const int d = sstest::MaxDiff(naive, shot);
-    std::cout << "light kit, builder " << t.Mapper->GetBuilderAsString() << " -> "
-              << t.Mapper->GetBuilderUsed() << ": max |diff| vs Naive " << d << "/255\n";
-    if (d > 1)
-    {
-      ++failures;
-    }
-  }
+  failures += t.BuildersAgainstNaive("light kit, ");
   // Only the GPU builders' fallbacks may have warned (machines without CUDA), not the lights.
   SS_CHECK(messages->Warnings.find("light") == std::string::npos);
   messages->Clear();

@@ -75,17 +75,8 @@ int TestSpaceSkippingVolumeSlice(int argc, char* argv[])
     plane->SetNormal(c.normal[0], c.normal[1], c.normal[2]);
     volume->SetPosition(c.transformed ? 6.0 : 0.0, c.transformed ? -4.0 : 0.0, c.transformed ? 3.0 : 0.0);
     volume->SetOrientation(0.0, c.transformed ? 10.0 : 0.0, c.transformed ? 25.0 : 0.0);
-    auto a = sstest::RenderWith(win, volume, gpu);
-    auto b = sstest::RenderWith(win, volume, t.Mapper);
-    const double psnr = sstest::PrintComparison(c.name, a, b);
-    std::cout << "\n";
-    sstest::WritePNG(a, dir + "/TestSpaceSkippingVolumeSlice-" + c.name + "-gpu.png");
-    sstest::WritePNG(b, dir + "/TestSpaceSkippingVolumeSlice-" + c.name + "-ours.png");
-    if (psnr < kMinPSNR || sstest::CountNonBackground(b, sstest::kNavy) < 5000)
-    {
-      std::cout << "  FAILED (threshold " << kMinPSNR << " dB)\n";
-      ++failures;
-    }
+    auto b = sstest::CompareWithGPU(
+      win, volume, gpu, t.Mapper, dir, "TestSpaceSkippingVolumeSlice", c.name, kMinPSNR, failures);
     if (std::string(c.name).find("offcentre") != std::string::npos)
     {
       // Not the centre fallback: the plane through the data's centre, normal z, differs.
@@ -111,23 +102,7 @@ int TestSpaceSkippingVolumeSlice(int argc, char* argv[])
   for (int shade = 0; shade < 2; ++shade)
   {
     prop->SetShade(shade);
-    vtkSmartPointer<vtkImageData> naive;
-    for (int b = vtkSpaceSkippingVolumeMapper::Naive; b <= vtkSpaceSkippingVolumeMapper::DistanceGrid; ++b)
-    {
-      t.Mapper->SetBuilder(b);
-      auto shot = t.Stage.Shot();
-      if (!naive)
-      {
-        naive = shot;
-      }
-      const int d = sstest::MaxDiff(naive, shot);
-      std::cout << "shade " << shade << " builder " << t.Mapper->GetBuilderAsString() << " -> "
-                << t.Mapper->GetBuilderUsed() << ": max |diff| vs Naive " << d << "/255\n";
-      if (d > 1)
-      {
-        ++failures;
-      }
-    }
+    failures += t.BuildersAgainstNaive("shade " + std::to_string(shade) + " ");
   }
   prop->ShadeOff();
 

@@ -20,28 +20,8 @@ namespace
 // Gaussian blobs in uint8 on 192^3 points (7 MiB): a few percent of the volume visible.
 vtkSmartPointer<vtkImageData> MakeSparseBlobs()
 {
-  const int n = 192;
-  auto img = vtkSmartPointer<vtkImageData>::New();
-  img->SetDimensions(n, n, n);
-  vtkNew<vtkUnsignedCharArray> a;
-  a->SetName("blobs");
-  a->SetNumberOfTuples(vtkIdType(n) * n * n);
-  const double c[4][4] = { { 40, 50, 60, 10 }, { 130, 70, 50, 14 }, { 90, 140, 150, 12 },
-    { 160, 160, 40, 7 } };
-  for (int z = 0; z < n; ++z)
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x)
-      {
-        double v = 0;
-        for (const auto& b : c)
-        {
-          const double d2 = (x - b[0]) * (x - b[0]) + (y - b[1]) * (y - b[1]) + (z - b[2]) * (z - b[2]);
-          v = std::max(v, 250.0 * std::exp(-d2 / (2 * b[3] * b[3])));
-        }
-        a->SetValue((vtkIdType(z) * n + y) * n + x, static_cast<unsigned char>(v < 4 ? 0 : v));
-      }
-  img->GetPointData()->SetScalars(a);
-  return img;
+  return sstest::MakeBlobs(192, 192, 192,
+    { { 40, 50, 60, 10 }, { 130, 70, 50, 14 }, { 90, 140, 150, 12 }, { 160, 160, 40, 7 } }, 250.0, 4);
 }
 
 // Transparent below `from`, then a ramp.
