@@ -112,6 +112,21 @@ bool DrawBox(vtkOpenGLState* ostate, const int rect[4], int vp[4], int box[4])
   }
   return true;
 }
+
+// `texture` (made on first use) in `renWin`'s context, sampled as the compositing draws it:
+// nearest, clamped to the edge.
+void PrepareTexture(vtkSmartPointer<vtkTextureObject>& texture, vtkOpenGLRenderWindow* renWin)
+{
+  if (!texture)
+  {
+    texture = vtkSmartPointer<vtkTextureObject>::New();
+  }
+  texture->SetContext(renWin);
+  texture->SetMinificationFilter(vtkTextureObject::Nearest);
+  texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+  texture->SetWrapS(vtkTextureObject::ClampToEdge);
+  texture->SetWrapT(vtkTextureObject::ClampToEdge);
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -343,15 +358,7 @@ bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip
 void vtkSpaceSkipCompositor::UploadHostImage(vtkOpenGLRenderWindow* renWin,
   const spaceskip::Image* image, int width, int height, bool eightBit)
 {
-  if (!this->Texture)
-  {
-    this->Texture = vtkSmartPointer<vtkTextureObject>::New();
-  }
-  this->Texture->SetContext(renWin);
-  this->Texture->SetMinificationFilter(vtkTextureObject::Nearest);
-  this->Texture->SetMagnificationFilter(vtkTextureObject::Nearest);
-  this->Texture->SetWrapS(vtkTextureObject::ClampToEdge);
-  this->Texture->SetWrapT(vtkTextureObject::ClampToEdge);
+  PrepareTexture(this->Texture, renWin);
   if (!image)
   {
     return; // this frame is drawn from the interop texture
@@ -615,15 +622,7 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(vtkOpenGLRenderWindow* renWin,
       this->InteropProblem = std::string("the window's OpenGL is ") + other + "'s, not NVIDIA's";
       return false;
     }
-    if (!this->InteropTexture)
-    {
-      this->InteropTexture = vtkSmartPointer<vtkTextureObject>::New();
-    }
-    this->InteropTexture->SetContext(renWin);
-    this->InteropTexture->SetMinificationFilter(vtkTextureObject::Nearest);
-    this->InteropTexture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    this->InteropTexture->SetWrapS(vtkTextureObject::ClampToEdge);
-    this->InteropTexture->SetWrapT(vtkTextureObject::ClampToEdge);
+    PrepareTexture(this->InteropTexture, renWin);
     // vtkTextureObject keeps the first internal format it chose: RGBA8 <-> RGBA32F needs a reset.
     this->InteropTexture->ResetFormatAndType();
     if (!this->InteropTexture->Allocate2D(static_cast<unsigned>(w), static_cast<unsigned>(h), 4,

@@ -16,36 +16,26 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 namespace
 {
 // Core voxel types by VTK type; int/unsigned int/long become float (see ConvertibleToFloat).
 bool CoreTypeOf(int vtkType, spaceskip::VoxelType& out)
 {
-  switch (vtkType)
+  using VT = spaceskip::VoxelType;
+  static const std::pair<int, VT> kTypes[] = { { VTK_UNSIGNED_CHAR, VT::UInt8 },
+    { VTK_CHAR, VT::Int8 }, { VTK_SIGNED_CHAR, VT::Int8 }, { VTK_UNSIGNED_SHORT, VT::UInt16 },
+    { VTK_SHORT, VT::Int16 }, { VTK_FLOAT, VT::Float32 }, { VTK_DOUBLE, VT::Float64 } };
+  for (const auto& t : kTypes)
   {
-    case VTK_UNSIGNED_CHAR:
-      out = spaceskip::VoxelType::UInt8;
+    if (t.first == vtkType)
+    {
+      out = t.second;
       return true;
-    case VTK_CHAR:
-    case VTK_SIGNED_CHAR:
-      out = spaceskip::VoxelType::Int8;
-      return true;
-    case VTK_UNSIGNED_SHORT:
-      out = spaceskip::VoxelType::UInt16;
-      return true;
-    case VTK_SHORT:
-      out = spaceskip::VoxelType::Int16;
-      return true;
-    case VTK_FLOAT:
-      out = spaceskip::VoxelType::Float32;
-      return true;
-    case VTK_DOUBLE:
-      out = spaceskip::VoxelType::Float64;
-      return true;
-    default:
-      return false;
+    }
   }
+  return false;
 }
 
 bool ConvertibleToFloat(int vtkType)
