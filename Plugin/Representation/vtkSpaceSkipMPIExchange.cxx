@@ -228,6 +228,15 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
   // Every rank began this frame (else it is not drawing it: give up, never wait forever).
   std::vector<int> begun(n, -1);
   std::vector<Request> reqs(n);
+  // The receives in `reqs` done within ImageSeconds; false: given up, saying `failure`.
+  auto imagesArrived = [&](const char* failure) {
+    if (WaitAll(reqs, After(this->ImageSeconds)))
+    {
+      return true;
+    }
+    this->GiveUp(failure);
+    return false;
+  };
   for (int r = 1; r < this->Size; ++r)
   {
     comm->NoBlockReceive(&begun[r - 1], 1, r, kBeginTag, reqs[r - 1]);
@@ -254,9 +263,8 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
   {
     comm->NoBlockReceive(&headers[size_t(r - 1) * kHeaderInts], kHeaderInts, r, kHeaderTag, reqs[r - 1]);
   }
-  if (!WaitAll(reqs, After(this->ImageSeconds)))
+  if (!imagesArrived("a rank did not send its image"))
   {
-    this->GiveUp("a rank did not send its image");
     return -1;
   }
   std::vector<std::vector<int>> boxes(n);
@@ -279,9 +287,8 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
         reqs.back());
     }
   }
-  if (!WaitAll(reqs, After(this->ImageSeconds)))
+  if (!imagesArrived("a rank did not send its pieces"))
   {
-    this->GiveUp("a rank did not send its pieces");
     return -1;
   }
   std::vector<std::vector<float>> pixels(n);
@@ -307,9 +314,8 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
       comm->NoBlockReceive(pixels[r - 1].data(), static_cast<int>(total), r, kDataTag, reqs.back());
     }
   }
-  if (!WaitAll(reqs, After(this->ImageSeconds)))
+  if (!imagesArrived("a rank's image did not arrive"))
   {
-    this->GiveUp("a rank's image did not arrive");
     return -1;
   }
   others.clear();

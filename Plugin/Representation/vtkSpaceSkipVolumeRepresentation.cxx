@@ -428,89 +428,57 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
 
 //------------------------------------------------------------------------------
 // Setters: the mapper's own Modified() makes the next render rebuild what the change needs.
-void vtkSpaceSkipVolumeRepresentation::SetBuilder(int v)
-{
-  this->SpaceSkipMapper->SetBuilder(v);
-}
-int vtkSpaceSkipVolumeRepresentation::GetBuilder()
-{
-  return this->SpaceSkipMapper->GetBuilder();
-}
-void vtkSpaceSkipVolumeRepresentation::SetLeafCriterion(int v)
-{
-  this->SpaceSkipMapper->SetLeafCriterion(v);
-}
-int vtkSpaceSkipVolumeRepresentation::GetLeafCriterion()
-{
-  return this->SpaceSkipMapper->GetLeafCriterion();
-}
-void vtkSpaceSkipVolumeRepresentation::SetMaxLeafSize(int v)
-{
-  this->SpaceSkipMapper->SetMaxLeafSize(v);
-}
-int vtkSpaceSkipVolumeRepresentation::GetMaxLeafSize()
-{
-  return this->SpaceSkipMapper->GetMaxLeafSize();
-}
-void vtkSpaceSkipVolumeRepresentation::SetBinCount(int v)
-{
-  this->SpaceSkipMapper->SetBinCount(v);
-}
-int vtkSpaceSkipVolumeRepresentation::GetBinCount()
-{
-  return this->SpaceSkipMapper->GetBinCount();
-}
-void vtkSpaceSkipVolumeRepresentation::SetMacroCellSize(int v)
-{
-  this->SpaceSkipMapper->SetMacroCellSize(v);
-}
-int vtkSpaceSkipVolumeRepresentation::GetMacroCellSize()
-{
-  return this->SpaceSkipMapper->GetMacroCellSize();
-}
-void vtkSpaceSkipVolumeRepresentation::SetSampleDistance(double v)
-{
-  this->SpaceSkipMapper->SetSampleDistance(v);
-}
-double vtkSpaceSkipVolumeRepresentation::GetSampleDistance()
-{
-  return this->SpaceSkipMapper->GetSampleDistance();
-}
-void vtkSpaceSkipVolumeRepresentation::SetBackend(int v)
-{
-  this->SpaceSkipMapper->SetBackend(v);
-}
-int vtkSpaceSkipVolumeRepresentation::GetBackend()
-{
-  return this->SpaceSkipMapper->GetBackend();
-}
-void vtkSpaceSkipVolumeRepresentation::SetEarlyRayTermination(int v)
-{
-  this->SpaceSkipMapper->SetEarlyRayTermination(v != 0);
-}
-int vtkSpaceSkipVolumeRepresentation::GetEarlyRayTermination()
-{
-  return this->SpaceSkipMapper->GetEarlyRayTermination() ? 1 : 0;
-}
+// Settings and statistics passed to and from the mapper as they are (the getters cast the
+// mapper's type to the representation's).
+#define vtkSpaceSkipForwardSet(name, type)                                                        \
+  void vtkSpaceSkipVolumeRepresentation::Set##name(type v)                                         \
+  {                                                                                                \
+    this->SpaceSkipMapper->Set##name(v);                                                           \
+  }
+#define vtkSpaceSkipForwardGet(name, type)                                                        \
+  type vtkSpaceSkipVolumeRepresentation::Get##name()                                               \
+  {                                                                                                \
+    return static_cast<type>(this->SpaceSkipMapper->Get##name());                                  \
+  }
+#define vtkSpaceSkipForward(name, type)                                                           \
+  vtkSpaceSkipForwardSet(name, type) vtkSpaceSkipForwardGet(name, type)
+// An on/off setting: the mapper's bool as the representation's 0/1 int.
+#define vtkSpaceSkipForwardBool(name)                                                             \
+  void vtkSpaceSkipVolumeRepresentation::Set##name(int v)                                          \
+  {                                                                                                \
+    this->SpaceSkipMapper->Set##name(v != 0);                                                      \
+  }                                                                                                \
+  int vtkSpaceSkipVolumeRepresentation::Get##name()                                                \
+  {                                                                                                \
+    return this->SpaceSkipMapper->Get##name() ? 1 : 0;                                             \
+  }
+
+vtkSpaceSkipForward(Builder, int)
+vtkSpaceSkipForward(LeafCriterion, int)
+vtkSpaceSkipForward(MaxLeafSize, int)
+vtkSpaceSkipForward(BinCount, int)
+vtkSpaceSkipForward(MacroCellSize, int)
+vtkSpaceSkipForward(SampleDistance, double)
+vtkSpaceSkipForward(Backend, int)
+vtkSpaceSkipForward(FilterMode, int)
+vtkSpaceSkipForwardGet(LastBuildSeconds, double)
+vtkSpaceSkipForwardGet(LastClassifySeconds, double)
+vtkSpaceSkipForwardGet(LastRenderSeconds, double)
+vtkSpaceSkipForwardGet(SampleDistanceUsed, double)
+vtkSpaceSkipForwardGet(NodeCount, double)
+vtkSpaceSkipForwardGet(TreeHeight, int)
+vtkSpaceSkipForwardGet(LeafCount, double)
+vtkSpaceSkipForwardGet(Occupancy, double)
+vtkSpaceSkipForwardGet(BuildCount, int)
+vtkSpaceSkipForwardGet(ClassifyCount, int)
+vtkSpaceSkipForwardGet(ColorUpdateCount, int)
+vtkSpaceSkipForwardGet(FrameCount, int)
+
+vtkSpaceSkipForwardBool(EarlyRayTermination)
+vtkSpaceSkipForwardBool(UseJittering)
 void vtkSpaceSkipVolumeRepresentation::SetDeviceMemoryBudget(int mib)
 {
   this->SpaceSkipMapper->SetDeviceMemoryBudget(mib);
-}
-void vtkSpaceSkipVolumeRepresentation::SetUseJittering(int v)
-{
-  this->SpaceSkipMapper->SetUseJittering(v != 0);
-}
-int vtkSpaceSkipVolumeRepresentation::GetUseJittering()
-{
-  return this->SpaceSkipMapper->GetUseJittering() ? 1 : 0;
-}
-void vtkSpaceSkipVolumeRepresentation::SetFilterMode(int v)
-{
-  this->SpaceSkipMapper->SetFilterMode(v);
-}
-int vtkSpaceSkipVolumeRepresentation::GetFilterMode()
-{
-  return this->SpaceSkipMapper->GetFilterMode();
 }
 
 void vtkSpaceSkipVolumeRepresentation::SetExtraBlendMode(int mode)
@@ -524,78 +492,31 @@ int vtkSpaceSkipVolumeRepresentation::GetExtraBlendMode()
 }
 
 //------------------------------------------------------------------------------
-double vtkSpaceSkipVolumeRepresentation::GetLastBuildSeconds()
-{
-  return this->SpaceSkipMapper->GetLastBuildSeconds();
-}
-double vtkSpaceSkipVolumeRepresentation::GetLastClassifySeconds()
-{
-  return this->SpaceSkipMapper->GetLastClassifySeconds();
-}
-double vtkSpaceSkipVolumeRepresentation::GetLastRenderSeconds()
-{
-  return this->SpaceSkipMapper->GetLastRenderSeconds();
-}
-double vtkSpaceSkipVolumeRepresentation::GetSampleDistanceUsed()
-{
-  return this->SpaceSkipMapper->GetSampleDistanceUsed();
-}
-double vtkSpaceSkipVolumeRepresentation::GetNodeCount()
-{
-  return static_cast<double>(this->SpaceSkipMapper->GetNodeCount());
-}
-int vtkSpaceSkipVolumeRepresentation::GetTreeHeight()
-{
-  return static_cast<int>(this->SpaceSkipMapper->GetTreeHeight());
-}
-double vtkSpaceSkipVolumeRepresentation::GetLeafCount()
-{
-  return static_cast<double>(this->SpaceSkipMapper->GetLeafCount());
-}
-double vtkSpaceSkipVolumeRepresentation::GetOccupancy()
-{
-  return this->SpaceSkipMapper->GetOccupancy();
-}
 // The string getters copy: the wrapped caller reads the value after the mapper may change it.
+namespace
+{
+const char* CopyText(const char* text, std::string& copy)
+{
+  copy = text ? text : "";
+  return copy.c_str();
+}
+} // namespace
+
 const char* vtkSpaceSkipVolumeRepresentation::GetResidency()
 {
-  const char* text = this->SpaceSkipMapper->GetResidency();
-  this->ResidencyText = text ? text : "";
-  return this->ResidencyText.c_str();
+  return CopyText(this->SpaceSkipMapper->GetResidency(), this->ResidencyText);
 }
 const char* vtkSpaceSkipVolumeRepresentation::GetBuilderChoice()
 {
-  const char* text = this->SpaceSkipMapper->GetBuilderChoice();
-  this->BuilderChoiceText = text ? text : "";
-  return this->BuilderChoiceText.c_str();
+  return CopyText(this->SpaceSkipMapper->GetBuilderChoice(), this->BuilderChoiceText);
 }
 const char* vtkSpaceSkipVolumeRepresentation::GetBuilderUsed()
 {
-  const char* name = this->SpaceSkipMapper->GetBuilderUsed();
-  this->BuilderUsedName = name ? name : "";
-  return this->BuilderUsedName.c_str();
+  return CopyText(this->SpaceSkipMapper->GetBuilderUsed(), this->BuilderUsedName);
 }
 const char* vtkSpaceSkipVolumeRepresentation::GetBackendUsed()
 {
-  const char* name = this->SpaceSkipMapper->GetBackendUsed();
-  this->BackendUsedName = name ? name : "";
-  return this->BackendUsedName.c_str();
-}
-int vtkSpaceSkipVolumeRepresentation::GetBuildCount()
-{
-  return static_cast<int>(this->SpaceSkipMapper->GetBuildCount());
-}
-int vtkSpaceSkipVolumeRepresentation::GetClassifyCount()
-{
-  return static_cast<int>(this->SpaceSkipMapper->GetClassifyCount());
-}
-int vtkSpaceSkipVolumeRepresentation::GetColorUpdateCount()
-{
-  return static_cast<int>(this->SpaceSkipMapper->GetColorUpdateCount());
-}
-int vtkSpaceSkipVolumeRepresentation::GetFrameCount()
-{
-  return static_cast<int>(this->SpaceSkipMapper->GetFrameCount());
+  return CopyText(this->SpaceSkipMapper->GetBackendUsed(), this->BackendUsedName);
 }
 
 //------------------------------------------------------------------------------
