@@ -221,6 +221,23 @@ std::vector<Volume> classificationVolumes() {
   return vs;
 }
 
+/// `e` set up for one frame: the volume, the transfer function, builder `k` and `rp`.
+void loadFrame(Engine& e, const Volume& v, const TransferFunction& tf, BuilderKind k, const RenderParams& rp) {
+  e.setVolume(v);
+  e.setTransferFunction(tf);
+  e.setBuildParams(params(k));
+  e.setRenderParams(rp);
+}
+
+/// `e` set up for one frame path: the volume, the transfer function, builder `k`, the filter and
+/// early ray termination at `ert` (> 1: off).
+void loadFrame(Engine& e, const Volume& v, const TransferFunction& tf, BuilderKind k, FilterMode filter,
+               double ert = 2.0) {
+  RenderParams rp;
+  rp.filter = filter;
+  rp.ertThreshold = ert;
+  loadFrame(e, v, tf, k, rp);
+}
 }  // namespace
 
 TEST(CudaBackend, NoDeviceIsABackendErrorAndEngineFallsBack) {
@@ -300,13 +317,10 @@ TEST(CudaBackend, PartWalkEqualsWholeBricksAndTheCpu) {
           Engine e(BackendKind::CUDA);
           e.setLogger([](const std::string&) {});
           e.setTuning(share);
-          e.setVolume(v);
-          e.setTransferFunction(tf);
-          e.setBuildParams(params(k));
           RenderParams rp;
           rp.countSamples = true;
           rp.filter = filter;
-          e.setRenderParams(rp);
+          loadFrame(e, v, tf, k, rp);
           double b[6];
           v.worldBounds(b);
           Image img[2];
@@ -829,17 +843,17 @@ TEST(CudaBackend, ErrorMidFrameFallsBackToTheCpuImage) {
 }
 
 namespace {
-/// `e` set up for one frame path: the volume, the transfer function, builder `k`, the filter and
-/// early ray termination at `ert` (> 1: off).
-void loadFrame(Engine& e, const Volume& v, const TransferFunction& tf, BuilderKind k, FilterMode filter,
-               double ert = 2.0) {
-  e.setVolume(v);
-  e.setTransferFunction(tf);
-  e.setBuildParams(params(k));
-  RenderParams rp;
-  rp.filter = filter;
-  rp.ertThreshold = ert;
-  e.setRenderParams(rp);
+/// `v` drawn by a CUDA engine with tuning `t` (loadFrame's settings), 100x70 from the orbit
+/// camera at (30, 20), into `img`; the backend that drew it.
+BackendKind renderTuned(const Tuning& t, const Volume& v, const TransferFunction& tf, BuilderKind k,
+                        FilterMode filter, double ert, Image& img) {
+  Engine e(BackendKind::CUDA);
+  e.setTuning(t);
+  loadFrame(e, v, tf, k, filter, ert);
+  double b[6];
+  v.worldBounds(b);
+  e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img);
+  return e.backendKind();
 }
 }  // namespace
 
@@ -852,20 +866,14 @@ TEST(CudaBackend, PersistentLaunchRendersTheSameImage) {
   REQUIRE_CUDA();
   Volume v = generateVolume("nbody", vec3l{96, 96, 96});
   TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
-  double b[6];
-  v.worldBounds(b);
   for (BuilderKind k : {BuilderKind::Naive, BuilderKind::DistanceGrid, BuilderKind::LBVH}) {
     for (FilterMode filter : {FilterMode::Exact, FilterMode::Hardware}) {
       Image img[2];
       for (int i = 0; i < 2; ++i) {
-        Engine e(BackendKind::CUDA);
         Tuning t;
         t.raySegments = 1;
         t.resident = i == 1 ? 1 : 0;  // plain launch vs 1 resident block per SM
-        e.setTuning(t);
-        loadFrame(e, v, tf, k, filter);
-        e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
-        ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+        ASSERT_EQ(renderTuned(t, v, tf, k, filter, 2.0, img[i]), BackendKind::CUDA);
       }
       ASSERT_GT(test::coverage(img[0]), 0.001);
       EXPECT_EQ(compareImages(img[0], img[1]).maxAbs, 0.f) << builderName(k);
@@ -883,8 +891,6 @@ TEST(CudaBackend, BatchedSamplesRenderTheSameImage) {
   REQUIRE_CUDA();
   Volume v = generateVolume("nbody", vec3l{96, 96, 96});
   TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
-  double b[6];
-  v.worldBounds(b);
   struct Mode {
     double ert;
     int segments;
@@ -899,11 +905,7 @@ TEST(CudaBackend, BatchedSamplesRenderTheSameImage) {
           Tuning t;
           t.sampleBatch = batches[i];
           t.raySegments = m.segments;
-          Engine e(BackendKind::CUDA);
-          e.setTuning(t);
-          loadFrame(e, v, tf, k, filter, m.ert);
-          e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
-          ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+          ASSERT_EQ(renderTuned(t, v, tf, k, filter, m.ert, img[i]), BackendKind::CUDA);
         }
         SCOPED_TRACE(std::string(builderName(k)) + (filter == FilterMode::Hardware ? " hw" : " exact") + " ert " +
                      std::to_string(m.ert) + " segments " + std::to_string(m.segments));
@@ -976,8 +978,6 @@ TEST(CudaBackend, SegmentedRaysRenderTheSameImage) {
   const Case cases[] = {{generateVolume("nbody", vec3l{96, 96, 96}), TransferFunction::preset("ramp", 0, 255)},
                         {generateVolume("menger", vec3l{54, 54, 54}), TransferFunction::preset("ramp", 0, 255)}};
   for (const Case& c : cases) {
-    double b[6];
-    c.v.worldBounds(b);
     for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid, BuilderKind::KdTreeGPUFast}) {
       for (FilterMode filter : {FilterMode::Exact, FilterMode::Hardware}) {
         for (double ert : {2.0, 0.99}) {
@@ -986,11 +986,7 @@ TEST(CudaBackend, SegmentedRaysRenderTheSameImage) {
           for (int i = 0; i < 3; ++i) {
             Tuning t;
             t.raySegments = counts[i];
-            Engine e(BackendKind::CUDA);
-            e.setTuning(t);
-            loadFrame(e, c.v, c.tf, k, filter, ert);
-            e.render(orbitCamera(b, 30, 20, 1.0, false, 100.0 / 70.0), 100, 70, img[i]);
-            ASSERT_EQ(e.backendKind(), BackendKind::CUDA);
+            ASSERT_EQ(renderTuned(t, c.v, c.tf, k, filter, ert, img[i]), BackendKind::CUDA);
           }
           SCOPED_TRACE(std::string(builderName(k)) + (filter == FilterMode::Hardware ? " hw" : " exact") +
                        (ert < 1 ? " ert" : ""));
