@@ -173,9 +173,10 @@ public:
    * How samples between voxels are interpolated (trilinear either way):
    * - ExactFilter (default): in float from the 8 voxels around the sample, on both backends;
    * - HardwareFilter: CUDA backend, the texture unit's trilinear filter, whose weights have
-   *   8 bits of fraction (about 1/256 of a voxel): faster (N-body 2048^3 on an H100: 750 against
-   *   615 kernel fps, docs/results/round6-h100) at a small cost in accuracy (PSNR per data set:
-   *   `spaceskip accuracy`, docs/results/paper-bench h100/pareto). Skipping stays lossless: the
+   *   8 bits of fraction (about 1/256 of a voxel): faster (N-body 2048^3 on an H100, DistanceGrid:
+   *   1601 against 1211 kernel fps with Auto's exact choice, docs/results/h100-kernel-ab) at a
+   *   small cost in accuracy (PSNR per data set: `spaceskip accuracy`, docs/results/paper-bench).
+   *   Skipping stays lossless: the
    *   filtered value lies within the 8 voxels' range like the exact one. The CPU backend has no
    *   texture unit and samples exactly (the image is ExactFilter's); volumes with several
    *   dependent components, and volumes drawn with sparse residency (DeviceMemoryBudget), are
