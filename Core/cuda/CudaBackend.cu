@@ -168,7 +168,7 @@ class CudaBackend final : public Backend {
       f.grid = GridView{nullptr, bdims_, brick_, nullptr, cls_.d_vmin.get(), cls_.d_vmax.get()};
     }
     if (pool_.active())
-      pool_.update(poolNeedFor(f.blend, f.shade != 0, tf_, f.avgLo, f.avgHi), cls_.d_occ[cls_.cur].get(),
+      pool_.update(poolNeedFor(f.blend, f.shade != 0 || f.gtf.mode != 0, tf_, f.avgLo, f.avgHi), cls_.d_occ[cls_.cur].get(),
                    cls_.generation, cls_.d_vmin.get(), cls_.d_vmax.get(), bdims_, brick_, stream_);
     const PoolView view = pool_.view();
     exec_.render(f, filter, depth, vol_, pool_.active() ? &view : nullptr, out, stream_);

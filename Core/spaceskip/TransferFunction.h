@@ -44,9 +44,43 @@ struct TransferFunction {
   /// Named presets over [lo, hi]: "ramp", "grayscale", "coolwarm", "spike", "band", "opaque", "zero".
   static TransferFunction preset(const std::string& name, double lo, double hi, int size = 1024);
 
+  /// 2-D transfer function (vtkVolumeProperty TF_2D): RGBA over (value, gradient magnitude),
+  /// row-major, width2D columns x height2D rows, read as vtkGPUVolumeRayCastMapper reads its
+  /// texture: column position u * width2D - 1/2 for u = (v - rangeMin) / (rangeMax - rangeMin),
+  /// row position g * height2D - 1/2 for the normalised gradient magnitude g (gradientMagnitude
+  /// in render/GradientTF.h), bilinear, clamped at the edges; opacity raw (VTK corrects it not
+  /// for the sample distance). Composite blending of one-component volumes. Empty: the 1-D table.
+  std::vector<vec4f> table2D;
+  int width2D = 0, height2D = 0;
+  /// Gradient opacity (vtkVolumeProperty::GetGradientOpacity, 1-D mode): the factor on a
+  /// sample's opacity over the normalised gradient magnitude g in [0, 1], entry positions
+  /// g * size - 1/2 as VTK's 1-D texture (the function sampled over [0, (max-min)/4]). Empty: none.
+  std::vector<float> gradientOpacity;
+
+  bool uses2D() const { return width2D > 0 && height2D > 0 && table2D.size() == size_t(width2D) * size_t(height2D); }
+  bool usesGradientOpacity() const { return !uses2D() && !gradientOpacity.empty(); }
+
   bool sameOpacity(const TransferFunction& o) const;
   bool sameColor(const TransferFunction& o) const;
+  /// Same 2-D table and gradient-opacity table (either change re-classifies).
+  bool sameGradientTables(const TransferFunction& o) const;
 };
+
+/// The table classification tests a brick's value range against (OpacityRangeMax): the TF itself
+/// with a 1-D table; with a 2-D one, over width2D + 1 entries (the integrator's column mapping:
+/// gradientColumnMapping) entry j holds the largest opacity of columns j-1 and j over every row
+/// (every gradient magnitude), so a brick is empty only when no value it can take has opacity
+/// at any gradient; with gradient opacity the 1-D table (the factor only lowers opacity), all
+/// transparent when the factor is 0 everywhere. Lossless without any per-brick gradient range.
+TransferFunction classificationTF(const TransferFunction& tf);
+
+/// The 2-D table's column mapping in float: position x = (v - lo) * scale - 1/2 with scale =
+/// width2D / (rangeMax - rangeMin), the same floats classificationTF's table is queried with.
+void gradientColumnMapping(const TransferFunction& tf, float& lo, float& scale);
+
+/// Appends the 2-D table and the gradient-opacity factors (in .w) to `table` (the table a backend
+/// uploads), returning their offsets (-1: none): they travel to the device with the 1-D table.
+void appendGradientTables(const TransferFunction& tf, std::vector<vec4f>& table, int& offset2D, int& offsetGO);
 
 /// Opacity correction for a step of dt world units: 1-(1-a)^(dt/unitDistance).
 SS_FUNC float correctOpacity(float a, float dt, float unitDistance) {

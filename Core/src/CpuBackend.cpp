@@ -121,7 +121,7 @@ class CpuBackend final : public Backend {
     overflow_ = false;
     if (pool_.active()) {
       try {
-        pool_.update(poolNeedFor(f.blend, f.shade != 0, tf_, f.avgLo, f.avgHi), occ_.occ.data(), generation_,
+        pool_.update(poolNeedFor(f.blend, f.shade != 0 || f.gtf.mode != 0, tf_, f.avgLo, f.avgHi), occ_.occ.data(), generation_,
                      ranges_.vmin.data(), ranges_.vmax.data(), ranges_.dims, ranges_.brick);
       } catch (const std::runtime_error&) {
         overflow_ = true;  // the whole volume is in host memory: this frame samples it in core

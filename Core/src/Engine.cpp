@@ -196,6 +196,15 @@ struct Engine::Impl {
     return render.blend;
   }
 
+  /// The TF's 2-D table or gradient opacity is used: composite blending of one-component
+  /// volumes (otherwise the 1-D tables draw, said once by fillGradientTF). Classification
+  /// follows it (classificationTF), so a change of it re-classifies (setRenderParams).
+  bool gradientTablesUsed() const {
+    return (tf.uses2D() || tf.usesGradientOpacity()) && volume.components == 1 && render.blend == BlendMode::Composite;
+  }
+  /// The 2-D table's and the gradient opacity's first entries in the uploaded table (updateTable).
+  int gradOffset2D = -1, gradOffsetGO = -1;
+
   TransferFunction scaledTF() const {
     if (valueExponent == 0) return tf;
     TransferFunction t = tf;
@@ -288,7 +297,7 @@ struct Engine::Impl {
     if (!opacityDirty && !cropClipDirty) return false;
     report(0.3, "classification");
     auto t0 = Clock::now();
-    const bool changed = backend->classify(scaledTF(), cropClip);
+    const bool changed = backend->classify(gradientTablesUsed() ? classificationTF(scaledTF()) : scaledTF(), cropClip);
     stats.classifySeconds = since(t0);
     stats.classifyWaitSeconds = backend->lastClassifyWaitSeconds();
     ++counters.classifications;
@@ -309,7 +318,9 @@ struct Engine::Impl {
     if (!note.empty()) warn(note);
     float lo, scale;
     tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
-    backend->setTransferTable(tableForBlend(tf, float(step), blendMode()), lo, scale);
+    std::vector<vec4f> table = tableForBlend(tf, float(step), blendMode());
+    appendGradientTables(tf, table, gradOffset2D, gradOffsetGO);  // after the 1-D entries
+    backend->setTransferTable(table, lo, scale);
     tableDirty = colorDirty = false;
   }
 
@@ -440,6 +451,8 @@ void Engine::setTransferFunction(TransferFunction tf, bool colorMayDiffer, bool 
     ++d.counters.opacityCompares;
     opacity = !tf.sameOpacity(d.tf);
   }
+  // A 2-D table or gradient-opacity edit re-classifies (the marginal may change) and re-uploads.
+  if (!opacity && !tf.sameGradientTables(d.tf)) opacity = true;
   if (opacity) {
     d.opacityDirty = true;  // re-classified, and the whole table set again
   } else if (colorMayDiffer) {
@@ -466,7 +479,9 @@ void Engine::setBuildParams(const BuildParams& p) {
 
 void Engine::setRenderParams(const RenderParams& p) {
   if (p.sampleDistance != impl_->render.sampleDistance || p.blend != impl_->render.blend) impl_->tableDirty = true;
+  const bool gradientTables = impl_->gradientTablesUsed();
   impl_->render = p;
+  if (impl_->gradientTablesUsed() != gradientTables) impl_->opacityDirty = true;  // classificationTF or not
 }
 
 void Engine::setPiece(const VolumePiece& p) {
@@ -620,6 +635,49 @@ void fillComponents(Impl& d, FrameView& f) {
   if (v.components > 1 && d.render.filter == FilterMode::Hardware)
     d.warn("hardware filtering with dependent components: sampling exactly");
 }
+
+/// 2-D transfer function / gradient opacity (render/GradientTF.h): where its entries are, the
+/// column mapping (classificationTF's) and VTK's gradient normalisation for this volume.
+template <class Impl>
+void fillGradientTF(Impl& d, FrameView& f) {
+  const TransferFunction& tf = d.tf;
+  if (!tf.uses2D() && !tf.usesGradientOpacity()) return;
+  const char* what = tf.uses2D() ? "2-D transfer function" : "gradient opacity";
+  if (d.volume.components != 1) {
+    d.warn(std::string(what) + " with dependent components is not supported: drawn with the 1-D tables");
+    return;
+  }
+  if (f.blend != BlendMode::Composite) {
+    d.warn(std::string(what) + " is used with composite blending only: blend mode " +
+           std::to_string(int(f.blend)) + " draws with the 1-D tables");
+    return;
+  }
+  const TransferFunction s = d.scaledTF();
+  GradientTFView& g = f.gtf;
+  if (tf.uses2D() && d.gradOffset2D >= 0) {
+    g.mode = 2;
+    g.offset = d.gradOffset2D;
+    g.width = tf.width2D;
+    g.height = tf.height2D;
+    gradientColumnMapping(s, g.xLo, g.xScale);
+  } else if (tf.usesGradientOpacity() && d.gradOffsetGO >= 0) {
+    g.mode = 1;
+    g.offset = d.gradOffsetGO;
+    g.width = int(tf.gradientOpacity.size());
+  } else {
+    return;
+  }
+  // vtkVolumeShaderComposer (computeGradient with gradient opacity): (f(p+e) - f(p-e)) divided
+  // by 2 spacing / average spacing per axis, the length over a quarter of the scalar range.
+  const double* sp = d.volume.spacing;
+  const double avg = (std::fabs(sp[0]) + std::fabs(sp[1]) + std::fabs(sp[2])) / 3.0;
+  double range = s.rangeMax - s.rangeMin;
+  if (!(range > 0) || !std::isfinite(range)) range = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    const double h = std::fabs(sp[a]);
+    g.gradScale[a] = h > 0 ? float(avg / (2.0 * h) / (0.25 * range)) : 0.f;
+  }
+}
 }  // namespace
 
 void Engine::render(const Camera& cam, int width, int height, Image& out, const float* depth,
@@ -676,6 +734,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.eyeW = vec3f{float(iv.m[12] - origin[0]), float(iv.m[13] - origin[1]), float(iv.m[14] - origin[2])};
   fillBlend(d, f);
   fillComponents(d, f);
+  fillGradientTF(d, f);
   std::vector<unsigned> counts;
   if (d.render.countSamples) {
     counts.assign(size_t(width) * size_t(height), 0u);

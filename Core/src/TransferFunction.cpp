@@ -86,6 +86,64 @@ bool TransferFunction::sameColor(const TransferFunction& o) const {
   return true;
 }
 
+bool TransferFunction::sameGradientTables(const TransferFunction& o) const {
+  if (width2D != o.width2D || height2D != o.height2D || table2D.size() != o.table2D.size() ||
+      gradientOpacity != o.gradientOpacity)
+    return false;
+  for (size_t i = 0; i < table2D.size(); ++i) {
+    const vec4f &a = table2D[i], &b = o.table2D[i];
+    if (a.x != b.x || a.y != b.y || a.z != b.z || a.w != b.w) return false;
+  }
+  return true;
+}
+
+TransferFunction classificationTF(const TransferFunction& tf) {
+  if (tf.uses2D()) {
+    const int W = tf.width2D, H = tf.height2D;
+    std::vector<float> col(size_t(W), 0.f);  // each column's largest opacity over all rows
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const float a = tf.table2D[size_t(y) * size_t(W) + size_t(x)].w;
+        if (a > col[size_t(x)]) col[size_t(x)] = a;  // NaN entries never raise it (and draw nothing)
+      }
+    TransferFunction c;
+    c.rangeMin = tf.rangeMin;
+    c.rangeMax = tf.rangeMax;
+    c.unitDistance = tf.unitDistance;
+    c.table.resize(size_t(W) + 1);
+    // Position x in [j, j+1] of this table is column position x - 1/2: columns j-1, j, j+1,
+    // which entries j and j+1 (the query takes both) cover.
+    for (int j = 0; j <= W; ++j)
+      c.table[size_t(j)] = vec4f{0, 0, 0, std::max(col[size_t(std::max(j - 1, 0))], col[size_t(std::min(j, W - 1))])};
+    return c;
+  }
+  if (tf.usesGradientOpacity()) {
+    bool any = false;
+    for (float g : tf.gradientOpacity) any = any || g > 0.f;
+    TransferFunction c = tf;
+    c.gradientOpacity.clear();
+    if (!any)
+      for (auto& e : c.table) e.w = 0.f;
+    return c;
+  }
+  return tf;
+}
+
+void gradientColumnMapping(const TransferFunction& tf, float& lo, float& scale) {
+  tableMapping(tf, tf.width2D + 1, lo, scale);
+}
+
+void appendGradientTables(const TransferFunction& tf, std::vector<vec4f>& table, int& offset2D, int& offsetGO) {
+  offset2D = offsetGO = -1;
+  if (tf.uses2D()) {
+    offset2D = int(table.size());
+    table.insert(table.end(), tf.table2D.begin(), tf.table2D.end());
+  } else if (tf.usesGradientOpacity()) {
+    offsetGO = int(table.size());
+    for (float g : tf.gradientOpacity) table.push_back(vec4f{0, 0, 0, std::clamp(g, 0.f, 1.f)});
+  }
+}
+
 std::vector<vec4f> correctedTable(const TransferFunction& tf, float dt) {
   std::vector<vec4f> out(tf.table);
   for (auto& e : out) e.w = correctOpacity(e.w, dt, float(tf.unitDistance));

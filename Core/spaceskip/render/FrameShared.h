@@ -69,6 +69,19 @@ struct LightView {
   int positional;
 };
 
+/// A 2-D transfer function or gradient opacity (TransferFunction::table2D / gradientOpacity) as
+/// the integrator reads it (render/GradientTF.h): their entries follow the 1-D table in the
+/// table the backend uploads (FrameView::tf.table + offset). Composite, one component.
+struct GradientTFView {
+  int mode = 0;            ///< 0: none; 1: gradient opacity; 2: 2-D table
+  int offset = 0;          ///< first entry in tf.table
+  int width = 0, height = 0;  ///< 2-D: columns, rows; gradient opacity: entries (width)
+  float xLo = 0.f, xScale = 0.f;  ///< 2-D: column position (v - xLo) * xScale - 1/2
+  /// Per index axis: the factor taking the central difference f(p+e) - f(p-e) to VTK's
+  /// normalised gradient component, avgSpacing / (2 spacing) / (range / 4).
+  float gradScale[3] = {0.f, 0.f, 0.f};
+};
+
 /// Everything a pixel needs, plain data (device pointers on the GPU).
 struct FrameView {
   float invViewProj[16];   ///< NDC -> world, column-major
@@ -120,6 +133,7 @@ struct FrameView {
   /// at a time. The CUDA executor sets it (the host's cores overlap the fetches of a loop on
   /// their own); the image is the same either way.
   int sampleBatch;
+  GradientTFView gtf;  ///< 2-D transfer function / gradient opacity (mode 0: neither)
 };
 
 }  // namespace spaceskip

@@ -67,6 +67,7 @@ struct ArraySampler {
 
 #include "Components.h"  // needs voxelValue and ArraySampler
 
+#include "GradientTF.h"
 namespace spaceskip {
 
 /// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
@@ -75,11 +76,13 @@ namespace spaceskip {
 /// far interval end must never wrap (a tiny step once overflowed int and drew nothing). It also
 /// keeps each blend mode's running state, from which `active` decides which bricks can still
 /// matter.
-/// A plain frame: composite blending, no shading, no clipping planes, no cropping. The GPU
+/// A plain frame: composite blending, no shading, no clipping planes, no cropping, no 2-D TF or
+/// gradient opacity. The GPU
 /// compiles its kernels for plain frames separately (renderPixel's `Plain`): without the code of
 /// the other modes the kernel needs far fewer registers, so more warps hide the voxel fetches.
 SS_FUNC bool isPlainFrame(const FrameView& f) {
-  return f.blend == BlendMode::Composite && !f.shade && f.cut.numClipPlanes == 0 && !f.cut.cropping;
+  return f.blend == BlendMode::Composite && !f.shade && f.cut.numClipPlanes == 0 && !f.cut.cropping &&
+         f.gtf.mode == 0;
 }
 
 /// Samples a GPU march fetches per step with a sampler (IntervalMarcher::takeBatch): the
@@ -305,7 +308,8 @@ struct IntervalMarcher {
     const vec3f p = ray.org + ray.dir * t;
     ++samples;
     if (Plain || f->blend == BlendMode::Composite) {
-      const vec4f c = classifySample(*f, *s, p);  // lookup(f->tf, s->sample(p)); dependent components
+      // lookup(f->tf, s->sample(p)); dependent components; 2-D TF or gradient opacity (not Plain)
+      const vec4f c = !Plain && f->gtf.mode != 0 ? classifyWithGradient(*f, *s, p) : classifySample(*f, *s, p);
       return c.w > 0.f ? composite(c, p) : true;
     }
     return blendSample(s->sample(p), p);

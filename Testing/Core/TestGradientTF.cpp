@@ -1,0 +1,130 @@
+// 2-D transfer functions (value x gradient magnitude) and gradient opacity: they change the image
+// as VTK's semantics say, and skipping stays lossless (every builder equals Naive).
+#include "TestUtil.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace spaceskip;
+
+namespace {
+
+/// A 2-D table over [lo, hi] x gradient magnitude: opaque (alpha `a`) in a box of normalised
+/// value [x0, x1] and normalised gradient magnitude [y0, y1], colour varying over both axes.
+void setBox(TransferFunction& tf, int w, int h, float x0, float x1, float y0, float y1, float a) {
+  tf.width2D = w;
+  tf.height2D = h;
+  tf.table2D.assign(size_t(w) * size_t(h), vec4f{0, 0, 0, 0});
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float u = (float(x) + 0.5f) / float(w), g = (float(y) + 0.5f) / float(h);
+      const bool in = u >= x0 && u <= x1 && g >= y0 && g <= y1;
+      tf.table2D[size_t(y) * size_t(w) + size_t(x)] = vec4f{u, 1.f - g, 0.5f, in ? a : 0.f};
+    }
+}
+
+vec4f at(const Image& img, int x, int y) { return img.rgba[size_t(y) * size_t(img.width) + size_t(x)]; }
+
+void expectBuildersEqualNaive(const Volume& v, const TransferFunction& tf, const RenderParams& rp, const char* what) {
+  const Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 30, 20, true, 48, BackendKind::CPU, rp);
+  ASSERT_GT(test::coverage(ref), 0.0) << what << " renders nothing";
+  for (const BuildParams& bp : test::skippingBuilders(true)) {
+    const Image img = test::renderWith(v, tf, bp, 30, 20, true, 48, BackendKind::CPU, rp);
+    const ImageDiff d = compareImages(ref, img);
+    EXPECT_LE(d.maxAbs, 1.f / 255.f) << what << " " << builderName(bp.builder) << " brick " << bp.brick;
+  }
+}
+
+}  // namespace
+
+TEST(GradientTF, EveryBuilderEqualsNaiveWith2DTableAndGradientOpacity) {
+  for (const char* shape : {"nbody", "vessels", "rm"}) {
+    Volume v = generateVolume(shape, vec3l{40, 42, 37});
+    v.spacing[0] = 0.8;  // anisotropic: the gradient's per-axis normalisation matters
+    v.spacing[2] = 1.3;
+    double lo, hi;
+    ASSERT_TRUE(v.scalarRange(lo, hi));
+    TransferFunction tf = TransferFunction::preset("ramp", lo, hi, 256);
+    TransferFunction tf2 = tf;
+    // From 0.02 of the range: where the 1-D ramp is transparent (so the 1-D occupancy would lose it).
+    setBox(tf2, 48, 24, 0.02f, 0.9f, 0.05f, 0.6f, 0.7f);
+    for (bool shade : {false, true}) {
+      RenderParams rp;
+      rp.shade = shade;
+      expectBuildersEqualNaive(v, tf2, rp, (std::string(shape) + " 2-D" + (shade ? " shaded" : "")).c_str());
+    }
+    TransferFunction go = tf;
+    go.gradientOpacity.resize(1024);
+    for (size_t i = 0; i < go.gradientOpacity.size(); ++i)
+      go.gradientOpacity[i] = float(i) / 1023.f;  // flat regions fade out
+    expectBuildersEqualNaive(v, go, RenderParams{}, (std::string(shape) + " gradient opacity").c_str());
+    // Both change the image (the tests above could not pass by ignoring them).
+    const Image plain = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 30, 20, true, 48);
+    EXPECT_GT(compareImages(plain, test::renderWith(v, tf2, test::builder(BuilderKind::Grid), 30, 20, true, 48)).maxAbs,
+              0.05f) << shape;
+    EXPECT_GT(compareImages(plain, test::renderWith(v, go, test::builder(BuilderKind::Grid), 30, 20, true, 48)).maxAbs,
+              0.05f) << shape;
+  }
+}
+
+TEST(GradientTF, FlatRegionTransparentIn2DOpaqueIn1D) {
+  // A cube of constant value 200 inside a background of 0: inside, the gradient is 0. The 1-D TF
+  // makes 200 opaque; the 2-D TF makes 200 opaque only where the gradient is large (the cube's
+  // faces), so a ray through the cube's middle along z, which meets a face only where the
+  // gradient is large, sees far less than with the 1-D TF; the background stays empty in both.
+  Volume v = test::makeVolume<float>(40, 40, 40, VoxelType::Float32, [](int i, int j, int k) {
+    return (i >= 8 && i < 32 && j >= 8 && j < 32 && k >= 8 && k < 32) ? 200.f : 0.f;
+  });
+  TransferFunction tf = TransferFunction::fromPoints({{0, 1.f, 1.f, 1.f, 0.f}, {100, 1.f, 1.f, 1.f, 0.f},
+                                                      {150, 1.f, 1.f, 1.f, 0.5f}, {200, 1.f, 1.f, 1.f, 0.5f}},
+                                                     0, 200, 256);
+  TransferFunction tf2 = tf;
+  // Value >= 140, gradient magnitude >= range/16; opacity 0.1 per sample (2-D opacity is raw).
+  setBox(tf2, 32, 16, 0.7f, 1.f, 0.25f, 1.f, 0.1f);
+  const Image one = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 0, 0, false, 64);
+  const Image two = test::renderWith(v, tf2, test::builder(BuilderKind::Grid), 0, 0, false, 64);
+  EXPECT_GT(at(one, 32, 32).w, 0.99f);  // 24 cells of opacity 0.5 per unit
+  EXPECT_LT(at(two, 32, 32).w, 0.8f);   // only the samples near the two faces
+  EXPECT_GT(at(two, 32, 32).w, 0.1f);
+  // Lossless with the flat inside transparent.
+  expectBuildersEqualNaive(v, tf2, RenderParams{}, "cube 2-D");
+  // A 2-D table that gives no value in the data opacity at any gradient: every brick empty.
+  TransferFunction none = tf;
+  setBox(none, 32, 16, 0.1f, 0.3f, 0.f, 1.f, 1.f);  // values 20..60: none in the data (0 and 200)
+  // (voxel values 0 and 200 blend to 20..60 only at the cube's faces: those bricks stay occupied)
+  Engine e(BackendKind::CPU);
+  test::load(e, v, none, test::builder(BuilderKind::Grid));
+  Image img;
+  e.render(test::orbit(v, 0, 0), 32, 32, img);
+  const OccupancyGrid& occ = e.occupancy();
+  int64_t occupied = 0;
+  for (uint8_t o : occ.occ) occupied += o != 0;
+  Engine e1(BackendKind::CPU);
+  test::load(e1, v, tf, test::builder(BuilderKind::Grid));
+  e1.render(test::orbit(v, 0, 0), 32, 32, img);
+  int64_t occupied1 = 0;
+  for (uint8_t o : e1.occupancy().occ) occupied1 += o != 0;
+  EXPECT_LT(occupied, occupied1);  // the cube's inner bricks (value 200 only) are empty with `none`
+}
+
+TEST(GradientTF, ZeroGradientOpacityEmptiesEverything) {
+  Volume v = generateVolume("menger", vec3l{27, 27, 27});
+  double lo, hi;
+  ASSERT_TRUE(v.scalarRange(lo, hi));
+  TransferFunction tf = TransferFunction::preset("opaque", lo, hi, 256);
+  tf.gradientOpacity.assign(64, 0.f);
+  Engine e(BackendKind::CPU);
+  test::load(e, v, tf, test::builder(BuilderKind::KdTreeCPU));
+  Image img;
+  e.render(test::orbit(v, 30, 20), 32, 32, img);
+  EXPECT_EQ(test::coverage(img), 0.0);
+  int64_t occupied = 0;
+  for (uint8_t o : e.occupancy().occ) occupied += o != 0;
+  EXPECT_EQ(occupied, 0);
+  // An edit of the gradient opacity alone re-classifies: now everything is drawn again.
+  tf.gradientOpacity.assign(64, 1.f);
+  e.setTransferFunction(tf);
+  e.render(test::orbit(v, 30, 20), 32, 32, img);
+  EXPECT_GT(test::coverage(img), 0.1);
+}
