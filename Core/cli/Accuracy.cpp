@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <stdexcept>
 #include <vector>
 
@@ -16,9 +15,10 @@ namespace spaceskip::cli {
 // (hardware filtering exists on the CUDA backend only) and early ray termination.
 int cmdAccuracy(const Options& o) {
   if (o.positional.size() != 1) throw std::invalid_argument("accuracy needs one VOLUME");
+  const std::unique_ptr<OutputFile> csvFile = outputOption(o, "--csv");  // fails before any work
   Volume v = openVolume(o.positional[0], o);
   int w = 512, h = 512;
-  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  imageSize(o, w, h);
   const double minSpacing = std::min({v.spacing[0], v.spacing[1], v.spacing[2]});
   Engine engine(backendKind(o));
   engine.setLogger([](const std::string& m) { std::fprintf(stderr, "  note: %s\n", m.c_str()); });
@@ -31,16 +31,13 @@ int cmdAccuracy(const Options& o) {
   ref.sampleDistance = minSpacing / 8;
   engine.setRenderParams(ref);
   Image reference;
-  engine.render(cam, w, h, reference);
+  allocating(frameText(w, h), frameBytes(w, h), [&] { engine.render(cam, w, h, reference); });
   std::printf("reference: sample distance %g (1/8 voxel), exact filtering, no ERT, backend %s\n",
               ref.sampleDistance, engine.backendName());
   std::printf("%-10s %-9s %-5s %-6s %10s %10s %8s %9s %9s %9s\n", "dt/voxel", "filter", "ert", "jitter", "max_diff",
               "psnr_db", "ssim", "fps", "kern_fps", "Msmp/frm");
-  std::ofstream csv;
-  if (o.has("--csv")) {
-    csv.open(o.get("--csv", ""));
-    if (!csv) throw std::runtime_error("cannot write " + o.get("--csv", ""));
-    csv << "dataset,backend,builder,dt_voxel,filter,ert,jitter,max_diff,psnr_db,ssim,fps,kernel_fps,msamples\n";
+  if (csvFile) {
+    csvFile->stream() << "dataset,backend,builder,dt_voxel,filter,ert,jitter,max_diff,psnr_db,ssim,fps,kernel_fps,msamples\n";
   }
   std::vector<FilterMode> filters{FilterMode::Exact};
   if (std::string(engine.backendName()) == "cuda") filters.push_back(FilterMode::Hardware);
@@ -72,14 +69,15 @@ int cmdAccuracy(const Options& o) {
           std::printf("%-10.2f %-9s %-5s %-6s %10.4f %10.2f %8.4f %9.2f %9.2f %9.2f\n", f, fname, ert ? "0.99" : "off",
                       jitter ? "on" : "off", d.maxAbs, d.psnr, s, frames / t, frames / tk, ms);
           std::fflush(stdout);
-          if (csv.is_open())
-            csv << o.positional[0] << ',' << engine.backendName() << ',' << builderName(engine.buildStats().builder) << ','
+          if (csvFile)
+            csvFile->stream() << o.positional[0] << ',' << engine.backendName() << ',' << builderName(engine.buildStats().builder) << ','
                 << f << ',' << fname << ',' << (ert ? "0.99" : "off") << ',' << (jitter ? "on" : "off") << ','
                 << d.maxAbs << ',' << d.psnr << ',' << s << ',' << frames / t << ',' << frames / tk << ',' << ms << '\n';
         }
       }
     }
   }
+  if (csvFile) csvFile->commit();
   return 0;
 }
 

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -189,13 +188,15 @@ int cmdBench(const Options& o) {
   const int buildReps = int(o.getInt("--build-reps", 1, 1, 1000000));
   const Tuning knobs = tuning(o);
   int w = 1024, h = 1024;
-  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  imageSize(o, w, h);
   std::ostringstream json;
   json << "[\n";
-  std::ofstream csv;
-  if (o.has("--csv")) {
-    csv.open(o.get("--csv", ""));
-    csv << "dataset,dims,variant,builder,backend,leaf,mls,bins,brick,build_s,classify_s,fps,nodes,height,leaves,occupancy,"
+  // Both files opened before any work (a path that cannot be written fails at once), written to
+  // temporary files and renamed into place at the end.
+  const std::unique_ptr<OutputFile> jsonFile = outputOption(o, "--json");
+  const std::unique_ptr<OutputFile> csvFile = outputOption(o, "--csv");
+  if (csvFile) {
+    csvFile->stream() << "dataset,dims,variant,builder,backend,leaf,mls,bins,brick,build_s,classify_s,fps,nodes,height,leaves,occupancy,"
            "filter,kernel_fps,build_cold_s,built_on,samples_per_frame,gsamples_per_s_kernel,voxel_gbytes_per_s_kernel,frame_cpu_s\n";
   }
   bool firstJson = true;
@@ -215,7 +216,8 @@ int cmdBench(const Options& o) {
     engine.setVolume(v);
     engine.setTransferFunction(tf);
     for (const std::string& b : builders) {
-      const BenchRow r = measureItem(engine, v, b, o, w, h, frames, buildReps, knobs);
+      const BenchRow r = allocating(frameText(w, h), frameBytes(w, h),
+                                    [&] { return measureItem(engine, v, b, o, w, h, frames, buildReps, knobs); });
       const BuildStats& s = r.s;
       const BuildParams& bp = r.bp;
       if (s.builder == BuilderKind::Naive && naiveFps == 0) naiveFps = r.kernelFps;
@@ -238,8 +240,8 @@ int cmdBench(const Options& o) {
            << ", \"samples_per_frame\": " << r.samples << ", \"gsamples_per_s\": " << r.gsps
            << ", \"voxel_gbytes_per_s\": " << r.voxelGBs << ", \"occupancy\": " << s.occupancy << ", \"width\": " << w
            << ", \"height_px\": " << h << ", \"frames\": " << frames << "}";
-      if (csv.is_open())
-        csv << name << "," << dims << "," << r.label << "," << builderName(s.builder) << "," << engine.backendName() << ","
+      if (csvFile)
+        csvFile->stream() << name << "," << dims << "," << r.label << "," << builderName(s.builder) << "," << engine.backendName() << ","
             << r.leaf << "," << bp.maxLeafSize << "," << bp.bins << "," << bp.brick << "," << s.seconds << ","
             << s.classifySeconds << "," << r.fps << "," << s.nodes << "," << s.height << "," << s.leaves << ","
             << s.occupancy << "," << r.filter << "," << r.kernelFps << "," << r.cold << "," << s.builtOn << "," << r.samples
@@ -247,10 +249,11 @@ int cmdBench(const Options& o) {
     }
   }
   json << "\n]\n";
-  if (o.has("--json")) {
-    std::ofstream js(o.get("--json", ""));
-    js << json.str();
+  if (jsonFile) {
+    jsonFile->stream() << json.str();
+    jsonFile->commit();
   }
+  if (csvFile) csvFile->commit();
   return 0;
 }
 

@@ -3,8 +3,12 @@
 #pragma once
 #include "Options.h"
 #include "spaceskip/Engine.h"
+#include "spaceskip/OutputFile.h"
 
 #include <chrono>
+#include <memory>
+#include <new>
+#include <stdexcept>
 #include <string>
 
 namespace spaceskip::cli {
@@ -27,6 +31,25 @@ void printResidency(const ResidencyStats& r);
 std::string jsonEscape(const std::string& s);
 /// "XxYxZ".
 std::string dimsText(vec3l d);
+/// "out of memory WHAT (N bytes, G GiB)".
+std::string outOfMemory(const std::string& what, uint64_t bytes);
+/// Runs `f`; a std::bad_alloc becomes a std::runtime_error naming what was being allocated and
+/// how large (outOfMemory), instead of a bare "std::bad_alloc".
+template <class F>
+decltype(auto) allocating(const std::string& what, uint64_t bytes, F&& f) {
+  try {
+    return f();
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(outOfMemory(what, bytes));
+  }
+}
+/// A w x h frame's text for allocating(): "drawing a WxH frame (its image alone)" and its bytes.
+std::string frameText(int w, int h);
+inline uint64_t frameBytes(int w, int h) { return uint64_t(w) * uint64_t(h) * kImageBytesPerPixel; }
+
+/// The file an output option names (--json, --csv), opened before any work so that a path that
+/// cannot be written fails at once (the message names the option); null when it is absent.
+std::unique_ptr<OutputFile> outputOption(const Options& o, const std::string& option);
 
 /// One measured bench item: a builder variant on one volume, the paper's protocol (orthographic
 /// camera rotating about the volume, `frames` frames, the TF of --tf, no ERT unless --ert).

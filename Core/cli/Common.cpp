@@ -20,7 +20,9 @@ Volume openVolume(const std::string& spec, const Options& o) {
   const uint64_t cap = maxVolumeBytes(o);
   std::string shape;
   vec3l dims;
-  if (parseGeneratorSpec(spec, cap, shape, dims)) return generateVolume(shape, dims);
+  if (parseGeneratorSpec(spec, cap, shape, dims))
+    return allocating("generating " + spec + " (" + dimsText(dims) + ")", checkGeneratorSize(shape, dims, cap),
+                      [&] { return generateVolume(shape, dims); });
   ReadLimits limits;
   limits.maxBytes = cap;
   return loadVolume(spec, limits);
@@ -68,6 +70,25 @@ std::string jsonEscape(const std::string& s) {
 
 std::string dimsText(vec3l d) {
   return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+}
+
+std::string outOfMemory(const std::string& what, uint64_t bytes) {
+  char b[64];
+  std::snprintf(b, sizeof b, " (%llu bytes, %.2f GiB)", (unsigned long long)bytes, double(bytes) / 1073741824.0);
+  return "out of memory " + what + b;
+}
+
+std::string frameText(int w, int h) {
+  return "drawing a " + std::to_string(w) + "x" + std::to_string(h) + " frame (its image alone)";
+}
+
+std::unique_ptr<OutputFile> outputOption(const Options& o, const std::string& option) {
+  if (!o.has(option)) return nullptr;
+  try {
+    return std::make_unique<OutputFile>(o.get(option, ""));
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(option + " " + e.what());
+  }
 }
 
 }  // namespace spaceskip::cli

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <sstream>
 
@@ -28,7 +29,7 @@ const std::set<std::string>& valueOptions() {
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
       "--shade", "--cuda-block", "--scale", "--datasets", "--time-limit", "--memory-budget",
-      "--pool-brick", "--edit-tf", "--edits", "--edit-cut"};
+      "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
@@ -115,6 +116,29 @@ void parseSize(const std::string& s, int& w, int& h) {
   if (x == std::string::npos) throw bad("--size", s, "is not WxH");
   w = int(parseIntArg(s.substr(0, x), "--size (width)", 1, kMaxImageSide));
   h = int(parseIntArg(s.substr(x + 1), "--size (height)", 1, kMaxImageSide));
+}
+
+uint64_t maxImageBytes(const Options& o) {
+  if (!o.has("--max-image-bytes")) return kDefaultMaxImageBytes;
+  uint64_t v = 0;
+  const std::string s = o.get("--max-image-bytes", "");
+  if (!parseByteCount(s, v) || v == 0)
+    throw bad("--max-image-bytes", s, "is not a positive byte count (e.g. 1073741824 or 1G)");
+  return v;
+}
+
+void imageSize(const Options& o, int& w, int& h) {
+  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  const uint64_t bytes = uint64_t(w) * uint64_t(h) * kImageBytesPerPixel, cap = maxImageBytes(o);
+  if (bytes > cap) {
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  "--size %dx%d: the image takes %llu bytes (%.2f GiB at %d bytes a pixel), more than the image "
+                  "budget of %llu bytes (%.2f GiB); raise it with --max-image-bytes",
+                  w, h, (unsigned long long)bytes, double(bytes) / 1073741824.0, int(kImageBytesPerPixel),
+                  (unsigned long long)cap, double(cap) / 1073741824.0);
+    throw std::invalid_argument(msg);
+  }
 }
 
 void parseCamera(const std::string& s, double& az, double& el, double& zoom) {

@@ -41,6 +41,14 @@ vec3l parseDims(const std::string& s, const std::string& what);
 /// "WxH", each in [1, kMaxImageSide].
 constexpr int kMaxImageSide = 16384;
 void parseSize(const std::string& s, int& w, int& h);
+/// The image budget: an image takes kImageBytesPerPixel (float RGBA) per pixel on the host (and
+/// as much on a device); --max-image-bytes N[K|M|G|T] raises the default of 1 GiB (8192x8192).
+constexpr uint64_t kImageBytesPerPixel = 16;
+constexpr uint64_t kDefaultMaxImageBytes = uint64_t(1) << 30;
+uint64_t maxImageBytes(const Options& o);
+/// --size WxH if given (else w, h as passed: the command's default), within the image budget:
+/// std::invalid_argument naming the size, its bytes, the budget and --max-image-bytes.
+void imageSize(const Options& o, int& w, int& h);
 /// "AZ,EL[,ZOOM]": finite angles, zoom > 0.
 void parseCamera(const std::string& s, double& az, double& el, double& zoom);
 

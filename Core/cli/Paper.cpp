@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -109,15 +108,16 @@ std::vector<PaperVariant> selectVariants(const Options& o) {
 }
 
 /// The benchmark's results: a CSV row and a JSON row per item (skipped and failed items in the
-/// CSV only), the JSON written at the end.
+/// CSV only), the JSON written at the end. Both files are opened at the start (a path that cannot
+/// be written fails before any work) and renamed into place by finish(); until then the CSV rows
+/// are in the temporary file beside it (OutputFile), one flushed per item.
 class PaperOutput {
  public:
   PaperOutput(const Options& o, int w, int h, int frames, double scale)
-      : o_(o), w_(w), h_(h), frames_(frames), scale_(scale) {
-    if (o.has("--csv")) {
-      csv_.open(o.get("--csv", ""));
-      if (!csv_) throw std::runtime_error("cannot write " + o.get("--csv", ""));
-      csv_ << "dataset,paper_dims,dims,scale,variant,item,builder,backend,built_on,leaf,mls,bins,brick,build_s,build_cold_s,"
+      : w_(w), h_(h), frames_(frames), scale_(scale), jsonFile_(outputOption(o, "--json")),
+        csvFile_(outputOption(o, "--csv")) {
+    if (csvFile_) {
+      csvFile_->stream() << "dataset,paper_dims,dims,scale,variant,item,builder,backend,built_on,leaf,mls,bins,brick,build_s,build_cold_s,"
               "classify_s,fps,kernel_fps,frame_cpu_s,nodes,height,leaves,brick_occupancy,voxel_occupancy_pct,"
               "paper_occupancy_pct,samples_per_frame,vs_naive_kernel,width,height_px,frames,status,parts_share,"
               "edit_empty_ms,edit_occupy_ms,edit_occupy_classify_ms,edit_occupy_wait_ms,edit_occupy_build_ms,"
@@ -131,16 +131,17 @@ class PaperOutput {
 
   /// An item not measured: `status` says why.
   void skipped(const PaperDataset& ds, vec3l dims, const PaperVariant& pv, const std::string& status) {
-    if (csv_.is_open())
-      csv_ << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale_ << "," << pv.key << ","
+    if (csvFile_)
+      csvFile_->stream() << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale_ << "," << pv.key << ","
            << pv.item << ",,,,,,,,,,,,,,,,,,," << ds.occupancyPct << ",,,,,," << status << ",,,,,,,,\n";
   }
 
   void measured(const PaperDataset& ds, vec3l dims, const PaperVariant& pv, const BenchRow& r, const char* backend,
                 double voxelOcc, double vsNaive) {
     const BuildStats& s = r.s;
-    if (csv_.is_open()) {
-      csv_ << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale_ << "," << pv.key << ","
+    if (csvFile_) {
+      std::ostream& csv = csvFile_->stream();
+      csv << ds.name << "," << dimsText(ds.dims) << "," << dimsText(dims) << "," << scale_ << "," << pv.key << ","
            << r.label << "," << builderName(s.builder) << "," << backend << "," << s.builtOn << "," << r.leaf << ","
            << r.bp.maxLeafSize << "," << r.bp.bins << "," << r.bp.brick << "," << s.seconds << "," << r.cold << ","
            << s.classifySeconds << "," << r.fps << "," << r.kernelFps << "," << r.frameCpu << "," << s.nodes << ","
@@ -149,12 +150,12 @@ class PaperOutput {
       const BenchRow::Edit& em = r.edits[0];
       const BenchRow::Edit& oc = r.edits[1];
       if (oc.count)
-        csv_ << "," << em.ms << "," << oc.ms << "," << oc.classifyMs << "," << oc.waitMs << "," << oc.buildMs << ","
+        csv << "," << em.ms << "," << oc.ms << "," << oc.classifyMs << "," << oc.waitMs << "," << oc.buildMs << ","
              << oc.frameMs << "," << oc.kernelMs;
       else
-        csv_ << ",,,,,,,";
-      csv_ << "\n";
-      csv_.flush();
+        csv << ",,,,,,,";
+      csv << "\n";
+      csv.flush();
     }
     if (!firstJson_) json_ << ",\n";
     firstJson_ = false;
@@ -172,17 +173,17 @@ class PaperOutput {
 
   void finish() {
     json_ << "\n  ]\n}\n";
-    if (o_.has("--json")) {
-      std::ofstream js(o_.get("--json", ""));
-      js << json_.str();
+    if (jsonFile_) {
+      jsonFile_->stream() << json_.str();
+      jsonFile_->commit();
     }
+    if (csvFile_) csvFile_->commit();
   }
 
  private:
-  const Options& o_;
   int w_, h_, frames_;
   double scale_;
-  std::ofstream csv_;
+  std::unique_ptr<OutputFile> jsonFile_, csvFile_;
   std::ostringstream json_;
   bool firstJson_ = true;
 };
@@ -214,7 +215,7 @@ int cmdBenchPaper(const Options& o) {
   const uint64_t cap = maxVolumeBytes(o);
   const Tuning knobs = tuning(o);
   int w = 1024, h = 1024;
-  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  imageSize(o, w, h);
   const std::vector<PaperDataset> sets = selectDatasets(o);
   const std::vector<PaperVariant> vars = selectVariants(o);
   PaperOutput out(o, w, h, frames, scale);
@@ -271,7 +272,8 @@ int cmdBenchPaper(const Options& o) {
         status = "skipped: time limit";
       } else {
         try {
-          r = measureItem(*engine, v, pv.item, o, w, h, frames, buildReps, knobs);
+          r = allocating(frameText(w, h), frameBytes(w, h),
+                         [&] { return measureItem(*engine, v, pv.item, o, w, h, frames, buildReps, knobs); });
         } catch (const std::exception& e) {
           status = std::string("failed: ") + e.what();
           for (char& c : status)

@@ -10,11 +10,14 @@ namespace spaceskip::cli {
 
 int cmdRender(const Options& o) {
   if (o.positional.size() != 1 || !o.has("-o")) throw std::invalid_argument("render needs VOLUME -o out.png");
+  // Opened first: a path that cannot be written fails before any work, and the PNG replaces what
+  // is there only once it is written whole (OutputFile).
+  const std::unique_ptr<OutputFile> png = outputOption(o, "-o");
   auto t0 = Clock::now();
   Volume v = openVolume(o.positional[0], o);
   double load = since(t0);
   int w = 512, h = 512;
-  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  imageSize(o, w, h);
   Engine engine(backendKind(o));
   engine.setTuning(tuning(o));
   engine.setMemoryBudget(memoryBudget(o), poolBrick(o));
@@ -27,9 +30,11 @@ int cmdRender(const Options& o) {
   double prep = since(t1);
   Image img;
   Camera cam = makeCamera(o, v, w, h);
-  engine.render(cam, w, h, img);  // first frame (warm-up)
-  for (int i = 0; i < 40 && engine.exploring(); ++i) engine.render(cam, w, h, img);  // Auto measures
-  engine.render(cam, w, h, img);
+  allocating(frameText(w, h), frameBytes(w, h), [&] {
+    engine.render(cam, w, h, img);  // first frame (warm-up)
+    for (int i = 0; i < 40 && engine.exploring(); ++i) engine.render(cam, w, h, img);  // Auto measures
+    engine.render(cam, w, h, img);
+  });
   const BuildStats& s = engine.buildStats();
   if (!s.choice.empty()) std::printf("%s\n", s.choice.c_str());
   std::printf("volume %s: %lldx%lldx%lld %s, load %.3f s\n", o.positional[0].c_str(), (long long)v.dims.x,
@@ -41,7 +46,8 @@ int cmdRender(const Options& o) {
   std::printf("render %dx%d: %.4f s (%.2f fps), sample distance %g\n", w, h, engine.frameStats().seconds,
               1.0 / engine.frameStats().seconds, engine.sampleDistance());
   printResidency(engine.frameStats().residency);
-  savePng(img, o.get("-o", ""));
+  png->stream() << allocating("encoding the PNG", uint64_t(w) * uint64_t(h) * 4, [&] { return encodePng(img); });
+  png->commit();
   std::printf("wrote %s\n", o.get("-o", "").c_str());
   if (o.has("--compare")) {
     ImageDiff d = compareImages(img, loadPng(o.get("--compare", "")));

@@ -23,7 +23,7 @@ int cmdSparse(const Options& o) {
   const std::vector<std::string> builders = split(o.get("--builders", "naive,grid,distance-grid,auto"), ',');
   const int frames = int(o.getInt("--frames", 8, 1, 1000000));
   int w = 1024, h = 1024;
-  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  imageSize(o, w, h);
   const bool inCore = !o.has("--no-in-core");
   auto tg = Clock::now();
   Volume v = openVolume(o.positional[0], o);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <string>
 
 using namespace spaceskip;
@@ -64,6 +65,7 @@ options:
                      SPACESKIP_CUDA_BLOCK; the other SPACESKIP_* knobs: docs/tuning.md)
   --tf PRESET|FILE   presets: ramp grayscale coolwarm band spike opaque zero
   --size WxH         (render default 512x512, bench default 1024x1024)
+  --max-image-bytes N[K|M|G|T]  largest image (16 bytes a pixel; default 1G: 8192x8192)
   --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective
   --sample-distance D  (world units; default half the smallest spacing)
   --ert T  --jitter  --filter exact|hardware
@@ -112,6 +114,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "unknown command '%s'\n", cmd.c_str());
     printUsage(stderr);
     return 2;
+  } catch (const std::bad_alloc&) {
+    // The large allocations (volumes, frames, PNGs) name themselves (Commands.h, allocating);
+    // this is what is left: an acceleration structure or a buffer of the engine.
+    std::fprintf(stderr, "spaceskip: error: out of memory in '%s' (std::bad_alloc); the volume is bounded by "
+                 "--max-volume-bytes and the image by --size and --max-image-bytes\n", argv[1]);
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "spaceskip: error: %s\n", e.what());
     return 1;

@@ -1,6 +1,8 @@
 // PNG via libpng; image metrics.
 #include "spaceskip/ImageIO.h"
 
+#include "spaceskip/OutputFile.h"
+
 #ifdef SPACESKIP_HAVE_PNG
 #include <png.h>
 #endif
@@ -10,21 +12,32 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <new>
 #include <stdexcept>
 
 namespace spaceskip {
 
 namespace {
 [[maybe_unused]] unsigned char to8(float v) { return (unsigned char)std::lround(std::clamp(v, 0.f, 1.f) * 255.f); }
+
+/// n zeroed bytes, or an error naming what they were for, their count and the image's size.
+[[maybe_unused]] std::vector<unsigned char> allocatingBytes(size_t n, const char* what, const Image& img) {
+  try {
+    return std::vector<unsigned char>(n);
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error("out of memory allocating " + std::string(what) + " of a " + std::to_string(img.width) +
+                             "x" + std::to_string(img.height) + " image (" + std::to_string(n) + " bytes)");
+  }
+}
 }  // namespace
 
-void savePng(const Image& img, const std::string& path, bool overBlack) {
+std::string encodePng(const Image& img, bool overBlack) {
   if (img.width <= 0 || img.height <= 0) throw std::invalid_argument("empty image");
 #ifndef SPACESKIP_HAVE_PNG
   (void)overBlack;
-  throw std::runtime_error(path + ": cannot write PNG: SpaceSkip was built without libpng");
+  throw std::runtime_error("cannot write PNG: SpaceSkip was built without libpng");
 #else
-  std::vector<unsigned char> rows(size_t(img.width) * img.height * 4);
+  std::vector<unsigned char> rows = allocatingBytes(size_t(img.width) * img.height * 4, "the PNG's 8-bit pixels", img);
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) {
       const vec4f& p = img.rgba[size_t(y) * img.width + x];
@@ -43,9 +56,26 @@ void savePng(const Image& img, const std::string& path, bool overBlack) {
   pi.width = png_uint_32(img.width);
   pi.height = png_uint_32(img.height);
   pi.format = PNG_FORMAT_RGBA;
-  if (!png_image_write_to_file(&pi, path.c_str(), 0, rows.data(), 0, nullptr))
-    throw std::runtime_error(path + ": cannot write PNG (" + pi.message + ")");
+  // Encoded in memory: libpng's png_image_write_to_file removes its file on an error, which
+  // would delete the user's path (a device node, a symbolic link); OutputFile writes it.
+  png_alloc_size_t bytes = 0;
+  if (!png_image_write_get_memory_size(pi, bytes, 0, rows.data(), 0, nullptr))
+    throw std::runtime_error(std::string("cannot encode PNG (") + pi.message + ")");
+  std::vector<unsigned char> encoded = allocatingBytes(size_t(bytes), "the encoded PNG", img);
+  if (!png_image_write_to_memory(&pi, encoded.data(), &bytes, 0, rows.data(), 0, nullptr))
+    throw std::runtime_error(std::string("cannot encode PNG (") + pi.message + ")");
+  return std::string(reinterpret_cast<const char*>(encoded.data()), size_t(bytes));
 #endif
+}
+
+void savePng(const Image& img, const std::string& path, bool overBlack) {
+  try {
+    writeOutputFile(path, encodePng(img, overBlack));
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    if (what.compare(0, path.size() + 1, path + ":") == 0) throw;
+    throw std::runtime_error(path + ": " + what);
+  }
 }
 
 Image loadPng(const std::string& path) {

@@ -3,6 +3,7 @@
 // before anything is allocated; header lines are bounded; only regular files are read.
 #include "spaceskip/VolumeIO.h"
 
+#include "spaceskip/OutputFile.h"
 #include "spaceskip/Parse.h"
 
 #include <algorithm>
@@ -10,7 +11,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
+#include <new>
 #include <stdexcept>
 
 namespace spaceskip {
@@ -65,6 +68,16 @@ void readExactly(std::istream& in, unsigned char* dst, uint64_t n, const std::st
                             std::to_string(in.gcount()) + " (did it shrink while being read?)");
   if (in.peek() != std::char_traits<char>::eof())
     throw ioError(path, "trailing bytes after the " + std::to_string(n) + " bytes of voxels (did it grow while being read?)");
+}
+
+/// Volume::allocate; a std::bad_alloc becomes an error naming the file, the dims and the bytes.
+void allocateVoxels(Volume& v, vec3l dims, VoxelType type, uint64_t bytes, const std::string& path) {
+  try {
+    v.allocate(dims, type);
+  } catch (const std::bad_alloc&) {
+    throw ioError(path, "out of memory allocating " + dimsText(dims) + " " + voxelTypeName(type) + " voxels (" +
+                            std::to_string(bytes) + " bytes)");
+  }
 }
 
 void swapBytes(Volume& v) {
@@ -170,6 +183,40 @@ std::vector<std::string> splitVectors(const std::string& s) {
   }
   return out;
 }
+
+/// NRRD "kinds" (format.html): one per axis. Spatial kinds are read; an axis of one sample may
+/// say stub or scalar; any kind whose samples are a voxel's components (colour, vector, list,
+/// matrix) is refused: the reader makes scalar volumes, and reading such an axis as space would
+/// draw the components side by side.
+void checkKinds(const std::string& path, const std::string& text, int n, vec3l dims) {
+  static const char* const spatial[] = {"domain", "space", "time", "???", "none"};
+  static const char* const oneSample[] = {"stub", "scalar"};
+  static const char* const components[] = {
+      "list", "point", "vector", "covariant-vector", "normal", "complex", "2-vector", "3-color", "rgb-color",
+      "hsv-color", "xyz-color", "4-color", "rgba-color", "3-vector", "3-gradient", "3-normal", "4-vector", "quaternion",
+      "2d-symmetric-matrix", "2d-masked-symmetric-matrix", "2d-matrix", "2d-masked-matrix", "3d-symmetric-matrix",
+      "3d-masked-symmetric-matrix", "3d-matrix", "3d-masked-matrix"};
+  auto in = [](const std::string& k, const auto& list) {
+    return std::find(std::begin(list), std::end(list), k) != std::end(list);
+  };
+  const auto tok = splitWhitespace(text);
+  if (int(tok.size()) != n)
+    throw fieldError(path, "kinds", std::to_string(tok.size()) + " values for dimension " + std::to_string(n));
+  const int64_t size[3] = {dims.x, dims.y, dims.z};
+  for (int a = 0; a < n; ++a) {
+    const std::string given(tok[size_t(a)].substr(0, 40));
+    const std::string k = lower(given);
+    if (in(k, spatial) || (in(k, oneSample) && size[a] == 1)) continue;
+    if (in(k, oneSample))
+      throw fieldError(path, "kinds", "axis " + std::to_string(a) + " is '" + given + "' but has " +
+                                          std::to_string(size[a]) + " samples (" + given + " means one)");
+    if (in(k, components))
+      throw fieldError(path, "kinds", "axis " + std::to_string(a) + " is '" + given + "' (" + std::to_string(size[a]) +
+                                          " components per voxel): only scalar volumes are read; make one scalar "
+                                          "per voxel first (e.g. unu project, or a magnitude)");
+    throw fieldError(path, "kinds", "'" + given + "' is not a NRRD kind");
+  }
+}
 }  // namespace
 
 bool parseRawName(const std::string& fileName, vec3l& dims, VoxelType& type) {
@@ -214,7 +261,7 @@ Volume readRaw(std::istream& in, uint64_t available, const std::string& path, co
                             (available < bytes ? "file too short"
                                                : std::to_string(available - bytes) + " trailing bytes"));
   Volume v;
-  v.allocate(dims, type);
+  allocateVoxels(v, dims, type, bytes, path);
   readExactly(in, v.mutableData(), bytes, path);
   return v;
 }
@@ -293,6 +340,7 @@ NrrdHeader readNrrdHeader(std::istream& in, const std::string& path, const ReadL
                                             "' is not a positive 64-bit integer");
     h.dims = vec3l{s[0], s[1], s[2]};
   }
+  if (has("kinds")) checkKinds(path, fields["kinds"], n, h.dims);
   const std::string enc = lower(need("encoding"));
   if (enc != "raw") throw fieldError(path, "encoding", "unsupported encoding '" + fields["encoding"] + "' (only raw)");
   if (has("endian")) {
@@ -370,7 +418,7 @@ Volume readNrrdData(const NrrdHeader& h, std::istream& in, uint64_t available, c
                             " need " + std::to_string(h.voxelBytes) + " bytes of voxels, the file has " +
                             std::to_string(available));
   Volume v;
-  v.allocate(h.dims, h.type);
+  allocateVoxels(v, h.dims, h.type, h.voxelBytes, path);
   std::copy(h.spacing, h.spacing + 3, v.spacing);
   std::copy(h.origin, h.origin + 3, v.origin);
   std::copy(h.direction, h.direction + 9, v.direction);
@@ -406,22 +454,21 @@ Volume loadVolume(const std::string& path, const ReadLimits& limits) {
 }
 
 void saveNrrd(const Volume& v, const std::string& path) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw ioError(path, "cannot write");
+  OutputFile file(path);
+  std::ostream& out = file.stream();
   static const char* nrrdType[] = {"uint8", "int8", "uint16", "int16", "float", "double"};
   out.precision(17);  // spacings round-trip exactly
   out << "NRRD0004\ntype: " << nrrdType[int(v.type)] << "\ndimension: 3\nsizes: " << v.dims.x << " "
       << v.dims.y << " " << v.dims.z << "\nspacings: " << v.spacing[0] << " " << v.spacing[1] << " "
       << v.spacing[2] << "\nencoding: raw\nendian: little\n\n";
   out.write(static_cast<const char*>(v.data), std::streamsize(v.byteSize()));
-  if (!out) throw ioError(path, "write failed");
+  file.commit();
 }
 
 void saveRaw(const Volume& v, const std::string& path) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw ioError(path, "cannot write");
-  out.write(static_cast<const char*>(v.data), std::streamsize(v.byteSize()));
-  if (!out) throw ioError(path, "write failed");
+  OutputFile file(path);
+  file.stream().write(static_cast<const char*>(v.data), std::streamsize(v.byteSize()));
+  file.commit();
 }
 
 }  // namespace spaceskip

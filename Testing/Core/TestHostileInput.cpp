@@ -2,6 +2,7 @@
 // give a clear error naming the file and field, quickly, without allocating what they claim.
 #include "Environment.h"
 #include "Options.h"
+#include "spaceskip/OutputFile.h"
 #include "spaceskip/TransferFunctionIO.h"
 #include "spaceskip/VolumeIO.h"
 
@@ -12,6 +13,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -255,6 +257,15 @@ TEST(HostileInput, NrrdFieldErrorsNameTheField) {
        "field 'space directions': the axes are parallel"},
       {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: slice%03d.raw 0 9 1\n", "field 'data file'"},
       {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nsizes:2 2 2\n", "malformed NRRD field"},
+      // Issue 41: a colour or vector axis was read as space (the components side by side).
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: RGB-color domain domain\n",
+       "field 'kinds': axis 0 is 'RGB-color' (2 components per voxel): only scalar volumes"},
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: domain vector domain\n", "axis 1 is 'vector'"},
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: domain domain list\n", "axis 2 is 'list'"},
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: domain domain\n", "field 'kinds': 2 values for dimension 3"},
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: domain domain domain domain\n", "field 'kinds': 4 values"},
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: domain colour domain\n", "'colour' is not a NRRD kind"},
+      {"type: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: domain stub domain\n", "axis 1 is 'stub' but has 2 samples"},
   };
   int i = 0;
   for (const Case& c : cases) {
@@ -392,9 +403,78 @@ TEST(HostileInput, CliValuesAreParsedStrictly) {
   EXPECT_HAS(errorOf([&] { parseGeneratorSpec("gen:noise:1024", 1 << 20, shape, d); }), "more than the limit");
   EXPECT_TRUE(parseGeneratorSpec("gen:menger:64", 1 << 20, shape, d));
   EXPECT_FALSE(parseGeneratorSpec("menger.nrrd", 1 << 20, shape, d));
+  // Issue 41: the image budget names the size, its bytes and the option that raises it.
+  Options image;
+  image.kv["--size"] = "16384x16384";
+  EXPECT_HAS(argError([&] { imageSize(image, w, h); }),
+             "--size 16384x16384: the image takes 4294967296 bytes (4.00 GiB at 16 bytes a pixel), more than the "
+             "image budget of 1073741824 bytes (1.00 GiB); raise it with --max-image-bytes");
+  image.kv["--max-image-bytes"] = "4G";
+  imageSize(image, w, h);
+  EXPECT_EQ(w, 16384);
+  w = 512, h = 512;
+  imageSize(Options{}, w, h);  // the command's default stays
+  EXPECT_EQ(w, 512);
+  image.kv["--max-image-bytes"] = "0";
+  EXPECT_HAS(argError([&] { imageSize(image, w, h); }), "--max-image-bytes: '0' is not a positive byte count");
   Options cap;
   cap.kv["--max-volume-bytes"] = "64Q";
   EXPECT_HAS(argError([&] { maxVolumeBytes(cap); }), "--max-volume-bytes");
   cap.kv["--max-volume-bytes"] = "64M";
   EXPECT_EQ(maxVolumeBytes(cap), uint64_t(64) << 20);
+}
+
+// --- output files (issue 41): a failed write leaves what was there --------------------------------
+
+TEST(HostileInput, OutputFileLeavesTheTargetOnAFailedWrite) {
+  TempDir d;
+  const std::string target = d.file("keep.csv", "old contents\n");
+  const std::string link = (d.path / "link.csv").string();
+  fs::create_symlink("keep.csv", link);
+  auto onlyTheTwo = [&] {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(d.path)) n += e.path().filename().string()[0] == '.' ? 100 : 1;
+    EXPECT_EQ(n, 2) << "a temporary file was left behind";
+  };
+  // A write error on a regular file (as on a full disk): the file-size limit makes write() fail
+  // with EFBIG, its signal ignored.
+  rlimit old{};
+  getrlimit(RLIMIT_FSIZE, &old);
+  auto* prev = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit small = old;
+  small.rlim_cur = 4096;
+  setrlimit(RLIMIT_FSIZE, &small);
+  std::string msg = "(no error)";
+  try {
+    OutputFile f(link);
+    f.stream() << std::string(1 << 20, 'x');
+    f.commit();
+  } catch (const std::runtime_error& e) {
+    msg = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, prev);
+  EXPECT_HAS(msg, link + ": cannot write: File too large");
+  EXPECT_TRUE(fs::is_symlink(link));
+  std::ifstream in(target);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "old contents\n");
+  onlyTheTwo();
+  // Destroyed without commit(): nothing changes either.
+  { OutputFile f(target); f.stream() << "new"; }
+  onlyTheTwo();
+  // Committed through the link: the link stays, its target has the new contents and keeps its mode.
+  fs::permissions(target, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  writeOutputFile(link, "new contents\n");
+  EXPECT_TRUE(fs::is_symlink(link));
+  std::ifstream again(target);
+  text.assign(std::istreambuf_iterator<char>(again), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text, "new contents\n");
+  EXPECT_EQ(fs::status(target).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  onlyTheTwo();
+  // What can be known before writing fails at once, naming the path and the cause.
+  EXPECT_HAS(errorOf([&] { OutputFile f((d.path / "no" / "x.csv").string()); }), "the folder '");
+  EXPECT_HAS(errorOf([&] { OutputFile f(d.path.string()); }), "is a directory");
+  EXPECT_HAS(errorOf([&] { OutputFile f(target + "/x.csv"); }), "is not a folder");
 }

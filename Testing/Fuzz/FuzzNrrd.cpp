@@ -19,7 +19,8 @@ const char* pick(FuzzedDataProvider& p, const char* const* list, size_t n) {
 std::string anyValue(FuzzedDataProvider& p) {
   static const char* const words[] = {"uint8", "uchar", "int16", "unsigned short int", "float", "double", "int32",
                                       "block", "raw", "gzip", "ascii", "little", "big", "LIST", "domain", "none",
-                                      "RAS", "left-posterior-superior", "cell", "node"};
+                                      "RAS", "left-posterior-superior", "cell", "node", "domain domain domain",
+                                      "RGB-color domain domain", "domain vector domain", "stub domain domain"};
   std::string v;
   const int count = p.ConsumeIntegralInRange(0, 4);
   switch (p.ConsumeIntegralInRange(0, 4)) {

@@ -6,7 +6,9 @@
 
 namespace spaceskip {
 
-/// Writes premultiplied RGBA as 8-bit RGBA PNG (top row first), optionally over a background.
+/// Premultiplied RGBA as an 8-bit RGBA PNG file's bytes (top row first), optionally over black.
+std::string encodePng(const Image& img, bool overBlack = false);
+/// encodePng written to `path` through OutputFile: a failed write leaves what was there.
 void savePng(const Image& img, const std::string& path, bool overBlack = false);
 /// Reads an 8-bit RGB/RGBA PNG into a (straight-to-premultiplied is not applied) Image.
 Image loadPng(const std::string& path);
