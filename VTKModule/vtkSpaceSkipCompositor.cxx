@@ -16,7 +16,7 @@
 #include "vtkShaderProgram.h"
 #include "vtkTextureObject.h"
 #include "vtkVolume.h"
-#include "vtk_glew.h"
+#include "vtkSpaceSkipOpenGL.h"
 
 #include "spaceskip/DeviceImageCopy.h"
 #include "spaceskip/Engine.h"

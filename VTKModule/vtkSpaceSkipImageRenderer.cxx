@@ -6,11 +6,11 @@
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkRenderer.h"
+#include "vtkSpaceSkipOpenGL.h"
 #include "vtkSpaceSkipSettings.h"
 #include "vtkVolume.h"
 #include "vtkVolumeMapper.h"
 #include "vtkVolumeProperty.h"
-#include "vtk_glew.h"
 
 #include "spaceskip/Backend.h"
 

@@ -59,7 +59,7 @@
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkPolyDataMapper.h"
-#include "vtk_glew.h"
+#include "vtkSpaceSkipOpenGL.h"
 
 #include "cli/Environment.h"
 #include "spaceskip/Generators.h"

@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# Build the VTK module (Core inside) and its C++ tests against VTK from pip, then run the VTK
+# mapper tests under Xvfb: the check that one source tree builds against ParaView 5.11's VTK 9.2
+# (build/) and against VTK >= 9.4 (glad in place of GLEW; VTKModule/vtkSpaceSkipOpenGL.h).
+#
+# What it uses, all from PyPI (pip) and Debian:
+#   * `vtk==$VER` (the Linux manylinux wheel): the libvtk*.so in vtkmodules/, installed into a
+#     venv with --no-deps (its Python dependencies are not needed for C++);
+#   * `vtk-sdk==$VER`: headers and CMake package. PyPI has it only as macOS wheels, so the macOS
+#     one is downloaded and re-pointed at the Linux wheel's libraries (assemble_sdk.py says how);
+#     Kitware's Linux SDK wheels are the real-world route (docs/pip.md).
+# Everything is compiled with -D_GLIBCXX_USE_CXX11_ABI=0, the ABI of the manylinux2014 wheel
+# (else the module fails to load: undefined symbol ...GetObjectDescriptionB5cxx11).
+# Not built: the Python wrapping (needs VTK's wrapping executables, which neither wheel has for
+# Linux) and CUDA (a CPU build; the GPU runs are bench/device/ and Testing/gpu/).
+#
+# usage: scripts/pip-vtk/build.sh [ctest arguments; default -R SpaceSkipping: the VTK mapper tests]
+# environment (all optional):
+#   SPACESKIP_PIP_VTK_VERSION  VTK version from pip (default 9.5.0; vtk-sdk must exist on PyPI)
+#   SPACESKIP_PIP_VTK_CACHE    downloads, venv and assembled SDK (default ~/.cache/spaceskip-pip-vtk)
+#   SPACESKIP_PIP_VTK_BUILD    build folder (default build-pipvtk in the repository, git-ignored)
+#   SPACESKIP_PIP_VTK_JOBS     build jobs (default: nproc)
+#   SPACESKIP_XVFB_DISPLAY     Xvfb display number when DISPLAY is unset (default 92)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/../.." && pwd)
+ver=${SPACESKIP_PIP_VTK_VERSION:-9.5.0}
+cache=${SPACESKIP_PIP_VTK_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/spaceskip-pip-vtk}/$ver
+build=${SPACESKIP_PIP_VTK_BUILD:-$root/build-pipvtk}
+jobs=${SPACESKIP_PIP_VTK_JOBS:-$(nproc)}
+ctest_args=("$@")
+[ ${#ctest_args[@]} -gt 0 ] || ctest_args=(-R SpaceSkipping)
+py=${PYTHON:-python3}
+t0=$SECONDS
+step() { echo "== pip-vtk [$((SECONDS - t0)) s]: $*"; }
+mkdir -p "$cache"
+
+step "VTK $ver from PyPI (cache $cache)"
+if ! ls "$cache"/wheels/vtk-"$ver"-*manylinux*.whl >/dev/null 2>&1; then
+  if ! "$py" -m pip download --no-deps --only-binary=:all: -d "$cache/wheels" "vtk==$ver" >"$cache/pip-vtk.log" 2>&1; then
+    tail -5 "$cache/pip-vtk.log"
+    echo "pip-vtk: cannot download vtk==$ver from PyPI (see $cache/pip-vtk.log); nothing built" >&2
+    exit 1
+  fi
+fi
+venv=$cache/venv
+if [ ! -f "$venv/.vtk-installed" ]; then
+  rm -rf "$venv"
+  "$py" -m venv "$venv"
+  "$venv/bin/python" -m pip install -q --no-deps "$cache"/wheels/vtk-"$ver"-*manylinux*.whl
+  touch "$venv/.vtk-installed"
+fi
+vtkmodules=$("$venv/bin/python" -c 'import os, sysconfig; print(os.path.join(sysconfig.get_paths()["platlib"], "vtkmodules"))')
+echo "Linux libraries: $vtkmodules ($(ls "$vtkmodules"/libvtk*.so | wc -l) libvtk*.so)"
+
+step "vtk-sdk $ver (PyPI: macOS wheels only) -> a Linux SDK"
+if ! ls "$cache"/sdk-wheel/vtk_sdk-"$ver"-*.whl >/dev/null 2>&1; then
+  if ! "$py" -m pip download --no-deps --only-binary=:all: --platform macosx_10_9_x86_64 \
+      --python-version 3.10 -d "$cache/sdk-wheel" "vtk-sdk==$ver" >"$cache/pip-sdk.log" 2>&1; then
+    tail -5 "$cache/pip-sdk.log"
+    echo "pip-vtk: PyPI has no vtk-sdk==$ver macOS x86_64 wheel to take headers from; nothing built" >&2
+    exit 1
+  fi
+fi
+if [ ! -f "$cache/sdk-unzipped/.done" ]; then
+  rm -rf "$cache/sdk-unzipped"
+  "$py" -m zipfile -e "$cache"/sdk-wheel/vtk_sdk-"$ver"-*.whl "$cache/sdk-unzipped"
+  touch "$cache/sdk-unzipped/.done"
+fi
+vtk_dir=$("$py" "$root/scripts/pip-vtk/assemble_sdk.py" "$cache/sdk-unzipped" "$vtkmodules" "$cache/sdk")
+echo "VTK_DIR=$vtk_dir"
+echo "NOTE: Python wrapping is NOT built here: it needs VTK's wrapping executables (vtkWrapHierarchy,"
+echo "      vtkWrapPython, vtkWrapPythonInit) for Linux, which neither PyPI wheel ships (the vtk wheel"
+echo "      has libvtkWrappingTools.so only, vtk-sdk's are macOS binaries). Build them from VTK's"
+echo "      source of tag v$ver, or use Kitware's Linux vtk-sdk (docs/pip.md)."
+
+step "configure $build (ParaView off, CUDA off, -D_GLIBCXX_USE_CXX11_ABI=0)"
+# CMAKE_DISABLE_FIND_PACKAGE_ParaView: the system ParaView's VTK must not be loaded beside this one.
+mkdir -p "$build"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_DISABLE_FIND_PACKAGE_ParaView=TRUE -DSPACESKIP_ENABLE_PARAVIEW=OFF \
+  -DSPACESKIP_ENABLE_VTK=ON -DSPACESKIP_ENABLE_CUDA=OFF -DSPACESKIP_WRAP_PYTHON=OFF \
+  -DVTK_DIR="$vtk_dir" -DCMAKE_CXX_FLAGS="-D_GLIBCXX_USE_CXX11_ABI=0" >"$build/pip-vtk-configure.log" 2>&1 ||
+  { tail -30 "$build/pip-vtk-configure.log"; exit 1; }
+grep -E "SpaceSkip: " "$build/pip-vtk-configure.log"
+
+step "build the module, its C++ tests, the window benchmark and the test baselines (-j$jobs)"
+nice -n 10 cmake --build "$build" -j "$jobs" \
+  --target vtkSpaceSkipCxxTests spaceskip_window_bench SpaceSkip-data
+
+step "VTK C++ tests (ctest ${ctest_args[*]}) under X"
+source "$root/scripts/xvfb.sh" 92
+echo "DISPLAY=$DISPLAY"
+# The window the tests draw in, as the pip vtk opens it here.
+"$venv/bin/python" - <<'PY' || echo "pip-vtk: could not open a VTK render window to report its GL" >&2
+from vtkmodules.vtkRenderingCore import vtkRenderWindow
+import vtkmodules.vtkRenderingOpenGL2
+w = vtkRenderWindow()
+w.Render()
+caps = [l.strip() for l in w.ReportCapabilities().splitlines() if l.startswith("OpenGL")]
+print(w.GetClassName() + ": " + "; ".join(caps))
+PY
+set +e
+(cd "$build" && ctest "${ctest_args[@]}" --output-on-failure -j1 --timeout 600) 2>&1 | tee "$build/pip-vtk-ctest.log"
+rc=${PIPESTATUS[0]}
+set -e
+step "done: ctest exit $rc; VTK $ver from pip; log $build/pip-vtk-ctest.log"
+exit "$rc"
