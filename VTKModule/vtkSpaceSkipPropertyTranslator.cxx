@@ -4,9 +4,13 @@
 
 #include "vtkColorTransferFunction.h"
 #include "vtkContourValues.h"
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkImageResize.h"
 #include "vtkImplicitFunction.h"
 #include "vtkLight.h"
 #include "vtkLightCollection.h"
+#include "vtkMath.h"
 #include "vtkMatrix3x3.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNew.h"
@@ -14,6 +18,7 @@
 #include "vtkPiecewiseFunction.h"
 #include "vtkPlane.h"
 #include "vtkPlaneCollection.h"
+#include "vtkPointData.h"
 #include "vtkRenderer.h"
 #include "vtkSpaceSkipSettings.h"
 #include "vtkVolume.h"
@@ -31,6 +36,8 @@ namespace
 // Table resolution of the transfer function, sampled over the data's scalar range (what
 // vtkGPUVolumeRayCastMapper does by default, ColorRangeType == SCALAR).
 constexpr int kTableSize = 1024;
+// Entries of the gradient-opacity table: vtkOpenGLVolumeGradientOpacityTable's texture width.
+constexpr int kGradientTableSize = 1024;
 // Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
 constexpr double kErtThreshold = 0.99;
 
@@ -50,6 +57,27 @@ spaceskip::mat4 ToCore(const vtkMatrix4x4* m)
     }
   }
   return out;
+}
+
+// The property's 2-D transfer function when vtkGPUVolumeRayCastMapper would use it: TF_2D mode
+// and an image of 4-component scalars, one slice deep (ParaView's vtkPVTransferFunction2D).
+vtkImageData* Usable2D(vtkVolumeProperty* prop)
+{
+  if (prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_2D)
+  {
+    return nullptr;
+  }
+  vtkImageData* img = prop->GetTransferFunction2D(0);
+  if (!img)
+  {
+    return nullptr;
+  }
+  int dims[3];
+  img->GetDimensions(dims);
+  vtkDataArray* a = img->GetPointData() ? img->GetPointData()->GetScalars() : nullptr;
+  const bool ok = a && a->GetNumberOfComponents() == 4 && dims[0] >= 1 && dims[1] >= 1 && dims[2] == 1 &&
+    int64_t(dims[0]) * dims[1] <= (int64_t(1) << 24) && a->GetNumberOfTuples() == vtkIdType(dims[0]) * dims[1];
+  return ok ? img : nullptr;
 }
 } // namespace
 
@@ -85,9 +113,79 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& e
     this->OpacitySampleRange[1] != shi || this->OpacityTableRange[0] != alo ||
     this->OpacityTableRange[1] != ahi || this->OpacityComponent != opacityComponent ||
     this->UnitDistance != unit;
-  if (!colorStale && !opacityStale)
+  // The 2-D table (TF_2D) or the gradient opacity (1-D mode, unless disabled; the stored function
+  // only, as GetGradientOpacity would make a default one), one-component volumes only.
+  vtkImageData* table2D = opacityRange ? nullptr : Usable2D(prop);
+  vtkPiecewiseFunction* gradient = opacityRange || prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_1D ||
+      prop->GetDisableGradientOpacity(0)
+    ? nullptr
+    : prop->GetStoredGradientOpacity(0);
+  const bool table2DStale = this->Table2DKey != table2D || (table2D && this->Table2DMTime != table2D->GetMTime());
+  const bool gradientStale = this->GradientKey != gradient ||
+    (gradient &&
+      (this->GradientMTime != gradient->GetMTime() || this->GradientRange[0] != lo || this->GradientRange[1] != hi));
+  if (!colorStale && !opacityStale && !table2DStale && !gradientStale)
   {
     return;
+  }
+  if (table2DStale)
+  {
+    this->Table2D.clear();
+    this->Width2D = this->Height2D = 0;
+    if (table2D)
+    {
+      // vtkOpenGLVolumeTransferFunction2D uploads the image resized (vtkImageResize, its default
+      // sinc interpolation, corner points aligned) to a texture of max(1024, the next power of
+      // two) texels per axis (vtkOpenGLVolumeLookupTable::ComputeIdealTextureSize; one row stays
+      // one row): the engine gets that texture, read texel-centred as OpenGL reads it.
+      int dims[3];
+      table2D->GetDimensions(dims);
+      const int w = std::max(1024, vtkMath::NearestPowerOfTwo(dims[0]));
+      const int h = dims[1] > 1 ? std::max(1024, vtkMath::NearestPowerOfTwo(dims[1])) : 1;
+      vtkNew<vtkImageResize> resize;
+      vtkImageData* src = table2D;
+      if (w != dims[0] || h != dims[1])
+      {
+        resize->SetInputData(table2D);
+        resize->SetResizeMethodToOutputDimensions();
+        resize->SetOutputDimensions(w, h, 1);
+        resize->Update();
+        src = resize->GetOutput();
+        src->GetDimensions(dims);
+      }
+      vtkDataArray* a = src->GetPointData()->GetScalars();
+      this->Width2D = dims[0];
+      this->Height2D = dims[1];
+      this->Table2D.resize(size_t(dims[0]) * size_t(dims[1]) * 4);
+      for (vtkIdType i = 0; i < vtkIdType(dims[0]) * dims[1]; ++i)
+      {
+        for (int c = 0; c < 4; ++c)
+        {
+          this->Table2D[size_t(i) * 4 + c] = static_cast<float>(a->GetComponent(i, c));
+        }
+      }
+    }
+    this->Table2DKey = table2D;
+    this->Table2DMTime = table2D ? table2D->GetMTime() : 0;
+  }
+  if (gradientStale)
+  {
+    this->GradientOpacity.clear();
+    if (gradient)
+    {
+      // vtkOpenGLVolumeGradientOpacityTable: the function over [0, (max - min) / 4].
+      this->GradientOpacity.resize(kGradientTableSize);
+      gradient->GetTable(0, 0.25 * (hi - lo), kGradientTableSize, this->GradientOpacity.data());
+      // A factor of 1 everywhere (vtkVolumeProperty's default function) changes nothing.
+      if (std::all_of(this->GradientOpacity.begin(), this->GradientOpacity.end(), [](float g) { return g >= 1.f; }))
+      {
+        this->GradientOpacity.clear();
+      }
+    }
+    this->GradientKey = gradient;
+    this->GradientMTime = gradient ? gradient->GetMTime() : 0;
+    this->GradientRange[0] = lo;
+    this->GradientRange[1] = hi;
   }
   if (colorStale)
   {
@@ -139,7 +237,20 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& e
     tf.table[i] = spaceskip::vec4f{ this->RGB[3 * i], this->RGB[3 * i + 1], this->RGB[3 * i + 2],
       std::min(std::max(this->Alpha[i], 0.f), 1.f) };
   }
-  // The engine compares only the parts that may differ from what it has.
+  if (!this->Table2D.empty())
+  {
+    tf.width2D = this->Width2D;
+    tf.height2D = this->Height2D;
+    tf.table2D.resize(size_t(this->Width2D) * size_t(this->Height2D));
+    for (size_t i = 0; i < tf.table2D.size(); ++i)
+    {
+      const float* e = &this->Table2D[4 * i];
+      tf.table2D[i] = spaceskip::vec4f{ e[0], e[1], e[2], std::min(std::max(e[3], 0.f), 1.f) };
+    }
+  }
+  tf.gradientOpacity = this->GradientOpacity;
+  // The engine compares only the parts that may differ from what it has (the 2-D and gradient
+  // tables always).
   engine.setTransferFunction(std::move(tf), colorStale, opacityStale);
   this->HaveTF = true;
 }
@@ -161,6 +272,10 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
   unsupported(vol->GetProperty()->GetInterpolationType() == VTK_NEAREST_INTERPOLATION,
     this->WarnedNearest,
     "nearest interpolation is not supported; rendering with trilinear interpolation");
+  vtkVolumeProperty* prop = vol->GetProperty();
+  unsupported(prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D && !Usable2D(prop), this->Warned2D,
+    "2-D transfer function mode without a 2-D transfer function of 4-component scalars (one slice): "
+    "rendering with the 1-D transfer functions");
   unsupported(blendMode < vtkVolumeMapper::COMPOSITE_BLEND || blendMode > vtkVolumeMapper::SLICE_BLEND,
     this->WarnedBlend, "unknown blend mode; rendering with composite blending");
 

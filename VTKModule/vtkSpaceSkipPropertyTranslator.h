@@ -10,7 +10,9 @@
 #include <string>     // For the warning texts
 #include <vector>     // For the sampled tables
 
+class vtkImageData;
 class vtkOpenGLCamera;
+class vtkPiecewiseFunction;
 class vtkRenderer;
 class vtkVolume;
 class vtkVolumeProperty;
@@ -35,7 +37,9 @@ public:
    * compares no opacity, an opacity edit no colour; another change of the property, e.g. its
    * shading, does nothing here). Dependent components: the opacity function over `opacityRange`
    * instead, with component `opacityComponent`'s unit distance
-   * (vtkVolumeInputHelper::UpdateOpacityTransferFunction).
+   * (vtkVolumeInputHelper::UpdateOpacityTransferFunction). One-component volumes also get the
+   * property's 2-D transfer function (TF_2D mode) or its gradient opacity (1-D mode, unless
+   * disabled), as vtkGPUVolumeRayCastMapper reads them; an edit of either re-classifies.
    */
   void UpdateTransferFunction(spaceskip::Engine& engine, vtkVolumeProperty* prop,
     const double scalarRange[2], const double* opacityRange = nullptr, int opacityComponent = 0);
@@ -85,11 +89,22 @@ private:
   double UnitDistance = 1;
   bool HaveTF = false;
   std::vector<float> RGB, Alpha;
+  // The 2-D table (RGBA per entry, Width2D x Height2D) or the gradient-opacity table, with the
+  // function, MTime and scalar range they were read with.
+  const vtkImageData* Table2DKey = nullptr;
+  vtkMTimeType Table2DMTime = 0;
+  std::vector<float> Table2D;
+  int Width2D = 0, Height2D = 0;
+  const vtkPiecewiseFunction* GradientKey = nullptr;
+  vtkMTimeType GradientMTime = 0;
+  double GradientRange[2] = { 0, 0 };
+  std::vector<float> GradientOpacity;
   int ColorSamples = 0, OpacitySamples = 0;
 
   // Unsupported features already said (the lights say their first cause only).
   bool WarnedNearest = false;
   bool WarnedBlend = false;
+  bool Warned2D = false;
   bool WarnedLight = false;
   bool WarnedSlice = false;
 };

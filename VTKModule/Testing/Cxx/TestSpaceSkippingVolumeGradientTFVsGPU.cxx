@@ -1,0 +1,139 @@
+// 2-D transfer functions (vtkVolumeProperty TF_2D: value x gradient magnitude) and gradient
+// opacity through vtkGPUVolumeRayCastMapper and vtkSpaceSkippingVolumeMapper in the same scene:
+// prints the PSNR per case and checks it, that each case draws something and that it differs
+// from the same property without the 2-D table / gradient opacity (so ignoring them fails).
+#include "vtkFloatArray.h"
+#include "vtkPointData.h"
+
+#include "SpaceSkipTestHelpers.h"
+
+#include <functional>
+
+namespace
+{
+// Issue 34's target.
+constexpr double kMinPSNR = 40.0;
+
+// A w x h RGBA float image as ParaView's vtkPVTransferFunction2D builds it: x over the scalar
+// range, y over the normalised gradient magnitude; a box of opacity `a` over normalised value
+// [x0, x1] and gradient magnitude [y0, y1], its colour varying along both axes.
+vtkSmartPointer<vtkImageData> MakeBox2D(int w, int h, double x0, double x1, double y0, double y1, double a)
+{
+  auto img = vtkSmartPointer<vtkImageData>::New();
+  img->SetDimensions(w, h, 1);
+  img->AllocateScalars(VTK_FLOAT, 4);
+  auto* s = vtkFloatArray::SafeDownCast(img->GetPointData()->GetScalars());
+  for (int y = 0; y < h; ++y)
+  {
+    for (int x = 0; x < w; ++x)
+    {
+      const double u = (x + 0.5) / w, g = (y + 0.5) / h;
+      const bool in = u >= x0 && u <= x1 && g >= y0 && g <= y1;
+      const vtkIdType i = vtkIdType(y) * w + x;
+      s->SetTypedComponent(i, 0, static_cast<float>(u));
+      s->SetTypedComponent(i, 1, static_cast<float>(1.0 - g));
+      s->SetTypedComponent(i, 2, 0.4f);
+      s->SetTypedComponent(i, 3, in ? static_cast<float>(a) : 0.f);
+    }
+  }
+  return img;
+}
+}
+
+int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
+{
+  auto image = sstest::MakeWavelet(64);
+  double range[2];
+  image->GetScalarRange(range);
+  const double lo = range[0], hi = range[1];
+  const double sampleDistance = 0.5;
+
+  auto gpu = sstest::ReferenceGPUMapper(image, sampleDistance);
+  auto ours = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::Grid, sampleDistance, false);
+  sstest::Scene scene(ours, 256, 256);
+  scene.View(35, 25, 1.6, true);
+  vtkVolumeProperty* prop = scene.Property;
+  vtkVolume* volume = scene.Volume;
+  vtkRenderer* ren = scene.Renderer;
+  vtkRenderWindow* win = scene.Window;
+  const std::string dir = sstest::TempDir(argc, argv);
+
+  auto box = MakeBox2D(64, 32, 0.3, 0.95, 0.08, 0.5, 0.15);
+  auto plain = [&](vtkVolumeProperty* p) { sstest::SetupProperty(p, lo, hi, 0.6); };
+  auto twoD = [&](vtkVolumeProperty* p) {
+    plain(p);
+    p->SetTransferFunctionMode(vtkVolumeProperty::TF_2D);
+    p->SetTransferFunction2D(box);
+  };
+  auto twoDShaded = [&](vtkVolumeProperty* p) {
+    twoD(p);
+    p->ShadeOn();
+    p->SetAmbient(0.2);
+    p->SetDiffuse(0.7);
+    p->SetSpecular(0.3);
+    p->SetSpecularPower(20);
+  };
+  auto gradient = [&](vtkVolumeProperty* p) {
+    plain(p);
+    vtkNew<vtkPiecewiseFunction> g; // over the gradient magnitude in scalar units per voxel
+    g->AddPoint(0, 0.0);
+    g->AddPoint(0.05 * (hi - lo), 1.0);
+    g->AddPoint(0.25 * (hi - lo), 0.2);
+    p->SetGradientOpacity(g);
+  };
+  struct Case
+  {
+    const char* name;
+    std::function<void(vtkVolumeProperty*)> setup;
+  };
+  const Case cases[] = { { "1d", plain }, { "2d", twoD }, { "2d-shade", twoDShaded },
+    { "gradient-opacity", gradient } };
+  double worst = std::numeric_limits<double>::infinity();
+  vtkSmartPointer<vtkImageData> plainImage;
+  int failures = 0;
+  for (const Case& c : cases)
+  {
+    vtkNew<vtkVolumeProperty> fresh;
+    prop->DeepCopy(fresh);
+    c.setup(prop);
+    prop->SetInterpolationTypeToLinear();
+    prop->SetScalarOpacityUnitDistance(1.0);
+    ren->ResetCameraClippingRange();
+    volume->SetMapper(gpu);
+    win->Render();
+    auto a = sstest::Capture(win);
+    volume->SetMapper(ours);
+    win->Render();
+    auto b = sstest::Capture(win);
+    const double psnr = sstest::PrintComparison(c.name, a, b);
+    std::cout << "\n";
+    const vtkIdType drawn = sstest::CountNonBackground(b, sstest::kBlack);
+    const std::string prefix = dir + "/TestSpaceSkippingVolumeGradientTFVsGPU-" + c.name;
+    sstest::WritePNG(a, prefix + "-gpu.png");
+    sstest::WritePNG(b, prefix + "-ours.png");
+    worst = std::min(worst, psnr);
+    if (drawn < 1000 || psnr < kMinPSNR)
+    {
+      std::cout << "  FAILED\n";
+      ++failures;
+    }
+    if (!plainImage)
+    {
+      plainImage = b;
+    }
+    else
+    {
+      const double change = sstest::PSNR(plainImage, b);
+      std::cout << "  " << c.name << " vs 1d (ours): " << change << " dB, max diff " << sstest::MaxDiff(plainImage, b)
+                << "\n";
+      if (sstest::MaxDiff(plainImage, b) < 20)
+      {
+        std::cout << "  FAILED: the same image as without it\n";
+        ++failures;
+      }
+    }
+  }
+  std::cout << "worst PSNR " << worst << " dB (threshold " << kMinPSNR << ")\n";
+  SS_CHECK(failures == 0);
+  return EXIT_SUCCESS;
+}
