@@ -2,6 +2,7 @@
 #include "vtkSpaceSkipCompositor.h"
 
 #include "vtkActor2D.h"
+#include "vtkCommand.h"
 #include "vtkImageData.h"
 #include "vtkLogger.h"
 #include "vtkOpenGLFramebufferObject.h"
@@ -137,6 +138,60 @@ vtkSpaceSkipCompositor::~vtkSpaceSkipCompositor()
 {
   this->ReleaseTarget();
   this->ReleaseInterop();
+  this->TrackWindow(nullptr);
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipCompositor::TrackWindow(vtkOpenGLRenderWindow* renWin)
+{
+  vtkOpenGLRenderWindow* old = this->ResourceWindow;
+  if (old == renWin)
+  {
+    return;
+  }
+  if (old)
+  {
+    // Registrations of another window's context go with that context current.
+    this->ReleaseTarget();
+    this->ReleaseInterop();
+    if (this->WindowObserver)
+    {
+      old->RemoveObserver(this->WindowObserver);
+    }
+    if (renWin)
+    {
+      renWin->MakeCurrent();
+    }
+  }
+  this->WindowObserver = 0;
+  this->ResourceWindow = renWin;
+  if (renWin)
+  {
+    this->WindowObserver =
+      renWin->AddObserver(vtkCommand::DeleteEvent, this, &vtkSpaceSkipCompositor::OnWindowDeleted);
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipCompositor::MakeResourceContextCurrent()
+{
+  vtkOpenGLRenderWindow* w = this->ResourceWindow;
+  if (!w)
+  {
+    return false;
+  }
+  w->MakeCurrent(); // a no-op when it already is
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipCompositor::OnWindowDeleted()
+{
+  // Sent from the window's last UnRegister, before its destructor: its context still exists.
+  vtkOpenGLRenderWindow* w = this->ResourceWindow;
+  this->ReleaseGraphicsResources(w);
+  this->WindowObserver = 0; // the window drops its observers itself
+  this->ResourceWindow = nullptr;
 }
 
 //------------------------------------------------------------------------------
@@ -454,8 +509,13 @@ void vtkSpaceSkipCompositor::ReleaseInterop()
   {
     // A copy into the texture may still be queued on the engine's stream.
     cudaDeviceSynchronize();
-    cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->InteropResource));
-    cudaGetLastError(); // a failure here (context gone) must not reach the engine's checks
+    // Unregistered in its own context (TrackWindow); without a window the context is gone and
+    // the registration with it: unregistering would only fail.
+    if (this->MakeResourceContextCurrent())
+    {
+      cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->InteropResource));
+    }
+    cudaGetLastError(); // a failure here must not reach the engine's checks
   }
 #endif
   this->InteropResource = nullptr;
@@ -472,7 +532,10 @@ void vtkSpaceSkipCompositor::ReleaseTarget()
     {
       this->ImageCopy->releaseSurface(); // waits for the blends still queued
     }
-    cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->TargetResource));
+    if (this->MakeResourceContextCurrent()) // as in ReleaseInterop
+    {
+      cudaGraphicsUnregisterResource(static_cast<cudaGraphicsResource_t>(this->TargetResource));
+    }
     cudaGetLastError();
   }
 #endif
@@ -574,6 +637,7 @@ bool vtkSpaceSkipCompositor::BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin,
     {
       return false;
     }
+    this->TrackWindow(renWin);
     cudaGraphicsResource_t r = nullptr;
     const cudaError_t e = cudaGraphicsGLRegisterImage(
       &r, tex->GetHandle(), GL_TEXTURE_2D, cudaGraphicsRegisterFlagsSurfaceLoadStore);
@@ -631,6 +695,7 @@ bool vtkSpaceSkipCompositor::CopyToInteropTexture(vtkOpenGLRenderWindow* renWin,
       this->InteropProblem = "could not allocate the texture";
       return false;
     }
+    this->TrackWindow(renWin);
     cudaGraphicsResource_t r = nullptr;
     const cudaError_t e = cudaGraphicsGLRegisterImage(&r, this->InteropTexture->GetHandle(),
       GL_TEXTURE_2D, cudaGraphicsRegisterFlagsWriteDiscard);

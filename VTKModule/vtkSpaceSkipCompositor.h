@@ -5,6 +5,7 @@
 #define vtkSpaceSkipCompositor_h
 
 #include "vtkSmartPointer.h" // For the textures and the framebuffer
+#include "vtkWeakPointer.h"  // For the window the CUDA registrations belong to
 
 #include <functional> // For the flat image's getter
 #include <memory>     // For Quad
@@ -109,6 +110,16 @@ private:
   bool Blend(vtkOpenGLRenderWindow* renWin, vtkTextureObject* texture, const int rect[4]);
   void ReleaseInterop();
   void ReleaseTarget();
+  // CUDA unregisters a GL resource only while a context of its share group is current (else
+  // cudaErrorInvalidGraphicsContext). The window whose context registered InteropResource and
+  // TargetResource is kept (weakly), made current before they are released, and observed: its
+  // DeleteEvent (sent while its context still exists) releases them, whatever order the mapper
+  // and the window go in.
+  void TrackWindow(vtkOpenGLRenderWindow* renWin);
+  bool MakeResourceContextCurrent();
+  void OnWindowDeleted();
+  vtkWeakPointer<vtkOpenGLRenderWindow> ResourceWindow;
+  unsigned long WindowObserver = 0;
   // Defined with CUDA only.
   bool BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin, const spaceskip::DeviceImageView& image,
     void* stream, int w, int h, const int rect[4], bool eightBit);

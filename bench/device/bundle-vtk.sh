@@ -51,16 +51,17 @@ copy_libs() {  # DESTDIR FILE...
 # --- VTK part ---------------------------------------------------------------------------------
 v=$stage/vtk
 mkdir -p "$v/bin" "$v/lib"
-# BUNDLE_NO_CLI=1 leaves the CLI out (its CUDA kernels are ~5 MB of xz) when the bundle must shrink.
+# The CLI (its CUDA kernels are ~5 MB of xz) only with BUNDLE_NO_CLI=0: run-vtk.sh's phases that
+# time the CLI beside the window (bench-*, cli-ab) need it, the tests do not.
 exes="bin/vtkSpaceSkipCxxTests bin/spaceskip_window_bench"
-[ "${BUNDLE_NO_CLI:-0}" = 1 ] || exes="$exes Core/spaceskip"
+[ "${BUNDLE_NO_CLI:-1}" = 1 ] || exes="$exes Core/spaceskip"
 for exe in $exes; do
   [ -x "$build/$exe" ] || { echo "bundle-vtk: $build/$exe missing (build first)" >&2; exit 1; }
   cp "$build/$exe" "$v/bin/"
 done
 # Core's GoogleTest binary (CUDA tests included): run and sanitized on the device without a build.
-# BUNDLE_NO_CORE_TESTS=1 leaves it out (carry it separately, e.g. xz'd under build-bench/).
-[ "${BUNDLE_NO_CORE_TESTS:-0}" = 1 ] || { [ -x "$build/Testing/spaceskip_core_tests" ] && cp "$build/Testing/spaceskip_core_tests" "$v/bin/"; }
+# Only with BUNDLE_NO_CORE_TESTS=0 (else carry it separately, e.g. xz'd under build-bench/).
+[ "${BUNDLE_NO_CORE_TESTS:-1}" = 1 ] || { [ -x "$build/Testing/spaceskip_core_tests" ] && cp "$build/Testing/spaceskip_core_tests" "$v/bin/"; }
 cp -L "$build/lib/libvtkSpaceSkip.so" "$v/lib/"
 copy_libs "$v/lib" "$v/bin/"* "$build/lib/libvtkSpaceSkip.so"
 # glvnd's libEGL, dlopen()ed by the window benchmark's --egl mode (NVIDIA's headless EGL).

@@ -8,7 +8,9 @@
 # timings for the same cases. Writes everything into OUTDIR.
 #
 #   bench/device/run-vtk.sh OUTDIR [PHASE...]
-#   PHASE: tests memcheck bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
+#   PHASE: tests (every mapper test in the X window, NVIDIA's GLX) tests-egl (the same in an EGL
+#          pbuffer window: SPACESKIP_TEST_WINDOW=egl) memcheck (compute-sanitizer memcheck on every
+#          mapper test, or MEMCHECK_TESTS, in MEMCHECK_WINDOW: x or egl) bench-nbody1024 bench-menger1024 bench-nbody2048 bench-host bench-float
 #          bench-ert bench-hw (N-body 2048^3, the mapper's FilterMode Hardware (texture unit)
 #          against Exact: HW_ITEMS, default DistanceGrid,DistanceGrid:hw,Auto,Auto:hw)
 #          bench-frame (issue 13, the frame around the kernel: N-body 2048^3 Auto:hw with the
@@ -106,7 +108,9 @@ nvdir=${nvglx:+$(dirname "$nvglx")}
   echo "libGLX_nvidia: ${nvglx:-not found}"
   ls -la /usr/local/nvidia/lib64 2>/dev/null | grep -iE "GLX|EGL|libGL|nvidia-gl|glcore|tls" | head -12
 } >> "$work/env.txt"
-export LD_LIBRARY_PATH=$B/vtk/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
+# The bundle's X libraries after VTK's: without them NVIDIA's GLX client finds no config on
+# the bundled Xvfb ("no decent config") and the tests fell back to Mesa.
+export LD_LIBRARY_PATH=$B/vtk/lib:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
 export __GLX_VENDOR_LIBRARY_NAME=nvidia
 bench=$B/vtk/bin/spaceskip_window_bench
 tests=$B/vtk/bin/vtkSpaceSkipCxxTests
@@ -145,39 +149,55 @@ fi
 # --- the VTK mapper tests, CUDA forced --------------------------------------------------------
 cxx=$src/VTKModule/Testing/Cxx/CMakeLists.txt
 testnames=$(sed -n '/vtk_add_test_cxx/,/)/p' "$cxx" | grep -oE 'Test[A-Za-z0-9]+\.cxx(,NO_VALID)?')
-run_tests() {  # BACKEND LOGNAME (BACKEND "asis": no override, each test's own Backend setting)
-  local be=$1 name=$2 pass=0 fail=0 skip=0 t exe valid rc env=()
-  mkdir -p "$work/tmp-$be" "$work/data"
+run_tests() {  # BACKEND LOGNAME [WINDOW] (BACKEND "asis": each test's own Backend setting;
+  # WINDOW "egl": the tests draw into a vtkGenericOpenGLRenderWindow on an EGL pbuffer)
+  local be=$1 name=$2 win=${3:-x} pass=0 fail=0 skip=0 ongpu=0 t exe valid rc env=()
+  mkdir -p "$work/tmp-$be-$win" "$work/data"
   for t in $testnames; do
     exe=${t%%.cxx*}
     valid=()
     case $t in *NO_VALID) ;; *) valid=(-V "$src/VTKModule/Testing/Data/Baseline/$exe.png") ;; esac
-    echo "==== $exe (SPACESKIP_BACKEND=$be)" >> "$work/$name"
+    echo "==== $exe (SPACESKIP_BACKEND=$be, window $win)" >> "$work/$name"
     [ "$be" = asis ] && env=(-u SPACESKIP_BACKEND) || env=(SPACESKIP_BACKEND=$be)
-    env "${env[@]}" SPACESKIP_REPORT=1 timeout 300 "$tests" "$exe" -D "$work/data" \
-      -T "$work/tmp-$be" "${valid[@]}" >> "$work/$name" 2>&1
+    env "${env[@]}" SPACESKIP_REPORT=1 SPACESKIP_TEST_WINDOW=$win timeout 300 "$tests" "$exe" -D "$work/data" \
+      -T "$work/tmp-$be-$win" "${valid[@]}" > "$work/one.log" 2>&1
     rc=$?
+    cat "$work/one.log" >> "$work/$name"
+    grep -q "image on the GPU" "$work/one.log" && ongpu=$((ongpu + 1))
     case $rc in 0) pass=$((pass + 1)) ;; 125) skip=$((skip + 1)) ;; *) fail=$((fail + 1)) ;; esac
-    echo "==== $exe rc=$rc" >> "$work/$name"
-    log "  $be $exe rc=$rc"
+    echo "==== $exe rc=$rc renderer: $(grep -om1 'GL_RENDERER [^,]*' "$work/one.log")" >> "$work/$name"
+    log "  $be $win $exe rc=$rc"
   done
-  log "tests $be: $pass passed, $fail failed, $skip skipped"
-  echo "SUMMARY $be: $pass passed, $fail failed, $skip skipped of $((pass + fail + skip))" >> "$work/$name"
+  log "tests $be $win: $pass passed, $fail failed, $skip skipped; $ongpu kept an image on the GPU"
+  echo "SUMMARY $be window $win: $pass passed, $fail failed, $skip skipped of $((pass + fail + skip));" \
+    "$ongpu tests kept an image on the GPU (interop); renderers: $(grep -o 'GL_RENDERER [^,]*' "$work/$name" | sort | uniq -c | tr '\n' ';')" >> "$work/$name"
   [ $fail -eq 0 ] || status=1
 }
+summarize_tests() {  # LOGNAME
+  grep -E "^SUMMARY|rc=|SpaceSkip: backend|Backend|PSNR|max diff|check failed|ERROR|Warning|error|RSS|device bytes" \
+    "$work/$1" | head -400
+}
 if has tests && ! late; then
-  log "VTK mapper tests, CUDA forced"
+  log "VTK mapper tests, CUDA forced, X window ($gl)"
   run_tests cuda tests-cuda.log
   [ "${TESTS_ASIS:-1}" = 1 ] && run_tests asis tests-asis.log
-  { grep -E "^SUMMARY|rc=|SpaceSkip: backend|Backend|PSNR|max diff|check failed|ERROR|Warning|error|RSS|device bytes" \
-      "$work/tests-cuda.log" | head -400; grep -hE "^SUMMARY" "$work"/tests-asis.log 2>/dev/null; } > "$out/tests.log"
+  { summarize_tests tests-cuda.log; grep -hE "^SUMMARY" "$work"/tests-asis.log 2>/dev/null; } > "$out/tests.log"
+fi
+# The same tests in NVIDIA's EGL (a pbuffer; no X window): the GL of headless servers.
+if has tests-egl && ! late; then
+  egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
+  log "VTK mapper tests, CUDA forced, EGL window (${egl_json:-no NVIDIA EGL vendor file})"
+  __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json run_tests cuda tests-egl.log egl
+  summarize_tests tests-egl.log > "$out/tests-egl.log"
 fi
 
 # --- compute-sanitizer memcheck on mapper tests (CUDA) ----------------------------------------
 if has memcheck && ! late; then
-  for exe in ${MEMCHECK_TESTS:-TestSpaceSkippingVolumeBackends TestSpaceSkippingVolumeTFEdit}; do
+  all_tests=$(for t in $testnames; do echo "${t%%.cxx*}"; done)
+  for exe in ${MEMCHECK_TESTS:-$all_tests}; do
+    late && { log "memcheck $exe skipped (deadline)"; echo "==== $exe skipped (deadline)" >> "$out/memcheck.log"; continue; }
     log "memcheck $exe"
-    SPACESKIP_BACKEND=cuda SPACESKIP_REPORT=1 timeout 240 compute-sanitizer --tool memcheck \
+    SPACESKIP_BACKEND=cuda SPACESKIP_REPORT=1 SPACESKIP_TEST_WINDOW=${MEMCHECK_WINDOW:-x} timeout 240 compute-sanitizer --tool memcheck \
       --error-exitcode 99 "$tests" "$exe" -D "$work/data" -T "$work/tmp-cuda" \
       > "$work/memcheck-$exe.log" 2>&1
     rc=$?

@@ -4,6 +4,7 @@
 #ifndef SpaceSkipTestHelpers_h
 #define SpaceSkipTestHelpers_h
 
+#include "SpaceSkipEglWindow.h"
 #include "vtkActor.h"
 #include "vtkCamera.h"
 #include "vtkColorTransferFunction.h"
@@ -461,7 +462,7 @@ public:
   vtkNew<vtkVolumeProperty> Property;
   vtkNew<vtkVolume> Volume;
   vtkNew<vtkRenderer> Renderer;
-  vtkNew<vtkRenderWindow> Window;
+  vtkSmartPointer<vtkRenderWindow> Window = NewTestWindow(); // SpaceSkipEglWindow.h
   vtkSmartPointer<vtkRenderWindowInteractor> Interactor;
 };
 

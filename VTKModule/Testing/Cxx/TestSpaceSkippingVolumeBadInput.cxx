@@ -48,7 +48,7 @@ int TestSpaceSkippingVolumeBadInput(int, char*[])
 
   vtkNew<vtkRenderer> ren;
   ren->AddVolume(goodVolume);
-  vtkNew<vtkRenderWindow> win;
+  vtkSmartPointer<vtkRenderWindow> win = sstest::NewTestWindow();
   win->SetMultiSamples(0);
   win->SetSize(160, 120);
   win->AddRenderer(ren);

@@ -22,7 +22,7 @@ int TestSpaceSkippingVolumeCameras(int argc, char* argv[])
   vtkNew<vtkPolyDataMapper> barMapper;
   barMapper->SetInputConnection(bar->GetOutputPort());
 
-  vtkNew<vtkRenderWindow> win;
+  vtkSmartPointer<vtkRenderWindow> win = sstest::NewTestWindow();
   win->SetMultiSamples(0);
   win->SetSize(400, 220);
   vtkNew<vtkVolume> volumes[2];

@@ -76,7 +76,7 @@ int TestSpaceSkippingVolumeTransforms(int, char*[])
   vb->SetUserMatrix(user);
 
   vtkNew<vtkRenderer> ren;
-  vtkNew<vtkRenderWindow> win;
+  vtkSmartPointer<vtkRenderWindow> win = sstest::NewTestWindow();
   win->SetMultiSamples(0);
   win->SetSize(220, 220);
   win->AddRenderer(ren);

@@ -42,7 +42,7 @@ int TestSpaceSkippingVolumeVisibleRect(int, char*[])
   vtkNew<vtkRenderer> ren;
   ren->SetBackground(0.3, 0.2, 0.1);
   ren->AddVolume(volume);
-  vtkNew<vtkRenderWindow> win;
+  vtkSmartPointer<vtkRenderWindow> win = sstest::NewTestWindow();
   win->SetMultiSamples(0);
   win->SetSize(160, 120);
   win->AddRenderer(ren);
