@@ -150,11 +150,18 @@ struct RenderParams {
 constexpr int kMaxClipPlanes = 6;
 
 /// Bounds on the work per ray (so a typo in Sample Distance cannot freeze ParaView's GUI).
-/// The step is at least the smallest voxel spacing / kMinStepsPerVoxel, and a ray through the
-/// whole volume box takes at most kMaxSamplesPerRay samples (which also keeps every sample
-/// index exact in float).
+/// The step is at least the smallest voxel spacing / kMinStepsPerVoxel; a ray through the whole
+/// volume box takes at most kMaxSamplesPerCell samples per cell it can cross (cells along x + y
+/// + z: a tiny spacing on one axis cannot make every ray long in samples) and never more than
+/// kMaxSamplesPerRay (which also keeps every sample index exact in float); and the step is at
+/// most half the box's diagonal (larger ones would step over the volume).
 constexpr double kMinStepsPerVoxel = 16;
+constexpr double kMaxSamplesPerCell = 64;
 constexpr double kMaxSamplesPerRay = double(1 << 20);
+/// The march frame (Engine::render) keeps each axis at least 2^-kMaxAxisRatioLog2 of the box's
+/// longest extent: a thinner axis (spacing 1e-40 next to 1) is drawn that thin, so the float
+/// world-to-index matrix stays finite (float cannot tell the two apart at the box's scale).
+constexpr int kMaxAxisRatioLog2 = 40;
 
 /// Sub-brick masks (Classification.h, subBrickMask): parts per brick edge, and the bricks that
 /// have them (4 parts of >= 2 cells a side).

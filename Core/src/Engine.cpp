@@ -38,24 +38,40 @@ double effectiveSampleDistance(const Volume& v, double requested, std::string* n
   const bool automatic = !(requested > 0) || !std::isfinite(requested);
   double dt = automatic ? 0.5 * voxel : requested;
   const vec3i cd = v.cellDims();
-  const double ex = cd.x * v.spacing[0], ey = cd.y * v.spacing[1], ez = cd.z * v.spacing[2];
-  const double diagonal = std::sqrt(ex * ex + ey * ey + ez * ez);
-  const double floorDt = voxel / kMinStepsPerVoxel, capDt = diagonal / kMaxSamplesPerRay;
+  // hypot: no overflow for spacings near double's end (1e300 * cells).
+  const double diagonal = std::hypot(cd.x * v.spacing[0], cd.y * v.spacing[1], cd.z * v.spacing[2]);
+  // A ray crosses at most cd.x + cd.y + cd.z cells (+1) whatever the spacings.
+  const double cellsCrossed = double(cd.x) + double(cd.y) + double(cd.z);
+  const double maxSamples = std::min(kMaxSamplesPerRay, kMaxSamplesPerCell * cellsCrossed);
+  const double floorDt = voxel / kMinStepsPerVoxel, capDt = diagonal / maxSamples, maxDt = 0.5 * diagonal;
   std::string why;
+  char buf[512];
+  if (dt > maxDt && maxDt > 0) {
+    dt = maxDt;
+    std::snprintf(buf, sizeof buf, "larger than half the volume's diagonal (%g world units)", diagonal);
+    why = buf;
+  }
   if (dt < floorDt) {
     dt = floorDt;
     why = "below the floor of 1/" + std::to_string(int(kMinStepsPerVoxel)) + " of the smallest voxel spacing";
   }
   if (dt < capDt) {
     dt = capDt;
-    why = "more than " + std::to_string(int64_t(kMaxSamplesPerRay)) + " samples along the volume's diagonal";
+    std::snprintf(buf, sizeof buf,
+                  "more than %.0f samples a ray through the volume: at most %g per cell a ray can cross "
+                  "(%.0f cells along x + y + z) and at most %.0f",
+                  maxSamples, kMaxSamplesPerCell, cellsCrossed, kMaxSamplesPerRay);
+    why = buf;
   }
   if (note) {
     note->clear();
     if (!why.empty()) {
-      char buf[256];
-      std::snprintf(buf, sizeof buf, "sample distance %g %s: using %g world units (%s)", requested,
-                    "clamped", dt, why.c_str());
+      if (automatic)
+        std::snprintf(buf, sizeof buf, "the automatic sample distance (half the smallest spacing, %g) clamped: using %g world units (%s)",
+                      0.5 * voxel, dt, why.c_str());
+      else
+        std::snprintf(buf, sizeof buf, "sample distance %g clamped: using %g world units (%s)", requested, dt,
+                      why.c_str());
       *note = buf;
     }
   }
@@ -318,7 +334,12 @@ struct Engine::Impl {
     if (!note.empty()) warn(note);
     float lo, scale;
     tableMapping(scaledTF(), static_cast<int>(tf.table.size()), lo, scale);
-    std::vector<vec4f> table = tableForBlend(tf, float(step), blendMode());
+    // The opacity correction needs dt / unitDistance only: formed in double, so a step of
+    // 1e-40 or 1e21 world units keeps its ratio to a unit distance of the same scale.
+    TransferFunction unit = tf;
+    unit.unitDistance = 1;
+    const double ratio = tf.unitDistance > 0 && std::isfinite(tf.unitDistance) ? step / tf.unitDistance : step;
+    std::vector<vec4f> table = tableForBlend(unit, float(ratio), blendMode());
     appendGradientTables(tf, table, gradOffset2D, gradOffsetGO);  // after the 1-D entries
     backend->setTransferTable(table, lo, scale);
     tableDirty = colorDirty = false;
@@ -506,9 +527,67 @@ void Engine::update() {
 }
 
 namespace {
-/// The light list (RenderParams::lights) into the frame, in its origin-relative world space.
+/// The frame the kernels march in (float): world coordinates relative to `origin`, times
+/// 2^-exponent, so the volume's box is O(1) whatever its spacing (1e-30 and 1e21 alike) and
+/// origin (1e15). Every matrix, point and distance the kernels get is composed here in double and
+/// rounded to float once; a power of two keeps the scaling exact, so spacing 1 draws the same bits
+/// as in world units, and directions, shading and dt/unitDistance are unchanged by it.
+struct MarchFrame {
+  double origin[3];
+  int exponent = 0;
+  /// The volume as the march sees it: origin 0, spacing in frame units, axes thinner than
+  /// 2^-kMaxAxisRatioLog2 of the longest extent widened to that (`flattened` says which).
+  Volume shape;
+  std::string flattened;
+
+  double length(double world) const { return std::ldexp(world, -exponent); }
+  vec3f point(const double* world) const {
+    return vec3f{float(length(world[0] - origin[0])), float(length(world[1] - origin[1])),
+                 float(length(world[2] - origin[2]))};
+  }
+};
+
+/// The march frame of volume `v` (the whole volume's dims for a piece) anchored at `origin`.
+MarchFrame marchFrame(const Volume& v, const double* origin) {
+  MarchFrame m;
+  for (int i = 0; i < 3; ++i) m.origin[i] = origin[i];
+  m.shape = v;
+  const vec3i cd = v.cellDims();
+  const int cells[3] = {cd.x, cd.y, cd.z};
+  double axis[3];  // world length of one index step along each axis
+  for (int c = 0; c < 3; ++c)
+    axis[c] = std::hypot(v.direction[c], v.direction[3 + c], v.direction[6 + c]) * v.spacing[c];
+  const double longestStep = std::max({axis[0], axis[1], axis[2]});
+  if (!(longestStep > 0) || !std::isfinite(longestStep)) {  // setVolume refuses these; no scaling
+    for (int i = 0; i < 3; ++i) m.shape.origin[i] = 0;
+    return m;
+  }
+  const int e0 = std::ilogb(longestStep);
+  double extent[3];  // per axis, times 2^-e0 (finite for any finite spacing)
+  for (int c = 0; c < 3; ++c) extent[c] = std::ldexp(axis[c], -e0) * cells[c];
+  const double longest = std::max({extent[0], extent[1], extent[2]});
+  m.exponent = e0 + std::ilogb(longest) + 1;  // the longest extent in [0.5, 1) frame units
+  const double thinnest = std::ldexp(longest, -kMaxAxisRatioLog2);
+  static const char* names = "xyz";
+  for (int c = 0; c < 3; ++c) {
+    double s = std::ldexp(v.spacing[c], -m.exponent);
+    if (extent[c] < thinnest) {
+      s *= thinnest / extent[c];
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "%sspacing %g along %c is below 2^-%d of the volume's extent: drawn that thin",
+                    m.flattened.empty() ? "" : "; ", v.spacing[c], names[c], kMaxAxisRatioLog2);
+      m.flattened += buf;
+    }
+    m.shape.spacing[c] = s;
+    m.shape.origin[c] = 0;
+  }
+  if (!m.flattened.empty()) m.flattened += " (float cannot resolve a thinner axis next to the others)";
+  return m;
+}
+
+/// The light list (RenderParams::lights) into the frame, in the march frame (MarchFrame).
 template <class Impl>
-void fillLights(Impl& d, FrameView& f) {
+void fillLights(Impl& d, FrameView& f, const MarchFrame& frame) {
   const RenderParams& r = d.render;
   f.useLights = r.useLights ? 1 : 0;
   f.twoSided = r.twoSidedLighting ? 1 : 0;
@@ -532,11 +611,12 @@ void fillLights(Impl& d, FrameView& f) {
     }
     LightView& v = f.lights[f.numLights++];
     v.dir = vec3f{float(dir[0] / len), float(dir[1] / len), float(dir[2] / len)};
-    v.pos = vec3f{float(l.position[0] - d.volume.origin[0]), float(l.position[1] - d.volume.origin[1]),
-                  float(l.position[2] - d.volume.origin[2])};
+    v.pos = frame.point(l.position);
     v.diffuse = vec3f{float(l.diffuse[0]), float(l.diffuse[1]), float(l.diffuse[2])};
     v.specular = vec3f{float(l.specular[0]), float(l.specular[1]), float(l.specular[2])};
-    v.atten = vec3f{float(l.attenuation[0]), float(l.attenuation[1]), float(l.attenuation[2])};
+    // 1 / (c + l d + q d^2) of the world distance d = 2^exponent times the frame's.
+    v.atten = vec3f{float(l.attenuation[0]), float(std::ldexp(l.attenuation[1], frame.exponent)),
+                    float(std::ldexp(l.attenuation[2], 2 * frame.exponent))};
     v.positional = l.positional ? 1 : 0;
     v.cosCone = l.coneAngle <= 90.0 ? float(std::cos(l.coneAngle * 3.14159265358979323846 / 180.0)) : -2.f;
     v.exponent = float(l.exponent);
@@ -573,7 +653,7 @@ void fillSlice(Impl& d, FrameView& f) {
 
 /// The blend-mode and shading part of the frame from the render parameters.
 template <class Impl>
-void fillBlend(Impl& d, FrameView& f) {
+void fillBlend(Impl& d, FrameView& f, const MarchFrame& frame) {
   const RenderParams& r = d.render;
   f.blend = d.blendMode();
   // Scalar values in the frame are in the sampled units: times 2^valueExponent (setVolume).
@@ -605,7 +685,7 @@ void fillBlend(Impl& d, FrameView& f) {
   f.specular = float(r.specular);
   f.specularPower = float(r.specularPower);
   f.lightDir = vec3f{float(r.lightDirection[0]), float(r.lightDirection[1]), float(r.lightDirection[2])};
-  fillLights(d, f);
+  fillLights(d, f, frame);
   fillSlice(d, f);
 }
 
@@ -686,26 +766,46 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   update();
   Impl& d = *impl_;
   FrameView f{};
-  // The kernels march in float in a frame relative to the volume's origin: both matrices are
-  // composed with the origin shift here in double, so georeferenced data (origin 1e6..1e7,
-  // where a float ulp is ~1 world unit) renders exactly like the same volume at the origin.
-  mat4 vp = multiply(cam.proj, cam.view), ivp;
-  if (!invert(vp, ivp)) throw std::invalid_argument("camera matrix is singular");
+  // The kernels march in float in the MarchFrame: relative to the volume's origin and scaled so
+  // its box is O(1). The camera is moved into that frame before anything is inverted: the view
+  // times the frame's inverse (origin shift in long double, then an exact power-of-two scale),
+  // inverted as view^-1 * proj^-1 (inverting proj*view with a 1e15 translation in it lost up to
+  // 229/255 of a pixel's value at origin 1e15).
   // A piece of a larger volume (MPI): rays, box and planes are the whole volume's, relative to
   // its voxel 0, the same bits on every rank; the lattice part of the frame says what it draws.
   const VolumePiece* piece = d.fittingPiece();
   const double* origin = piece ? piece->wholeOrigin : d.volume.origin;
-  mat4 toOrigin = identity4();
-  Volume atOrigin = d.volume;
-  for (int i = 0; i < 3; ++i) {
-    toOrigin.m[12 + i] = -origin[i];
-    atOrigin.origin[i] = 0;
+  const MarchFrame frame = marchFrame(d.latticeShape(), origin);
+  if (!frame.flattened.empty()) d.warn(frame.flattened);
+  mat4 viewRel = cam.view;  // frame (unscaled, origin-relative) -> eye
+  for (int r = 0; r < 4; ++r) {
+    long double t = cam.view.m[12 + r];
+    for (int c = 0; c < 3; ++c) t += (long double)cam.view.m[c * 4 + r] * (long double)origin[c];
+    viewRel.m[12 + r] = double(t);
   }
-  const mat4 ivpRel = multiply(toOrigin, ivp);
-  for (int i = 0; i < 16; ++i) f.invViewProj[i] = float(ivpRel.m[i]);
-  const mat4 indexToWorldRel = atOrigin.indexToWorld();
+  mat4 invView, invProj;
+  if (!invert(viewRel, invView)) throw std::invalid_argument("camera view matrix is singular");
+  if (!invert(cam.proj, invProj)) throw std::invalid_argument("camera matrix is singular");
+  for (int c = 0; c < 4; ++c)  // rows 0..2 (positions) into frame units
+    for (int r = 0; r < 3; ++r) invView.m[c * 4 + r] = frame.length(invView.m[c * 4 + r]);
+  mat4 ivp = multiply(invView, invProj);  // NDC -> frame (homogeneous)
+  // A perspective projection of near distance n has a w row of ~1/n world units (1e100 for a
+  // volume of spacing 1e-100): the whole matrix times a power of two brings its largest entry
+  // to O(1) without changing a ray (x/w is unchanged, exactly).
+  double largest = 0;
+  for (double v : ivp.m) largest = std::max(largest, std::fabs(v));
+  if (largest > 0 && std::isfinite(largest)) {
+    const int shift = -std::ilogb(largest);
+    for (double& v : ivp.m) v = std::ldexp(v, shift);
+  }
+  bool finite = true;
+  for (int i = 0; i < 16; ++i) {
+    f.invViewProj[i] = float(ivp.m[i]);
+    finite = finite && std::isfinite(f.invViewProj[i]);
+  }
+  if (!finite) d.warn("the camera is not finite in float in the volume's frame: its rays draw nothing");
   mat4 w2i;
-  if (!invert(indexToWorldRel, w2i)) throw std::invalid_argument("volume direction/spacing is singular");
+  if (!invert(frame.shape.indexToWorld(), w2i)) throw std::invalid_argument("volume direction/spacing is singular");
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) f.worldToIndex[r * 4 + c] = float(w2i.m[c * 4 + r]);
   f.width = width;
@@ -722,17 +822,15 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
     }
     f.lattice.followBias = piece->followBias;
   }
-  f.dt = float(d.dt());
+  f.dt = float(frame.length(d.dt()));
   f.ertThreshold = d.render.ertThreshold > 1.0 ? 2.f : float(d.render.ertThreshold);
   f.cut = piece ? d.cropClipFor(origin) : d.cropClip;  // the planes classification used (shifted)
   f.jitter = d.render.jitter ? 1 : 0;
   f.jitterSeed = d.render.jitterSeed;
   f.firstSample = float(std::max(0.0, d.render.firstSampleOffset));
-  mat4 iv;
-  if (!invert(cam.view, iv)) throw std::invalid_argument("camera view matrix is singular");
-  // The eye in the same origin-relative frame as the rays (subtracted in double).
-  f.eyeW = vec3f{float(iv.m[12] - origin[0]), float(iv.m[13] - origin[1]), float(iv.m[14] - origin[2])};
-  fillBlend(d, f);
+  // The eye in the same frame as the rays (invView's translation: already relative and scaled).
+  f.eyeW = vec3f{float(invView.m[12]), float(invView.m[13]), float(invView.m[14])};
+  fillBlend(d, f, frame);
   fillComponents(d, f);
   fillGradientTF(d, f);
   std::vector<unsigned> counts;

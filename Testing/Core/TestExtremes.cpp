@@ -209,6 +209,148 @@ TEST(Extremes, SamplesPerRayAreCappedOnVeryLongAxes) {
   EXPECT_TRUE(note.empty()) << note;
 }
 
+// --- Spacing, origin and sample distance outside float's comfortable range (issue 41).
+
+namespace {
+struct Drawn {
+  Image img;
+  int64_t samples = 0;
+  double dt = 0;
+  std::vector<std::string> log;
+};
+Drawn drawCounted(const Volume& v, const TransferFunction& tf, BuilderKind k, const Camera& cam, int size,
+                  double sampleDistance = 0) {
+  Drawn d;
+  Engine e(BackendKind::CPU, [&](const std::string& m) { d.log.push_back(m); });
+  e.setVolume(v);
+  e.setTransferFunction(tf);
+  e.setBuildParams(test::builder(k));
+  RenderParams rp;
+  rp.countSamples = true;
+  rp.sampleDistance = sampleDistance;
+  e.setRenderParams(rp);
+  e.render(cam, size, size, d.img);
+  d.samples = e.frameStats().samples;
+  d.dt = e.sampleDistance();
+  return d;
+}
+bool logHas(const std::vector<std::string>& log, const std::string& what) {
+  for (const std::string& m : log)
+    if (m.find(what) != std::string::npos) return true;
+  return false;
+}
+}  // namespace
+
+TEST(Extremes, SpacingBelowFloatOnOneAxisDrawsBoundedWithAWarning) {
+  // Spacing 1e-40 on x overflowed the float world-to-index matrix (1e40): NaN rays crashed in
+  // ArraySampler::sample; 1e-39 on y clamped dt to diagonal / 2^20, ~2^20 samples a ray (a 64^2
+  // CLI image > 30 s). Now: the thin axis is drawn 2^-40 of the extent thin, with a warning, and
+  // a ray takes at most kMaxSamplesPerCell samples per cell it can cross.
+  const Volume v = generateVolume("shell", vec3l{16, 16, 16});
+  const auto tf = TransferFunction::preset("ramp", 0, 255);
+  const double cellsCrossed = 15 * 3;
+  for (int axis = 0; axis < 3; ++axis)
+    for (double tiny : {1e-40, 1e-39, 1e-300}) {
+      Volume w = v;
+      w.spacing[axis] = tiny;
+      for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::KdTreeCPU, BuilderKind::Auto})
+        for (auto view : {std::pair{30.0, 20.0}, {0.0, 0.0}, {90.0, 0.0}, {0.0, 90.0}}) {
+          SCOPED_TRACE(::testing::Message() << "axis " << axis << " spacing " << tiny << " builder " << int(k)
+                                          << " view " << view.first << "," << view.second);
+          const Drawn d = drawCounted(w, tf, k, test::orbit(w, view.first, view.second), 32);
+          EXPECT_FALSE(hasNonFinite(d.img));
+          EXPECT_GE(d.samples, 0);
+          EXPECT_LE(d.samples, int64_t(32 * 32 * (kMaxSamplesPerCell * cellsCrossed + 2)));
+          EXPECT_TRUE(logHas(d.log, "drawn that thin")) << (d.log.empty() ? "" : d.log[0]);
+          EXPECT_TRUE(logHas(d.log, "clamped")) << "the automatic sample distance is bounded, and says so";
+        }
+    }
+}
+
+TEST(Extremes, UniformSpacingsFarFromOneDrawLikeSpacingOne) {
+  // Spacing <= 1e-30 or >= 1e20 (astrophysics in cgs units) drew blank; with the camera and the
+  // opacity unit distance scaled alike the image is spacing 1's.
+  const Volume v = generateVolume("shell", vec3l{24, 24, 24});
+  const auto tf = TransferFunction::preset("ramp", 0, 255);
+  for (bool persp : {false, true}) {
+    const Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Naive), 30, 25, persp, 48);
+    ASSERT_GT(test::coverage(ref), 0.05);
+    for (double s : {1e-30, 1e-38, 1e-100, 1e20, 1e21, 1e22, 1e100}) {  // (1e300: the orbit camera overflows)
+      Volume w = v;
+      for (int i = 0; i < 3; ++i) {
+        w.spacing[i] = s;
+        w.origin[i] = -5 * s;
+      }
+      auto tfs = tf;
+      tfs.unitDistance = s;  // the same optical depth per voxel
+      for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::KdTreeCPU}) {
+        const Image img = test::renderWith(w, tfs, test::builder(k), 30, 25, persp, 48);
+        EXPECT_FALSE(hasNonFinite(img));
+        EXPECT_LE(compareImages(ref, img).maxAbs, 1.f / 255.f)
+            << "spacing " << s << " persp " << persp << " builder " << int(k);
+      }
+    }
+  }
+}
+
+TEST(Extremes, OriginFarBeyondFloatDrawsLikeTheOrigin) {
+  // Origin 1e15, spacing 1 (a double ulp is 0.125 there): 229/255 off in the CLI when the camera
+  // was inverted with its 1e15 translation and shifted afterwards. Cameras whose matrices are
+  // exact at 1e15 (axis-aligned orbits, integer eyes) must draw the origin-0 image.
+  const Volume v = generateVolume("nbody", vec3l{40, 40, 40});
+  const auto tf = TransferFunction::preset("ramp", 0, 255);
+  for (bool persp : {false, true})
+    for (auto view : {std::pair{0.0, 0.0}, {90.0, 0.0}, {180.0, 0.0}, {0.0, 90.0}}) {
+      const Image ref = test::renderWith(v, tf, test::builder(BuilderKind::Grid), view.first, view.second, persp, 64);
+      ASSERT_GT(test::coverage(ref), 0.01);
+      for (double o : {1e15, -1e15, 3e15}) {
+        Volume w = v;
+        for (int i = 0; i < 3; ++i) w.origin[i] = o;
+        for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::KdTreeCPU}) {
+          const Image img = test::renderWith(w, tf, test::builder(k), view.first, view.second, persp, 64);
+          EXPECT_LE(compareImages(ref, img).maxAbs, 1.f / 255.f)
+              << "origin " << o << " persp " << persp << " view " << view.first << "," << view.second;
+        }
+      }
+    }
+}
+
+TEST(Extremes, SampleDistanceLargerThanTheVolumeIsClampedWithAWarning) {
+  // 1e6 and 1e300 drew blank without a word; they are clamped to half the diagonal, as tiny
+  // ones are clamped to the floor, and the image shows the volume.
+  const Volume v = generateVolume("shell", vec3l{16, 16, 16});
+  const auto tf = TransferFunction::preset("opaque", 0, 255);
+  const double diagonal = std::sqrt(3.0) * 15;
+  const Camera cam = test::orbit(v, 20, 30);
+  for (double dt : {1e6, 1e300, 100.0}) {
+    const Drawn d = drawCounted(v, tf, BuilderKind::Naive, cam, 32, dt);
+    EXPECT_DOUBLE_EQ(d.dt, 0.5 * diagonal) << dt;
+    EXPECT_TRUE(logHas(d.log, "clamped")) << dt;
+    EXPECT_TRUE(logHas(d.log, "half the volume's diagonal")) << (d.log.empty() ? "" : d.log[0]);
+    EXPECT_GT(test::coverage(d.img), 0.05) << dt;
+  }
+  // Up to half the diagonal it is taken as asked, silently.
+  const Drawn ok = drawCounted(v, tf, BuilderKind::Naive, cam, 32, 10.0);
+  EXPECT_DOUBLE_EQ(ok.dt, 10.0);
+  EXPECT_TRUE(ok.log.empty()) << ok.log[0];
+}
+
+TEST(Extremes, SamplesPerRayFollowTheCellsCrossed) {
+  // The bound is per cell a ray can cross: the automatic step of a 1e-39-thin axis gives at most
+  // kMaxSamplesPerCell * (cells along x + y + z) samples; usual anisotropy (1:10) stays unclamped.
+  Volume thin = filled(vec3l{16, 16, 16}, VoxelType::UInt8, 0);
+  thin.spacing[1] = 1e-39;
+  std::string note;
+  const double dt = effectiveSampleDistance(thin, 0, &note);
+  const double diagonal = std::hypot(15.0, 15.0 * 1e-39, 15.0);
+  EXPECT_NEAR(diagonal / dt, kMaxSamplesPerCell * 45, 1e-6);
+  EXPECT_NE(note.find("per cell"), std::string::npos) << note;
+  Volume ct = filled(vec3l{64, 64, 64}, VoxelType::UInt8, 0);
+  ct.spacing[2] = 10;
+  EXPECT_EQ(effectiveSampleDistance(ct, 0, &note), 0.5);
+  EXPECT_TRUE(note.empty()) << note;
+}
+
 TEST(Extremes, FarFromTheOriginEqualsAtTheOrigin) {
   // Georeferenced data: origins of 1e6..1e7 (a float ulp is 0.06..1 world unit there).
   Volume v = generateVolume("nbody", vec3l{40, 40, 40});

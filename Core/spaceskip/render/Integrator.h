@@ -41,7 +41,8 @@ struct ArraySampler {
     return voxelValue(data[i + nx * (j + ny * k)]);
   }
   SS_FUNC static void axis(float p, int64_t n, int64_t& i0, int64_t& i1, float& f) {
-    float x = ss_clamp(p, 0.f, float(n - 1));
+    // Clamped so that NaN lands on 0 (ss_clamp would pass it through to the int conversion).
+    const float x = p > 0.f ? ss_min(p, float(n - 1)) : 0.f;
     i0 = int64_t(x);
     if (i0 > n - 2) i0 = n > 1 ? n - 2 : 0;
     f = x - float(i0);

@@ -61,6 +61,11 @@ SS_FUNC PrimaryRay primaryRay(const FrameView& f, int px, int py) {
   intersectBox(p.r, p.inv, vec3f{0, 0, 0}, f.boxHi, p.tEnter, p.tExit);
   p.tEnter = ss_max(p.tEnter, 0.f);
   p.tExit = ss_min(p.tExit, tLimit);
+  // A ray that is not finite (a camera or volume matrix out of float's range) draws nothing:
+  // intersectBox's fminf/fmaxf drop a NaN axis, which would leave a long interval whose sample
+  // positions are NaN. x - x is 0 for finite x only.
+  const float all = p.r.org.x + p.r.org.y + p.r.org.z + p.r.dir.x + p.r.dir.y + p.r.dir.z + p.tExit;
+  if (!(all - all == 0.f)) p.tEnter = p.tExit = 0.f;
   return p;
 }
 
