@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <functional>
 #include <set>
@@ -557,10 +558,83 @@ vtkDataSet* vtkSpaceSkippingVolumeMapper::GetInput()
 }
 
 //------------------------------------------------------------------------------
+// Setters of bounded properties: a value outside [lo, hi] becomes the nearest bound, with one
+// warning naming the property, the value and what was used.
+namespace
+{
+template <class T>
+T ClampSaid(vtkObject* self, const char* name, T v, T lo, T hi, const char* (*label)(T) = nullptr)
+{
+  const T used = v < lo ? lo : (v > hi ? hi : v);
+  if (used != v)
+  {
+    vtkWarningWithObjectMacro(self, << name << " " << v << " is outside its domain [" << lo << ", " << hi
+                                    << "]: using " << used << (label ? " (" : "") << (label ? label(used) : "")
+                                    << (label ? ")" : ""));
+  }
+  return used;
+}
+const char* BuilderLabel(int b)
+{
+  static const char* names[] = { "Naive", "Grid", "LBVH", "LBVHCPU", "KdTreeCPU", "KdTreeGPU", "KdTreeGPUFast",
+    "Hybrid", "DistanceGrid", "Auto" };
+  return b >= 0 && b < int(sizeof(names) / sizeof(names[0])) ? names[b] : "";
+}
+const char* BlendOverrideLabel(int m)
+{
+  static const char* names[] = { "composite", "maximum intensity", "minimum intensity", "average intensity",
+    "additive", "isosurface" };
+  return m < 0 ? "the volume mapper's BlendMode" : (m < 6 ? names[m] : "");
+}
+} // namespace
+
+#define vtkSpaceSkipSetClampedMacro(name, type, lo, hi, label)                                    \
+  void vtkSpaceSkippingVolumeMapper::Set##name(type v)                                          \
+  {                                                                                              \
+    const type used = ClampSaid<type>(this, #name, v, lo, hi, label);                            \
+    if (used != this->name)                                                                      \
+    {                                                                                            \
+      this->name = used;                                                                         \
+      this->Modified();                                                                          \
+    }                                                                                            \
+  }
+vtkSpaceSkipSetClampedMacro(Builder, int, Naive, AutoBuilder, BuilderLabel)
+vtkSpaceSkipSetClampedMacro(LeafCriterion, int, Shallow, Deep, nullptr)
+vtkSpaceSkipSetClampedMacro(MaxLeafSize, int, 0, VTK_INT_MAX, nullptr)
+vtkSpaceSkipSetClampedMacro(MacroCellSize, int, 1, 64, nullptr)
+vtkSpaceSkipSetClampedMacro(Backend, int, Auto, CUDA, nullptr)
+vtkSpaceSkipSetClampedMacro(FilterMode, int, ExactFilter, HardwareFilter, nullptr)
+vtkSpaceSkipSetClampedMacro(BlendModeOverride, int, -1, vtkVolumeMapper::ISOSURFACE_BLEND, BlendOverrideLabel)
+vtkSpaceSkipSetClampedMacro(DeviceMemoryBudget, vtkIdType, 0, VTK_ID_MAX, nullptr)
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::SetSampleDistance(double distance)
+{
+  // 0 is automatic; negative, NaN or infinite are not distances (the engine took them as 0
+  // without a word). Too small or too large finite ones are the engine's to clamp, said once.
+  double used = distance;
+  if (!(distance >= 0) || !std::isfinite(distance))
+  {
+    used = 0;
+    vtkWarningMacro(<< "SampleDistance " << distance
+                    << " is not a non-negative finite distance: using 0 (automatic: half the smallest spacing)");
+  }
+  if (used != this->SampleDistance)
+  {
+    this->SampleDistance = used;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::SetBinCount(int bins)
 {
   // 0 is the sweep; 1 (no candidate plane) would make the engine throw, so it clamps to 2.
   const int v = bins <= 0 ? 0 : std::min(std::max(bins, 2), 64);
+  if (v != bins)
+  {
+    vtkWarningMacro(<< "BinCount " << bins << " is outside its domain (0, or 2..64): using " << v);
+  }
   if (v != this->BinCount)
   {
     this->BinCount = v;

@@ -83,6 +83,10 @@ public:
     HardwareFilter = 1
   };
 
+  // The setters of the enumerated and bounded properties below take a value outside their
+  // domain (a script, a saved state) as the nearest one in it, with one warning naming the
+  // property, the value and what was used (vtkSetClampMacro's rule, said).
+
   ///@{
   /**
    * The hierarchy builder (default Grid). Builders a backend cannot run fall back, with a
@@ -90,7 +94,7 @@ public:
    * DDA leaping through empty space with a capped Chebyshev distance field over the macro cells
    * (CPU and CUDA); it is fastest on very sparse data with MacroCellSize 4.
    */
-  vtkSetClampMacro(Builder, int, Naive, AutoBuilder);
+  virtual void SetBuilder(int builder);
   vtkGetMacro(Builder, int);
   void SetBuilderToNaive() { this->SetBuilder(Naive); }
   void SetBuilderToGrid() { this->SetBuilder(Grid); }
@@ -109,7 +113,7 @@ public:
   /**
    * k-d tree halting: Shallow (node volume < 10% of the root) or Deep (leaf volume <= 8^3).
    */
-  vtkSetClampMacro(LeafCriterion, int, Shallow, Deep);
+  virtual void SetLeafCriterion(int criterion);
   vtkGetMacro(LeafCriterion, int);
   void SetLeafCriterionToShallow() { this->SetLeafCriterion(Shallow); }
   void SetLeafCriterionToDeep() { this->SetLeafCriterion(Deep); }
@@ -119,7 +123,7 @@ public:
   /**
    * Maximum leaf edge in cells (0: unlimited; the paper uses 32 and 128).
    */
-  vtkSetClampMacro(MaxLeafSize, int, 0, VTK_INT_MAX);
+  virtual void SetMaxLeafSize(int cells);
   vtkGetMacro(MaxLeafSize, int);
   ///@}
 
@@ -140,16 +144,18 @@ public:
    * paper's; clamped to [1, 64]); 4 suits very sparse data with DistanceGrid. A change redoes the
    * per-cell value ranges, the classification and the hierarchy (the image stays the same).
    */
-  vtkSetClampMacro(MacroCellSize, int, 1, 64);
+  virtual void SetMacroCellSize(int cells);
   vtkGetMacro(MacroCellSize, int);
   ///@}
 
   ///@{
   /**
    * Distance between samples along a ray, in the volume's data coordinates (before the
-   * vtkVolume's matrix). <= 0 (default): half the smallest spacing.
+   * vtkVolume's matrix). 0 (default): half the smallest spacing. Negative, NaN or infinite:
+   * one warning, and 0. The engine clamps what would step below 1/16 of the smallest spacing,
+   * take too many samples a ray or step over the volume (more than half its diagonal), said once.
    */
-  vtkSetMacro(SampleDistance, double);
+  virtual void SetSampleDistance(double distance);
   vtkGetMacro(SampleDistance, double);
   ///@}
 
@@ -161,7 +167,7 @@ public:
    * backend); SPACESKIP_REPORT (any value) prints one line per mapper with the backend, builder
    * and GL_RENDERER whenever they change (docs/tuning.md).
    */
-  vtkSetClampMacro(Backend, int, Auto, CUDA);
+  virtual void SetBackend(int backend);
   vtkGetMacro(Backend, int);
   void SetBackendToAuto() { this->SetBackend(Auto); }
   void SetBackendToCPU() { this->SetBackend(CPU); }
@@ -184,7 +190,7 @@ public:
    * With HardwareFilter the CUDA backend holds a second copy of the volume on the device (the
    * texture's array) from its first frame until the data changes.
    */
-  vtkSetClampMacro(FilterMode, int, ExactFilter, HardwareFilter);
+  virtual void SetFilterMode(int mode);
   vtkGetMacro(FilterMode, int);
   void SetFilterModeToExact() { this->SetFilterMode(ExactFilter); }
   void SetFilterModeToHardware() { this->SetFilterMode(HardwareFilter); }
@@ -275,7 +281,7 @@ public:
    * (default): BlendMode. For front ends whose BlendMode menu lacks modes this mapper has
    * (ParaView 5.11 offers composite, isosurface and slice only).
    */
-  vtkSetClampMacro(BlendModeOverride, int, -1, vtkVolumeMapper::ISOSURFACE_BLEND);
+  virtual void SetBlendModeOverride(int mode);
   vtkGetMacro(BlendModeOverride, int);
   ///@}
 
@@ -312,7 +318,7 @@ public:
    * A view whose visible bricks exceed it is drawn by the CPU backend, said once.
    * GetResidency() reports which ran. The CPU backend ignores it.
    */
-  vtkSetClampMacro(DeviceMemoryBudget, vtkIdType, 0, VTK_ID_MAX);
+  virtual void SetDeviceMemoryBudget(vtkIdType mib);
   vtkGetMacro(DeviceMemoryBudget, vtkIdType);
   /// "in core", "sparse: R of N bricks resident (P MiB pool)", or "none" before the first frame.
   const char* GetResidency();
