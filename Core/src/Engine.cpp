@@ -339,7 +339,7 @@ struct Engine::Impl {
     TransferFunction unit = tf;
     unit.unitDistance = 1;
     const double ratio = tf.unitDistance > 0 && std::isfinite(tf.unitDistance) ? step / tf.unitDistance : step;
-    std::vector<vec4f> table = tableForBlend(unit, float(ratio), blendMode());
+    std::vector<vec4f> table = tableForBlend(unit, float(std::min(ratio, 1e30)), blendMode());
     appendGradientTables(tf, table, gradOffset2D, gradOffsetGO);  // after the 1-D entries
     backend->setTransferTable(table, lo, scale);
     tableDirty = colorDirty = false;
@@ -532,6 +532,12 @@ namespace {
 /// origin (1e15). Every matrix, point and distance the kernels get is composed here in double and
 /// rounded to float once; a power of two keeps the scaling exact, so spacing 1 draws the same bits
 /// as in world units, and directions, shading and dt/unitDistance are unchanged by it.
+/// `v` in float, saturated at +-FLT_MAX (a plain conversion of a larger double is undefined).
+float saturatedFloat(double v) {
+  const double big = std::numeric_limits<float>::max();
+  return float(v > big ? big : (v < -big ? -big : v));
+}
+
 struct MarchFrame {
   double origin[3];
   int exponent = 0;
@@ -542,8 +548,8 @@ struct MarchFrame {
 
   double length(double world) const { return std::ldexp(world, -exponent); }
   vec3f point(const double* world) const {
-    return vec3f{float(length(world[0] - origin[0])), float(length(world[1] - origin[1])),
-                 float(length(world[2] - origin[2]))};
+    return vec3f{saturatedFloat(length(world[0] - origin[0])), saturatedFloat(length(world[1] - origin[1])),
+                 saturatedFloat(length(world[2] - origin[2]))};
   }
 };
 
@@ -615,8 +621,8 @@ void fillLights(Impl& d, FrameView& f, const MarchFrame& frame) {
     v.diffuse = vec3f{float(l.diffuse[0]), float(l.diffuse[1]), float(l.diffuse[2])};
     v.specular = vec3f{float(l.specular[0]), float(l.specular[1]), float(l.specular[2])};
     // 1 / (c + l d + q d^2) of the world distance d = 2^exponent times the frame's.
-    v.atten = vec3f{float(l.attenuation[0]), float(std::ldexp(l.attenuation[1], frame.exponent)),
-                    float(std::ldexp(l.attenuation[2], 2 * frame.exponent))};
+    v.atten = vec3f{saturatedFloat(l.attenuation[0]), saturatedFloat(std::ldexp(l.attenuation[1], frame.exponent)),
+                    saturatedFloat(std::ldexp(l.attenuation[2], 2 * frame.exponent))};
     v.positional = l.positional ? 1 : 0;
     v.cosCone = l.coneAngle <= 90.0 ? float(std::cos(l.coneAngle * 3.14159265358979323846 / 180.0)) : -2.f;
     v.exponent = float(l.exponent);
@@ -829,7 +835,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   f.jitterSeed = d.render.jitterSeed;
   f.firstSample = float(std::max(0.0, d.render.firstSampleOffset));
   // The eye in the same frame as the rays (invView's translation: already relative and scaled).
-  f.eyeW = vec3f{float(invView.m[12]), float(invView.m[13]), float(invView.m[14])};
+  f.eyeW = vec3f{saturatedFloat(invView.m[12]), saturatedFloat(invView.m[13]), saturatedFloat(invView.m[14])};
   fillBlend(d, f, frame);
   fillComponents(d, f);
   fillGradientTF(d, f);
