@@ -16,7 +16,7 @@ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 cmake --build "$build" -j "$(nproc)" --target spaceskip_fuzzers
 
 harnesses=("$@")
-[ ${#harnesses[@]} -gt 0 ] || harnesses=(raw_name nrrd transfer_function cli_options)
+[ ${#harnesses[@]} -gt 0 ] || harnesses=(raw_name nrrd transfer_function cli_options render)
 if [ -n "${FUZZ_RUNS:-}" ]; then bound=(-runs="$FUZZ_RUNS"); else bound=(-max_total_time="${FUZZ_SECONDS:-30}"); fi
 mkdir -p "$build/artifacts"
 for h in "${harnesses[@]}"; do

@@ -15,8 +15,8 @@ void parseLikeTheCommands(const Options& o) {
   buildParams(o, o.get("--builder", "grid"));
   renderParams(o);
   backendKind(o);
-  int w, h;
-  if (o.has("--size")) parseSize(o.get("--size", ""), w, h);
+  int w = 512, h = 512;
+  imageSize(o, w, h);  // --size and the image budget (--max-image-bytes)
   double az, el, zoom;
   if (o.has("--camera")) parseCamera(o.get("--camera", ""), az, el, zoom);
   if (o.has("--dims")) checkGeneratorSize("menger", parseDims(o.get("--dims", ""), "--dims"), fuzz::kFuzzMaxBytes);
@@ -40,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const char* const opts[] = {"--dims", "--seed", "-o", "--builder", "--builders", "--leaf", "--mls", "--bins",
                                      "--brick", "--backend", "--threads", "--tf", "--size", "--camera",
                                      "--sample-distance", "--ert", "--filter", "--compare", "--max-diff", "--frames",
-                                     "--build-reps", "--json", "--csv", "--max-volume-bytes", "--perspective",
+                                     "--build-reps", "--json", "--csv", "--max-volume-bytes", "--max-image-bytes", "--perspective",
                                      "--jitter", "--bogus", "gen:menger:", "gen:noise:"};
   std::vector<std::string> args{"spaceskip", "render"};
   const int n = p.ConsumeIntegralInRange(0, 16);
