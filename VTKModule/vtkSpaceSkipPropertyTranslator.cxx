@@ -28,6 +28,7 @@
 #include "spaceskip/Engine.h"
 
 #include <algorithm>
+#include <limits>
 #include <array>
 #include <vector>
 
@@ -103,7 +104,11 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& e
   }
   // ParaView and VTK call Modified() on the property for many reasons (its MTime includes its
   // functions'): each part is judged by its own function, range and settings.
-  const double unit = std::max(prop->GetScalarOpacityUnitDistance(opacityComponent), 1e-12);
+  // Any positive unit distance is taken as it is (a volume of spacing 1e-30 needs one that small:
+  // a floor of 1e-12 drew it transparent); the engine forms dt / unit in double. Not positive
+  // (or NaN): 1e-12, as before.
+  const double askedUnit = prop->GetScalarOpacityUnitDistance(opacityComponent);
+  const double unit = askedUnit > 0 ? std::min(askedUnit, std::numeric_limits<double>::max()) : 1e-12;
   const double slo = opacityRange ? alo : lo, shi = opacityRange ? ahi : hi;
   const bool colorStale = !this->HaveTF || this->ColorKey != color ||
     this->ColorMTime != color->GetMTime() || this->TableRange[0] != lo || this->TableRange[1] != hi ||

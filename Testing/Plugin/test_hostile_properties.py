@@ -118,4 +118,28 @@ for spacing, builder in (([1e-40, 1.0, 1.0], 0), ([1.0, 1e-39, 1.0], 0), ([1e-30
     ok.check("drawn that thin" in text, "spacing %r: the thin axis is said (%r)" % (spacing, text[:300]))
     ok.check("samples a ray" in text, "spacing %r: the bounded step is said (%r)" % (spacing, text[:300]))
 
+# -- 4. Uniform spacings far from 1 and a far origin draw the spacing-1 image -------------------
+# (camera and opacity unit distance scaled alike). 1e21 (a kiloparsec in cm) drew blank; 1e-20
+# drew transparent (the translator floored the unit distance at 1e-12). Below ~1e-20 ParaView's
+# own clipping range cuts this 64^3 volume away (the stock Volume too): not tested here.
+def scaled_shot(s, origin, name):
+    reader.DataSpacing = [s, s, s]
+    reader.DataOrigin = [origin, origin, origin]
+    disp.ScalarOpacityUnitDistance = 4.0 * s
+    c = [origin + 31.5 * s] * 3
+    view.CameraFocalPoint = c
+    view.CameraPosition = [c[0] + 70.0 * s, c[1] + 45.0 * s, c[2] + 95.0 * s]
+    view.CameraViewUp = [0.0, 1.0, 0.0]
+    view.CameraParallelProjection = 0
+    return ssptest.read_png(ssptest.render_to(view, name)).astype(float)
+
+
+set_raw("Builder", 1)
+ref = scaled_shot(1.0, 0.0, "hostile_scale_ref.png")
+for s, origin, min_psnr in ((1e21, 0.0, 50.0), (1e22, -5e22, 50.0), (1e-20, 0.0, 50.0), (1.0, 1e15, 50.0)):
+    img = scaled_shot(s, origin, "hostile_scale_%g_%g.png" % (s, origin))
+    p = ssptest.psnr(ref, img)
+    ok.check(p >= min_psnr, "spacing %g origin %g: the spacing-1 image (PSNR %.2f dB >= %g; max diff %d/255)"
+             % (s, origin, p, min_psnr, abs(img - ref).max()))
+
 ok.done()
