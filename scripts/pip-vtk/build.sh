@@ -96,7 +96,8 @@ from vtkmodules.vtkRenderingCore import vtkRenderWindow
 import vtkmodules.vtkRenderingOpenGL2
 w = vtkRenderWindow()
 w.Render()
-caps = [l.strip() for l in w.ReportCapabilities().splitlines() if l.startswith("OpenGL")]
+caps = [l.strip() for l in w.ReportCapabilities().splitlines()
+        if l.startswith("OpenGL") and "extensions" not in l]
 print(w.GetClassName() + ": " + "; ".join(caps))
 PY
 set +e
