@@ -126,6 +126,9 @@ protected:
   /// input), with the outline and data size of the whole.
   int RequestPartitionedData(vtkInformation*, vtkInformationVector**, vtkInformationVector*);
 
+  /// Use Transfer 2D with a second array (not the gradient) was said (once).
+  bool WarnedSecondArray = false;
+
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
   std::string BackendUsedName;
