@@ -128,3 +128,24 @@ TEST(GradientTF, ZeroGradientOpacityEmptiesEverything) {
   e.render(test::orbit(v, 30, 20), 32, 32, img);
   EXPECT_GT(test::coverage(img), 0.1);
 }
+
+TEST(GradientTF, CudaBuildersEqualCpuNaive) {
+  SKIP_WITHOUT_CUDA();
+  for (const char* shape : {"vessels", "nbody"}) {
+    Volume v = generateVolume(shape, vec3l{64, 61, 67});
+    v.spacing[1] = 0.7;
+    double lo, hi;
+    ASSERT_TRUE(v.scalarRange(lo, hi));
+    TransferFunction tf = TransferFunction::preset("ramp", lo, hi, 256);
+    TransferFunction tf2 = tf;
+    setBox(tf2, 48, 24, 0.02f, 0.9f, 0.05f, 0.6f, 0.7f);
+    RenderParams rp, shaded;
+    shaded.shade = true;
+    test::expectCudaBuildersEqualCpuNaive(v, tf2, rp, std::string(shape) + " 2-D");
+    test::expectCudaBuildersEqualCpuNaive(v, tf2, shaded, std::string(shape) + " 2-D shaded");
+    TransferFunction go = tf;
+    go.gradientOpacity.resize(1024);
+    for (size_t i = 0; i < go.gradientOpacity.size(); ++i) go.gradientOpacity[i] = float(i) / 1023.f;
+    test::expectCudaBuildersEqualCpuNaive(v, go, rp, std::string(shape) + " gradient opacity");
+  }
+}
