@@ -9,7 +9,9 @@
  * renderer's lights: VTK's headlight, or up to 8 directional/positional lights such as
  * vtkLightKit's) and IsoSurfaceValues, and every blend mode of vtkVolumeMapper (composite,
  * maximum/minimum/average intensity with AverageIPScalarRange, additive, isosurface, slice with
- * the property's SliceFunction plane), with vtkGPUVolumeRayCastMapper's semantics. The hierarchy over the occupied macro cells is built by `Builder`
+ * the property's SliceFunction plane), its 2-D transfer function (TF_2D: value x gradient
+ * magnitude) and gradient opacity (composite blending of one component; skipping stays lossless),
+ * with vtkGPUVolumeRayCastMapper's semantics. The hierarchy over the occupied macro cells is built by `Builder`
  * (the builders of Morrical/Zellmann et al.); a colour-only transfer-function edit only updates
  * the lookup table, an opacity edit re-classifies and rebuilds only when the occupied cells changed.
  * The image is marched by the CUDA backend when a device is usable (Backend Auto), else by the
