@@ -67,8 +67,8 @@ struct ArraySampler {
 }  // namespace spaceskip
 
 #include "Components.h"  // needs voxelValue and ArraySampler
-
 #include "GradientTF.h"
+
 namespace spaceskip {
 
 /// Marches the samples of one interval [a, b): k in [ceil((a-t0)/dt), ceil((b-t0)/dt)),
