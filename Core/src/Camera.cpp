@@ -31,9 +31,14 @@ mat4 lookAt(const double eye[3], const double center[3], const double up[3]) {
     m.m[i * 4 + 1] = u[i];
     m.m[i * 4 + 2] = -f[i];
   }
-  m.m[12] = -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]);
-  m.m[13] = -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]);
-  m.m[14] = (f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2]);
+  // The translation rounded once (long double sums): far from the origin (1e15, where a double
+  // ulp is 0.125) three rounded products would move the view by up to ~0.2 world units.
+  auto dot = [&](const double* a) {
+    return double((long double)a[0] * eye[0] + (long double)a[1] * eye[1] + (long double)a[2] * eye[2]);
+  };
+  m.m[12] = -dot(s);
+  m.m[13] = -dot(u);
+  m.m[14] = dot(f);
   return m;
 }
 
