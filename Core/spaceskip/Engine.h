@@ -20,8 +20,8 @@
 namespace spaceskip {
 
 /// The sample distance the engine renders with for `requested` world units (<= 0: half the
-/// smallest spacing), after the bounds kMinStepsPerVoxel and
-/// kMaxSamplesPerRay (Types.h). When a bound applied, `note` (if given) says
+/// smallest spacing), after the bounds kMinStepsPerVoxel, kMaxSamplesPerCell, kMaxSamplesPerRay
+/// and half the volume's diagonal (Types.h). When a bound applied, `note` (if given) says
 /// what was clamped and why; otherwise it is left empty.
 double effectiveSampleDistance(const Volume& v, double requested, std::string* note = nullptr);
 
