@@ -118,11 +118,14 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& e
     this->OpacitySampleRange[1] != shi || this->OpacityTableRange[0] != alo ||
     this->OpacityTableRange[1] != ahi || this->OpacityComponent != opacityComponent ||
     this->UnitDistance != unit;
-  // The 2-D table (TF_2D) or the gradient opacity (1-D mode, unless disabled; the stored function
-  // only, as GetGradientOpacity would make a default one), one-component volumes only.
+  // The 2-D table (TF_2D) or the gradient opacity (1-D mode, when the user set one and did not
+  // disable it), one-component volumes only. HasGradientOpacity first: GetGradientOpacity and
+  // GetStoredGradientOpacity both create a default function on the user's property, which then
+  // turns gradient opacity on for every other mapper drawing with it (vtkSmartVolumeMapper drew
+  // nothing on TestSpaceSkippingVolumeComponents after ours had created one).
   vtkImageData* table2D = opacityRange ? nullptr : Usable2D(prop);
   vtkPiecewiseFunction* gradient = opacityRange || prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_1D ||
-      prop->GetDisableGradientOpacity(0)
+      !prop->HasGradientOpacity(0) || prop->GetDisableGradientOpacity(0)
     ? nullptr
     : prop->GetStoredGradientOpacity(0);
   const bool table2DStale = this->Table2DKey != table2D || (table2D && this->Table2DMTime != table2D->GetMTime());
