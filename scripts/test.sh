@@ -32,7 +32,8 @@ fi
 if [ "${SPACESKIP_PIP_VTK:-1}" != 0 ]; then
   echo "== VTK 9.5.0 from pip: the module and its VTK C++ tests (scripts/pip-vtk/build.sh; 222.7 s of CPU)"
   echo "   not run here: the Python wrapping against pip's vtk (VTK's wrapping executables are in no"
-  echo "   PyPI wheel for Linux: see docs/pip.md), CUDA (a CPU build)"
+  echo "   PyPI wheel for Linux; build.sh builds them from a VTK git repository given as"
+  echo "   SPACESKIP_PIP_VTK_SOURCE, which CI does not have: docs/pip.md), CUDA (a CPU build)"
   echo "   excluded: TestSpaceSkippingVolumeRGBA: its shaded case differs from VTK 9.5's own mapper"
   echo "   (25.9 dB < 40: VTK 9.5 lights 4 dependent components by component 3's gradient, the"
   echo "   mapper by component 0's as VTK 9.2 does; docs/rendering.md, docs/results/pip-vtk)"

@@ -10,19 +10,24 @@ macOS SDK's headers and CMake package and points them at Linux:
     at the Linux wheel's vtkmodules/lib*.so (the file must exist there, else this fails);
   * `-framework Cocoa` dropped from the link interfaces;
   * vtk-config.cmake: VTK_USE_X and VTK_OPENGL_HAS_EGL ON (the Linux wheel's
-    libvtkRenderingOpenGL2 has the X, EGL and OSMesa windows), Python wrapping OFF;
+    libvtkRenderingOpenGL2 has the X, EGL and OSMesa windows), Python wrapping OFF (ON with
+    WRAP_TOOLS_DIR, below);
   * vtkRenderingOpenGLConfigure.h: VTK_USE_X in place of VTK_USE_COCOA;
   * the wrapping executables (macOS binaries in the SDK; the Linux wheel ships only
-    libvtkWrappingTools.so) replaced by stubs that fail with a message saying so.
+    libvtkWrappingTools.so) replaced by stubs that fail with a message saying so; or, given
+    WRAP_TOOLS_DIR (vtkWrapHierarchy, vtkWrapPython, vtkWrapPythonInit built for Linux from
+    VTK's source of the same tag, see build.sh), by those, with Python wrapping left ON and
+    the wrapped vtkmodules/*.cpython-*.so re-pointed at the Linux wheel's too.
 
 The SMP configuration (vtkSMP.h: Sequential default, STDThread built, no TBB/OpenMP) is the
 same in both wheels of 9.5.0; this script checks it against what the Linux libvtkCommonCore.so
 links (no libtbb, no libgomp) rather than trusting it.
 
-usage: assemble_sdk.py SDK_UNZIPPED VTKMODULES_DIR OUT_DIR
+usage: assemble_sdk.py SDK_UNZIPPED VTKMODULES_DIR OUT_DIR [WRAP_TOOLS_DIR]
   SDK_UNZIPPED   the unzipped vtk_sdk-X.Y.Z-...-macosx_*.whl (holds vtk_sdk/content/)
   VTKMODULES_DIR the Linux wheel's installed vtkmodules/ folder (site-packages/vtkmodules)
   OUT_DIR        where the SDK goes; VTK_DIR is then OUT_DIR/vtk-X.Y.Z.data/headers/cmake
+  WRAP_TOOLS_DIR optional: Linux builds of the three Python wrapping executables
 """
 import glob
 import os
@@ -49,9 +54,15 @@ def patch(path, fn):
 
 
 def main():
-    if len(sys.argv) != 4:
-        fail(__doc__.strip().splitlines()[-4])
-    src, vtkmodules, out = (os.path.abspath(a) for a in sys.argv[1:])
+    if len(sys.argv) not in (4, 5):
+        fail("usage: assemble_sdk.py SDK_UNZIPPED VTKMODULES_DIR OUT_DIR [WRAP_TOOLS_DIR]")
+    src, vtkmodules, out = (os.path.abspath(a) for a in sys.argv[1:4])
+    tools = os.path.abspath(sys.argv[4]) if len(sys.argv) == 5 else None
+    python_tools = ["vtkWrapHierarchy", "vtkWrapPython", "vtkWrapPythonInit"]
+    if tools:
+        for tool in python_tools:
+            if not os.access(os.path.join(tools, tool), os.X_OK):
+                fail(f"{tools} has no executable {tool}")
     content = os.path.join(src, "vtk_sdk", "content")
     data = glob.glob(os.path.join(content, "vtk-*.data"))
     if len(data) != 1:
@@ -64,8 +75,9 @@ def main():
     if os.path.exists(out):
         shutil.rmtree(out)
     out_headers = os.path.join(out, data_name, "headers")
-    # hierarchy/ holds the wrapping hierarchy files: only wrapping needs them, and it is off.
-    shutil.copytree(headers, out_headers, ignore=shutil.ignore_patterns("hierarchy"))
+    # hierarchy/ holds VTK's wrapping hierarchy files: only wrapping needs them.
+    shutil.copytree(headers, out_headers,
+                    ignore=None if tools else shutil.ignore_patterns("hierarchy"))
     cmake_dir = os.path.join(out_headers, "cmake")
     include_dir = glob.glob(os.path.join(out_headers, "vtk-*"))[0]
 
@@ -86,8 +98,17 @@ def main():
                 missing.append(name)
         return '"' + os.path.join(vtkmodules, so) + '"'
 
+    def python_module(m):
+        found = glob.glob(os.path.join(vtkmodules, m.group(1) + ".cpython-*.so"))
+        if len(found) != 1:
+            missing.append(m.group(1) + " (Python module)")
+            return m.group(0)
+        return '"' + found[0] + '"'
+
     def fix_release(text):
         text = re.sub(r'"\$\{_IMPORT_PREFIX\}/build/[^"]*/\.dylibs/(lib[^"/]+)\.dylib"', to_linux, text)
+        text = re.sub(r'"\$\{_IMPORT_PREFIX\}/\./vtkmodules/(vtk\w+)\.cpython-[^"/]*darwin\.so"',
+                      python_module, text)
         return re.sub(r'"@rpath/(lib[^"/]+)\.dylib"', lambda m: '"' + m.group(1) + '.so"', text)
 
     # VTK's own targets and those of the packages it bundles (viskores/).
@@ -98,7 +119,7 @@ def main():
         fail("the Linux wheel lacks " + ", ".join(missing))
     for release in releases:
         with open(release) as f:
-            left = re.findall(r"\.dylib|macosx", f.read())
+            left = re.findall(r"\.dylib|macosx|darwin", f.read())
         if left:
             fail(f"{release} still names macOS files ({len(left)} places)")
 
@@ -107,6 +128,9 @@ def main():
     os.makedirs(bindir)
     for tool in WRAP_TOOLS:
         stub = os.path.join(bindir, tool)
+        if tools and tool in python_tools:
+            shutil.copy2(os.path.join(tools, tool), stub)
+            continue
         with open(stub, "w") as f:
             f.write("#!/bin/sh\necho \"%s: not available in this assembled SDK: PyPI's vtk-sdk "
                     "wheel ships macOS binaries and the Linux vtk wheel ships no wrapping "
@@ -123,13 +147,16 @@ def main():
     def fix_config(t):
         t = t.replace('set(VTK_OPENGL_HAS_EGL "OFF")', 'set(VTK_OPENGL_HAS_EGL "ON")')
         t = t.replace('set(VTK_USE_X "OFF")', 'set(VTK_USE_X "ON")')
+        if tools:
+            return t
         return t.replace('set("${CMAKE_FIND_PACKAGE_NAME}_WRAP_PYTHON" "ON")',
                          'set("${CMAKE_FIND_PACKAGE_NAME}_WRAP_PYTHON" "OFF")')
     config = os.path.join(cmake_dir, "vtk-config.cmake")
     patch(config, fix_config)
     with open(config) as f:
         t = f.read()
-    for want in ['set(VTK_OPENGL_HAS_EGL "ON")', 'set(VTK_USE_X "ON")', '_WRAP_PYTHON" "OFF")']:
+    wrap = '_WRAP_PYTHON" "ON")' if tools else '_WRAP_PYTHON" "OFF")'
+    for want in ['set(VTK_OPENGL_HAS_EGL "ON")', 'set(VTK_USE_X "ON")', wrap]:
         if want not in t:
             fail(f"vtk-config.cmake: could not set {want}")
 

@@ -11,8 +11,12 @@
 #     Kitware's Linux SDK wheels are the real-world route (docs/pip.md).
 # Everything is compiled with -D_GLIBCXX_USE_CXX11_ABI=0, the ABI of the manylinux2014 wheel
 # (else the module fails to load: undefined symbol ...GetObjectDescriptionB5cxx11).
-# Not built: the Python wrapping (needs VTK's wrapping executables, which neither wheel has for
-# Linux) and CUDA (a CPU build; the GPU runs are bench/device/ and Testing/gpu/).
+# Python wrapping needs VTK's wrapping executables, which neither wheel has for Linux: given
+# SPACESKIP_PIP_VTK_SOURCE (a git repository of VTK with the tag v$VER, kept outside this
+# repository), the script compiles vtkWrapHierarchy, vtkWrapPython and vtkWrapPythonInit from
+# its Wrapping/Tools against the wheel's libvtkWrappingTools.so, wraps the mapper (package
+# spaceskip), installs numpy into the venv and runs the Python test too; without it, it says so
+# and builds C++ only. Not built: CUDA (a CPU build; the GPU runs are bench/device/, Testing/gpu/).
 #
 # usage: scripts/pip-vtk/build.sh [ctest arguments; default -R SpaceSkipping: the VTK mapper tests]
 # environment (all optional):
@@ -20,6 +24,7 @@
 #   SPACESKIP_PIP_VTK_CACHE    downloads, venv and assembled SDK (default ~/.cache/spaceskip-pip-vtk)
 #   SPACESKIP_PIP_VTK_BUILD    build folder (default build-pipvtk in the repository, git-ignored)
 #   SPACESKIP_PIP_VTK_JOBS     build jobs (default: nproc)
+#   SPACESKIP_PIP_VTK_SOURCE   VTK git repository with tag v$VER: Python wrapping (see above)
 #   SPACESKIP_XVFB_DISPLAY     Xvfb display number when DISPLAY is unset (default 92)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -66,26 +71,64 @@ if [ ! -f "$cache/sdk-unzipped/.done" ]; then
   "$py" -m zipfile -e "$cache"/sdk-wheel/vtk_sdk-"$ver"-*.whl "$cache/sdk-unzipped"
   touch "$cache/sdk-unzipped/.done"
 fi
-vtk_dir=$("$py" "$root/scripts/pip-vtk/assemble_sdk.py" "$cache/sdk-unzipped" "$vtkmodules" "$cache/sdk")
+tools=()
+wrap=OFF
+if [ -n "${SPACESKIP_PIP_VTK_SOURCE:-}" ]; then
+  step "VTK's Python wrapping tools from $SPACESKIP_PIP_VTK_SOURCE, tag v$ver"
+  if ! git -C "$SPACESKIP_PIP_VTK_SOURCE" rev-parse -q --verify "v$ver^{commit}" >/dev/null; then
+    echo "pip-vtk: $SPACESKIP_PIP_VTK_SOURCE is not a VTK git repository with the tag v$ver" >&2
+    exit 1
+  fi
+  wt=$cache/wrap-tools
+  if [ ! -f "$wt/.done" ]; then
+    rm -rf "$wt" && mkdir -p "$wt/src"
+    git -C "$SPACESKIP_PIP_VTK_SOURCE" archive --prefix=Wrapping/Tools/ "v$ver:Wrapping/Tools" | tar -x -C "$wt/src"
+    ws=$wt/src/Wrapping/Tools
+    # The SDK's headers (vtkParse.h, vtkWrappingToolsModule.h, ...) and the wheel's library.
+    inc=(-I"$ws" -I"$(ls -d "$cache"/sdk-unzipped/vtk_sdk/content/vtk-*.data/headers/vtk-*)")
+    lnk=(-L"$vtkmodules" -lvtkWrappingTools -Wl,-rpath,"$vtkmodules")
+    cc -O2 "${inc[@]}" -o "$wt/vtkWrapHierarchy" "$ws/vtkWrapHierarchy.c" "${lnk[@]}"
+    cc -O2 "${inc[@]}" -o "$wt/vtkWrapPythonInit" "$ws/vtkWrapPythonInit.c" "${lnk[@]}"
+    # vtkWrapPython's sources as Wrapping/Tools/CMakeLists.txt lists them.
+    py_src=()
+    for f in "" Class Constant Enum Method MethodDef Namespace NumberProtocol Overload Property \
+        Template Type; do
+      py_src+=("$ws/vtkWrapPython$f.c")
+    done
+    cc -O2 "${inc[@]}" -o "$wt/vtkWrapPython" "${py_src[@]}" "${lnk[@]}"
+    touch "$wt/.done"
+  fi
+  "$wt/vtkWrapPython" --version
+  tools=("$wt")
+  wrap=ON
+  # The Python test reads images through numpy.
+  "$venv/bin/python" -c 'import numpy' 2>/dev/null || "$venv/bin/python" -m pip install -q numpy
+fi
+vtk_dir=$("$py" "$root/scripts/pip-vtk/assemble_sdk.py" "$cache/sdk-unzipped" "$vtkmodules" "$cache/sdk" "${tools[@]}")
 echo "VTK_DIR=$vtk_dir"
-echo "NOTE: Python wrapping is NOT built here: it needs VTK's wrapping executables (vtkWrapHierarchy,"
-echo "      vtkWrapPython, vtkWrapPythonInit) for Linux, which neither PyPI wheel ships (the vtk wheel"
-echo "      has libvtkWrappingTools.so only, vtk-sdk's are macOS binaries). Build them from VTK's"
-echo "      source of tag v$ver, or use Kitware's Linux vtk-sdk (docs/pip.md)."
+if [ "$wrap" = OFF ]; then
+  echo "NOTE: Python wrapping is NOT built here: it needs VTK's wrapping executables (vtkWrapHierarchy,"
+  echo "      vtkWrapPython, vtkWrapPythonInit) for Linux, which neither PyPI wheel ships (the vtk wheel"
+  echo "      has libvtkWrappingTools.so only, vtk-sdk's are macOS binaries). Set"
+  echo "      SPACESKIP_PIP_VTK_SOURCE to a VTK git repository with tag v$ver to build them, or use"
+  echo "      Kitware's Linux vtk-sdk (docs/pip.md)."
+fi
 
-step "configure $build (ParaView off, CUDA off, -D_GLIBCXX_USE_CXX11_ABI=0)"
+step "configure $build (ParaView off, CUDA off, Python wrapping $wrap, -D_GLIBCXX_USE_CXX11_ABI=0)"
 # CMAKE_DISABLE_FIND_PACKAGE_ParaView: the system ParaView's VTK must not be loaded beside this one.
 mkdir -p "$build"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_DISABLE_FIND_PACKAGE_ParaView=TRUE -DSPACESKIP_ENABLE_PARAVIEW=OFF \
-  -DSPACESKIP_ENABLE_VTK=ON -DSPACESKIP_ENABLE_CUDA=OFF -DSPACESKIP_WRAP_PYTHON=OFF \
+  -DSPACESKIP_ENABLE_VTK=ON -DSPACESKIP_ENABLE_CUDA=OFF -DSPACESKIP_WRAP_PYTHON=$wrap \
+  -DPython3_EXECUTABLE="$venv/bin/python" \
   -DVTK_DIR="$vtk_dir" -DCMAKE_CXX_FLAGS="-D_GLIBCXX_USE_CXX11_ABI=0" >"$build/pip-vtk-configure.log" 2>&1 ||
   { tail -30 "$build/pip-vtk-configure.log"; exit 1; }
 grep -E "SpaceSkip: " "$build/pip-vtk-configure.log"
 
-step "build the module, its C++ tests, the window benchmark and the test baselines (-j$jobs)"
-nice -n 10 cmake --build "$build" -j "$jobs" \
-  --target vtkSpaceSkipCxxTests spaceskip_window_bench SpaceSkip-data
+step "build the module, its C++ tests, the window benchmark, the test baselines and, with wrapping, its Python module (-j$jobs)"
+targets=(vtkSpaceSkipCxxTests spaceskip_window_bench SpaceSkip-data)
+[ "$wrap" = OFF ] || targets+=(vtkSpaceSkipPython)
+nice -n 10 cmake --build "$build" -j "$jobs" --target "${targets[@]}"
 
 step "VTK C++ tests (ctest ${ctest_args[*]}) under X"
 source "$root/scripts/xvfb.sh" 92
