@@ -20,7 +20,7 @@
 #
 # usage: scripts/pip-vtk/build.sh [ctest arguments; default -R SpaceSkipping: the VTK mapper tests]
 # environment (all optional):
-#   SPACESKIP_PIP_VTK_VERSION  VTK version from pip (default 9.5.0; vtk-sdk must exist on PyPI)
+#   SPACESKIP_PIP_VTK_VERSION  VTK version from pip (default 9.5.0, PyPI's only vtk-sdk version)
 #   SPACESKIP_PIP_VTK_CACHE    downloads, venv and assembled SDK (default ~/.cache/spaceskip-pip-vtk)
 #   SPACESKIP_PIP_VTK_BUILD    build folder (default build-pipvtk in the repository, git-ignored)
 #   SPACESKIP_PIP_VTK_JOBS     build jobs (default: nproc)
