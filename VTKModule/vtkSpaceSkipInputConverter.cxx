@@ -6,6 +6,10 @@
 #include "vtkDataSetAttributes.h"
 #include "vtkImageData.h"
 #include "vtkMatrix3x3.h"
+#include "vtkNew.h"
+#include "vtkPointData.h"
+#include "vtkRectilinearGrid.h"
+#include "vtkResampleToImage.h"
 #include "vtkSMPTools.h"
 #include "vtkScalarsToColors.h"
 #include "vtkStructuredData.h"
@@ -16,6 +20,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace
@@ -350,4 +355,182 @@ spaceskip::VolumePiece vtkSpaceSkipInputConverter::PieceOf(vtkImageData* input, 
   // blend truncates (docs/paraview.md).
   piece.followBias = exact ? 0.f : static_cast<float>(bias / 255.0);
   return piece;
+}
+
+//------------------------------------------------------------------------------
+namespace
+{
+// One coordinate array of a rectilinear grid: its mean step (signed), the largest relative
+// deviation of a step from it, and whether it is strictly monotonic.
+struct AxisSteps
+{
+  vtkIdType Count = 0;
+  double First = 0, Last = 0, Mean = 1, Deviation = 0;
+  bool Monotonic = true;
+};
+
+AxisSteps StepsOf(vtkDataArray* coords)
+{
+  AxisSteps a;
+  a.Count = coords ? coords->GetNumberOfTuples() : 0;
+  if (a.Count == 0)
+  {
+    return a;
+  }
+  a.First = coords->GetComponent(0, 0);
+  a.Last = coords->GetComponent(a.Count - 1, 0);
+  if (a.Count == 1)
+  {
+    return a; // one point: any step; the image's spacing 1
+  }
+  a.Mean = (a.Last - a.First) / static_cast<double>(a.Count - 1);
+  double previous = a.First;
+  for (vtkIdType i = 1; i < a.Count; ++i)
+  {
+    const double x = coords->GetComponent(i, 0);
+    const double step = x - previous;
+    if (!(step * a.Mean > 0)) // zero, the other sign, or NaN
+    {
+      a.Monotonic = false;
+      return a;
+    }
+    a.Deviation = std::max(a.Deviation, std::abs(step - a.Mean) / std::abs(a.Mean));
+    previous = x;
+  }
+  return a;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkImageData* vtkSpaceSkipRectilinearImage::From(
+  vtkRectilinearGrid* grid, const WarnFunction& warn, std::string& problem)
+{
+  vtkDataArray* coords[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
+    grid->GetZCoordinates() };
+  vtkMTimeType mtime = grid->GetMTime();
+  for (vtkDataArray* c : coords)
+  {
+    mtime = std::max(mtime, c ? c->GetMTime() : 0);
+  }
+  if (this->Key == grid && this->MTime == mtime)
+  {
+    problem = this->Problem;
+    return this->Image;
+  }
+  this->Key = grid;
+  this->MTime = mtime;
+  this->Image = nullptr;
+  this->Path = 0;
+  this->Problem.clear();
+  int ext[6];
+  grid->GetExtent(ext);
+  AxisSteps axes[3];
+  double deviation = 0;
+  int worst = 0;
+  bool descending = false;
+  static const char* kAxis = "xyz";
+  for (int a = 0; a < 3; ++a)
+  {
+    axes[a] = StepsOf(coords[a]);
+    if (axes[a].Count != ext[2 * a + 1] - ext[2 * a] + 1)
+    {
+      this->Problem = std::string("vtkRectilinearGrid: its ") + kAxis[a] +
+        " coordinates do not match its extent: nothing drawn";
+      problem = this->Problem;
+      return nullptr;
+    }
+    if (!axes[a].Monotonic)
+    {
+      this->Problem = std::string("vtkRectilinearGrid: its ") + kAxis[a] +
+        " coordinates are not strictly monotonic: nothing drawn";
+      problem = this->Problem;
+      return nullptr;
+    }
+    descending = descending || axes[a].Mean < 0;
+    if (axes[a].Deviation > deviation)
+    {
+      deviation = axes[a].Deviation;
+      worst = a;
+    }
+  }
+  const std::string name = grid->GetObjectName().empty()
+    ? std::string("vtkRectilinearGrid")
+    : "vtkRectilinearGrid '" + grid->GetObjectName() + "'";
+  constexpr double kUniform = 1e-6;
+  if (deviation <= kUniform)
+  {
+    // The same points as an image: index (i, j, k) at first + (i - ext0) * mean step per axis.
+    auto image = vtkSmartPointer<vtkImageData>::New();
+    image->SetExtent(ext);
+    double spacing[3], origin[3];
+    double direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+    for (int a = 0; a < 3; ++a)
+    {
+      const double sign = axes[a].Mean < 0 ? -1.0 : 1.0;
+      spacing[a] = std::abs(axes[a].Mean);
+      direction[4 * a] = sign;
+      origin[a] = axes[a].First - sign * spacing[a] * ext[2 * a];
+    }
+    image->SetSpacing(spacing);
+    image->SetOrigin(origin);
+    image->SetDirectionMatrix(direction);
+    image->GetPointData()->ShallowCopy(grid->GetPointData());
+    image->GetCellData()->ShallowCopy(grid->GetCellData());
+    image->GetFieldData()->ShallowCopy(grid->GetFieldData());
+    this->Image = image;
+    this->Path = 1;
+    return this->Image;
+  }
+  if (descending)
+  {
+    this->Problem = name + " has non-uniform descending coordinates: not drawn (only ascending "
+                           "non-uniform coordinates are resampled to an image)";
+    problem = this->Problem;
+    return nullptr;
+  }
+  // The smallest step per axis over the grid's bounds, coarsened alike on every axis (never
+  // below the grid's own point count) until the lattice holds at most kMaxResampleFactor times
+  // the grid's points.
+  double smallest[3];
+  double dims[3];
+  const double cap = kMaxResampleFactor * static_cast<double>(grid->GetNumberOfPoints());
+  for (int a = 0; a < 3; ++a)
+  {
+    smallest[a] = std::abs(axes[a].Mean);
+    for (vtkIdType i = 1; i < axes[a].Count; ++i)
+    {
+      smallest[a] =
+        std::min(smallest[a], coords[a]->GetComponent(i, 0) - coords[a]->GetComponent(i - 1, 0));
+    }
+    dims[a] = axes[a].Count > 1 ? std::ceil((axes[a].Last - axes[a].First) / smallest[a] - 1e-9) + 1 : 1;
+  }
+  for (int pass = 0; pass < 8 && dims[0] * dims[1] * dims[2] > cap; ++pass)
+  {
+    const double f = std::cbrt(dims[0] * dims[1] * dims[2] / cap);
+    for (int a = 0; a < 3; ++a)
+    {
+      dims[a] = std::max(static_cast<double>(axes[a].Count), std::floor((dims[a] - 1) / f) + 1);
+    }
+  }
+  int n[3] = { static_cast<int>(dims[0]), static_cast<int>(dims[1]), static_cast<int>(dims[2]) };
+  vtkNew<vtkResampleToImage> resample;
+  resample->SetInputDataObject(grid);
+  resample->UseInputBoundsOff();
+  resample->SetSamplingBounds(grid->GetBounds());
+  resample->SetSamplingDimensions(n);
+  resample->Update();
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->ShallowCopy(resample->GetOutput());
+  this->Image = image;
+  this->Path = 2;
+  char dev[32];
+  std::snprintf(dev, sizeof(dev), "%.3g", deviation);
+  warn(name + " (" + std::to_string(axes[0].Count) + " x " + std::to_string(axes[1].Count) +
+    " x " + std::to_string(axes[2].Count) + " points) has non-uniform coordinates (largest " +
+    "relative step deviation " + dev + ", on " + kAxis[worst] + "): drawn resampled by " +
+    "vtkResampleToImage on a uniform " + std::to_string(n[0]) + " x " + std::to_string(n[1]) +
+    " x " + std::to_string(n[2]) + " lattice (the smallest step per axis, at most " +
+    std::to_string(static_cast<int>(kMaxResampleFactor)) + "x the grid's points); sampling " +
+    "through the coordinate arrays is not done yet");
+  return this->Image;
 }

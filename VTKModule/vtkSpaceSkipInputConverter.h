@@ -12,6 +12,7 @@
 
 class vtkDataArray;
 class vtkImageData;
+class vtkRectilinearGrid;
 namespace spaceskip
 {
 class Engine;
@@ -96,6 +97,42 @@ private:
   vtkSmartPointer<vtkDataArray> Borrowed;
   double ScalarRange[2] = { 0, 1 };
   double OpacityRange[2] = { 0, 1 };
+};
+
+/**
+ * A vtkRectilinearGrid as the vtkImageData the converter reads, remade only when the grid (its
+ * coordinates, its arrays) changed: kept by identity and MTime, so that the converter hands the
+ * volume to the engine again only then.
+ * - Each coordinate array uniformly spaced (every step within a relative 1e-6 of the mean step):
+ *   the same points as an image (origin and extent from the first coordinates, spacing the mean
+ *   steps; a descending array: a positive spacing and -1 in the direction matrix), the grid's
+ *   point, cell and field data shallow-copied (no copy of the scalars). Drawn as that image.
+ * - Otherwise (strictly monotonic coordinates): one warning naming the grid and its largest
+ *   relative step deviation, then the grid resampled by vtkResampleToImage (trilinear within
+ *   the grid's cells) on a uniform lattice over its bounds with the smallest step per axis,
+ *   coarsened so that the lattice holds at most kMaxResampleFactor times the grid's points.
+ * - Coordinates that are not strictly monotonic, or non-uniform descending ones: `problem`,
+ *   nothing drawn.
+ */
+class vtkSpaceSkipRectilinearImage
+{
+public:
+  using WarnFunction = vtkSpaceSkipInputConverter::WarnFunction;
+  /// The resampled lattice of a non-uniform grid holds at most this many times its points.
+  static constexpr double kMaxResampleFactor = 4.0;
+
+  /// The image to draw for `grid` (nullptr, with `problem` set, when nothing can be drawn).
+  vtkImageData* From(vtkRectilinearGrid* grid, const WarnFunction& warn, std::string& problem);
+
+  /// How the last image was made: 0 none, 1 the uniform grid's arrays, 2 resampled.
+  int GetPath() const { return this->Path; }
+
+private:
+  vtkSmartPointer<vtkImageData> Image;
+  const void* Key = nullptr;
+  vtkMTimeType MTime = 0;
+  int Path = 0;
+  std::string Problem;
 };
 
 #endif

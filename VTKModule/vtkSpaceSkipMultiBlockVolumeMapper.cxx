@@ -19,6 +19,7 @@
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkPointData.h"
+#include "vtkRectilinearGrid.h"
 #include "vtkRenderer.h"
 #include "vtkScalarsToColors.h"
 #include "vtkStructuredData.h"
@@ -239,12 +240,36 @@ bool vtkSpaceSkipMultiBlockVolumeMapper::CollectImages(
 {
   auto* cds = vtkCompositeDataSet::SafeDownCast(this->GetInputDataObject(0, 0));
   std::set<std::string> others;
+  // This frame's rectilinear leaves; those of earlier frames that are gone are dropped.
+  std::map<vtkRectilinearGrid*, vtkSpaceSkipRectilinearImage> grids;
   vtkSmartPointer<vtkCompositeDataIterator> it;
   it.TakeReference(cds->NewIterator());
   for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
   {
+    if (auto* grid = vtkRectilinearGrid::SafeDownCast(it->GetCurrentDataObject()))
+    {
+      auto found = this->Grids.find(grid);
+      grids[grid] = found != this->Grids.end() ? std::move(found->second) : vtkSpaceSkipRectilinearImage();
+    }
+  }
+  this->Grids.swap(grids);
+  grids.clear();
+  for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
+  {
     vtkDataObject* leaf = it->GetCurrentDataObject();
     auto* image = vtkImageData::SafeDownCast(leaf);
+    if (auto* grid = vtkRectilinearGrid::SafeDownCast(leaf))
+    {
+      // A rectilinear block as an image (its own arrays when uniform, else resampled), kept
+      // per leaf and made again only when the leaf changed.
+      std::string problem;
+      image = grid->GetNumberOfPoints() > 0 ? this->Grids[grid].From(grid, this->Warn, problem) : nullptr;
+      if (!image && !problem.empty())
+      {
+        this->Warn("composite input: a block is not drawn: " + problem);
+      }
+      leaf = image ? leaf : nullptr;
+    }
     if (image && image->GetNumberOfPoints() > 0)
     {
       images.push_back(image);
@@ -262,8 +287,8 @@ bool vtkSpaceSkipMultiBlockVolumeMapper::CollectImages(
       names += (names.empty() ? "" : ", ") + n;
     }
     this->Warn("composite input: blocks of type " + names +
-      " are not drawn (vtkSpaceSkippingVolumeMapper draws vtkImageData blocks only; resample "
-      "rectilinear or unstructured data to an image first)");
+      " are not drawn (vtkSpaceSkippingVolumeMapper draws vtkImageData and vtkRectilinearGrid "
+      "blocks only; resample other data to an image first)");
   }
   if (images.size() > kManyBlocks)
   {
@@ -785,8 +810,9 @@ bool vtkSpaceSkipMultiBlockVolumeMapper::ComputeBounds(vtkDataObject* input, dou
   it.TakeReference(cds->NewIterator());
   for (it->InitTraversal(); !it->IsDoneWithTraversal(); it->GoToNextItem())
   {
-    auto* image = vtkImageData::SafeDownCast(it->GetCurrentDataObject());
-    if (!image || image->GetNumberOfPoints() == 0)
+    auto* image = vtkDataSet::SafeDownCast(it->GetCurrentDataObject());
+    if (!image || image->GetNumberOfPoints() == 0 ||
+      !(image->IsA("vtkImageData") || image->IsA("vtkRectilinearGrid")))
     {
       continue;
     }

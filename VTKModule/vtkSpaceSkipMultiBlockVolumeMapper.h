@@ -27,11 +27,13 @@
 #include "vtkSmartPointer.h" // For the lattice
 #include "vtkVolumeMapper.h"
 
+#include "vtkSpaceSkipInputConverter.h" // For vtkSpaceSkipRectilinearImage
 #include "vtkSpaceSkipPieceExchange.h" // For vtkSpaceSkipPieceImage
 #include "vtkSpaceSkipSettings.h"      // For the settings
 #include "vtkSpaceSkipStatistics.h"    // For the statistics
 
 #include <functional> // For BlockFactory, WarnFunction
+#include <map>        // For the rectilinear leaves
 #include <memory>     // For the block mappers
 #include <string>     // For the problem
 #include <vector>     // For the blocks
@@ -39,6 +41,7 @@
 class vtkDataArray;
 class vtkDataObject;
 class vtkImageData;
+class vtkRectilinearGrid;
 class vtkSpaceSkipCompositor;
 namespace spaceskip
 {
@@ -158,6 +161,8 @@ private:
   WarnFunction Warn;
   std::string Problem;
   std::vector<Block> Blocks;
+  // The rectilinear leaves as images (vtkSpaceSkipInputConverter.h), by leaf.
+  std::map<vtkRectilinearGrid*, vtkSpaceSkipRectilinearImage> Grids;
   int Frames = 0;
   // The lattice of the last plan and what it was made from (re-planned when that changes).
   bool OnLattice = false;

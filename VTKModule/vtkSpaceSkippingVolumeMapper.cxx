@@ -13,8 +13,10 @@
 #include "vtkObjectFactory.h"
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkRectilinearGrid.h"
 #include "vtkRenderer.h"
 #include "vtkSpaceSkipImageRenderer.h"
+#include "vtkSpaceSkipInputConverter.h"
 #include "vtkSpaceSkipMultiBlockVolumeMapper.h"
 #include "vtkSpaceSkipPieceCompositing.h"
 #include "vtkSpaceSkipSettings.h"
@@ -135,6 +137,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   // composite mapper that draws it with one mapper per image block (vtkBlock).
   vtkSpaceSkipImageRenderer Image;
   vtkSmartPointer<vtkSpaceSkipMultiBlockVolumeMapper> Composite;
+  // vtkRectilinearGrid input as the image drawn (vtkSpaceSkipInputConverter.h).
+  vtkSpaceSkipRectilinearImage Rectilinear;
   // How a frame is drawn: a block of composite input (set by vtkBlock) or a piece for the
   // exchange keeps its float image, with the table range of all blocks and its own cells.
   vtkSpaceSkipImageRenderer::FrameMode Mode;
@@ -151,7 +155,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
     }
   }
 
-  void RenderImage(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam);
+  void RenderImage(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam,
+    vtkImageData* input);
   void RenderComposite(vtkRenderer* ren, vtkVolume* vol, vtkDataObject* input);
   vtkSpaceSkipMultiBlockVolumeMapper* CompositeMapper();
   const vtkSpaceSkipStatistics& Statistics(bool deviceTimes)
@@ -207,15 +212,14 @@ struct vtkSpaceSkippingVolumeMapper::vtkBlock : public vtkSpaceSkipMultiBlockVol
 
 //------------------------------------------------------------------------------
 // One image through vtkSpaceSkipImageRenderer; SPACESKIP_BACKEND overrides the backend.
-void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(
-  vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam)
+void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(vtkRenderer* ren, vtkVolume* vol,
+  vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam, vtkImageData* input)
 {
   vtkSpaceSkippingVolumeMapper* self = this->Self;
   const auto t0 = std::chrono::steady_clock::now();
   this->Image.ResetFrameTimes();
   vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(self);
   s.Backend = Overrides().Backend >= 0 ? Overrides().Backend : s.Backend;
-  vtkImageData* input = vtkImageData::SafeDownCast(self->GetInput());
   int cellFlag = 0;
   vtkDataArray* scalars = input ? vtkAbstractMapper::GetScalars(input, self->ScalarMode,
                                     self->ArrayAccessMode, self->ArrayId, self->ArrayName, cellFlag)
@@ -414,13 +418,20 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
     d.Composite->ReleaseGraphicsResources(renWin); // back to an image: the blocks go
     d.Composite = nullptr;
   }
-  if (input && input->IsA("vtkRectilinearGrid"))
+  vtkImageData* image = vtkImageData::SafeDownCast(this->GetInput());
+  if (auto* grid = vtkRectilinearGrid::SafeDownCast(input))
   {
-    d.Fail("vtkRectilinearGrid input is not drawn: vtkSpaceSkippingVolumeMapper draws "
-           "vtkImageData (resample the grid to an image first, e.g. vtkResampleToImage)");
-    return;
+    // The grid as an image (its own arrays when uniform, else resampled), made again only
+    // when the grid changed.
+    std::string problem;
+    image = d.Rectilinear.From(grid, d.Warn, problem);
+    if (!image)
+    {
+      d.Fail(problem);
+      return;
+    }
   }
-  d.RenderImage(ren, vol, renWin, cam);
+  d.RenderImage(ren, vol, renWin, cam, image);
 }
 
 //------------------------------------------------------------------------------

@@ -22,6 +22,13 @@
  * of vtkImageData) draws every image block with a hierarchy of its own, back to front (see
  * GetBounds()).
  *
+ * vtkRectilinearGrid input (alone or as blocks): uniformly spaced coordinates (each step within
+ * a relative 1e-6 of the mean) are drawn as the image of the same points, the grid's arrays
+ * shared, not copied (a descending array: a mirrored direction matrix); non-uniform ones with
+ * one warning, resampled by vtkResampleToImage on a uniform lattice (the smallest step per axis,
+ * at most 4x the grid's points) once per change of the grid. Sampling through the coordinate
+ * arrays themselves is not done (docs/limits.md).
+ *
  * Bad input (no/cell scalars, several components, unsupported type, empty extent) raises one
  * vtkErrorMacro and draws nothing; backend failures (no device, out of device memory) fall back
  * to the CPU backend with a warning.

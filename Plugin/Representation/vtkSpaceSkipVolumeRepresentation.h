@@ -11,7 +11,7 @@
  * Input: vtkImageData, and the vtkPartitionedDataSet of vtkImageData that ParaView makes of
  * partitioned, multiblock and partitioned-collection image data (the base class keeps those for
  * vtkMultiBlockVolumeMapper; the mapper draws each block with its own hierarchy). Rectilinear
- * grids are refused by the mapper with a warning.
+ * grids do not reach it (ParaView offers it for image data); the mapper itself draws them.
  */
 #ifndef vtkSpaceSkipVolumeRepresentation_h
 #define vtkSpaceSkipVolumeRepresentation_h

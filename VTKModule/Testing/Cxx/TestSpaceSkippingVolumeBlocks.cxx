@@ -4,8 +4,9 @@
 // front to back in float): blocks sharing their face points, blocks with a gap of one cell
 // between them, blocks with ghost layers, with and without shading, three cameras; like
 // vtkMultiBlockVolumeMapper on the same blocks; blocks off one lattice (another spacing) or
-// overlapping are drawn each on its own with one warning; a rectilinear block is skipped with
-// one warning; the statistics add up.
+// overlapping are drawn each on its own with one warning; a rectilinear block without
+// coordinates for its extent is skipped with one warning (rectilinear blocks that have them are
+// drawn: TestSpaceSkippingVolumeRectilinear); the statistics add up.
 #include "SpaceSkipTestHelpers.h"
 
 #include "vtkExtractVOI.h"
@@ -104,7 +105,8 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
   ghosts->SetPartition(1, CutWithGhosts(image, -5, 12, 1, 1));
   ghosts->SetPartition(2, CutWithGhosts(image, 12, 31, 2, 0));
 
-  // The two blocks plus a rectilinear grid and a nested multiblock holding nothing drawable.
+  // The two blocks plus a rectilinear grid without coordinates for its extent (not drawable)
+  // and a nested multiblock.
   vtkNew<vtkRectilinearGrid> grid;
   grid->SetDimensions(2, 2, 2);
   vtkNew<vtkMultiBlockDataSet> mixed;
@@ -302,7 +304,7 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
     std::cerr << "the rectilinear block was warned about again: " << messages->Warnings << "\n";
     ok = false;
   }
-  // A rectilinear grid alone: one error naming it, nothing drawn.
+  // That rectilinear grid alone: one error naming it, nothing drawn.
   vtkNew<vtkRectilinearGrid> lonely;
   lonely->DeepCopy(grid);
   messages->Clear();
