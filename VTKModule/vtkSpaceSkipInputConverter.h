@@ -124,8 +124,11 @@ public:
   /// The image to draw for `grid` (nullptr, with `problem` set, when nothing can be drawn).
   vtkImageData* From(vtkRectilinearGrid* grid, const WarnFunction& warn, std::string& problem);
 
-  /// How the last image was made: 0 none, 1 the uniform grid's arrays, 2 resampled.
+  /// How the last image was made: 0 none, 1 the uniform grid's arrays, 2 resampled (its
+  /// extent is not the grid's: a WholeExtent of the grid's pieces does not apply to it).
   int GetPath() const { return this->Path; }
+  /// The last image made (null when none).
+  vtkImageData* GetImage() const { return this->Image; }
 
 private:
   vtkSmartPointer<vtkImageData> Image;

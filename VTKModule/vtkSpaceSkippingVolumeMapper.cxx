@@ -156,7 +156,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   }
 
   void RenderImage(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam,
-    vtkImageData* input);
+    vtkImageData* input, bool resampled);
   void RenderComposite(vtkRenderer* ren, vtkVolume* vol, vtkDataObject* input);
   vtkSpaceSkipMultiBlockVolumeMapper* CompositeMapper();
   const vtkSpaceSkipStatistics& Statistics(bool deviceTimes)
@@ -213,12 +213,18 @@ struct vtkSpaceSkippingVolumeMapper::vtkBlock : public vtkSpaceSkipMultiBlockVol
 //------------------------------------------------------------------------------
 // One image through vtkSpaceSkipImageRenderer; SPACESKIP_BACKEND overrides the backend.
 void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(vtkRenderer* ren, vtkVolume* vol,
-  vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam, vtkImageData* input)
+  vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam, vtkImageData* input, bool resampled)
 {
   vtkSpaceSkippingVolumeMapper* self = this->Self;
   const auto t0 = std::chrono::steady_clock::now();
   this->Image.ResetFrameTimes();
   vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(self);
+  if (resampled)
+  {
+    // A resampled grid is not on the lattice of the grid's WholeExtent: drawn whole.
+    const int none[6] = { 0, -1, 0, -1, 0, -1 };
+    std::copy(none, none + 6, s.WholeExtent);
+  }
   s.Backend = Overrides().Backend >= 0 ? Overrides().Backend : s.Backend;
   int cellFlag = 0;
   vtkDataArray* scalars = input ? vtkAbstractMapper::GetScalars(input, self->ScalarMode,
@@ -419,6 +425,7 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
     d.Composite = nullptr;
   }
   vtkImageData* image = vtkImageData::SafeDownCast(this->GetInput());
+  bool resampled = false;
   if (auto* grid = vtkRectilinearGrid::SafeDownCast(input))
   {
     // The grid as an image (its own arrays when uniform, else resampled), made again only
@@ -430,8 +437,9 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
       d.Fail(problem);
       return;
     }
+    resampled = d.Rectilinear.GetPath() == 2;
   }
-  d.RenderImage(ren, vol, renWin, cam, image);
+  d.RenderImage(ren, vol, renWin, cam, image, resampled);
 }
 
 //------------------------------------------------------------------------------
@@ -472,6 +480,18 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     int w = 0, h = 0;
     image = d.Image.DeferredImage(w, h);
     auto* input = vtkImageData::SafeDownCast(this->GetInput());
+    if (!input && vtkRectilinearGrid::SafeDownCast(this->GetInputDataObject(0, 0)))
+    {
+      // A uniform grid's piece is the image of its points, on the grid's index lattice; a
+      // resampled one is on a lattice of its own, which the exchange cannot place.
+      input = d.Rectilinear.GetPath() == 1 ? d.Rectilinear.GetImage() : nullptr;
+      if (d.Rectilinear.GetPath() == 2)
+      {
+        this->WarnOnce("a vtkRectilinearGrid piece with non-uniform coordinates is not drawn "
+                       "when pieces are composited across processes (resample the grid to an "
+                       "image first)");
+      }
+    }
     if (image && input && ren->GetActiveCamera())
     {
       const int* whole = this->WholeExtent;

@@ -10,8 +10,9 @@
  *
  * Input: vtkImageData, and the vtkPartitionedDataSet of vtkImageData that ParaView makes of
  * partitioned, multiblock and partitioned-collection image data (the base class keeps those for
- * vtkMultiBlockVolumeMapper; the mapper draws each block with its own hierarchy). Rectilinear
- * grids do not reach it (ParaView offers it for image data); the mapper itself draws them.
+ * vtkMultiBlockVolumeMapper; the mapper draws each block with its own hierarchy), and
+ * vtkRectilinearGrid (ParaView shows rectilinear grids through the image representation): the
+ * mapper draws it as an image (vtkSpaceSkippingVolumeMapper.h).
  */
 #ifndef vtkSpaceSkipVolumeRepresentation_h
 #define vtkSpaceSkipVolumeRepresentation_h
