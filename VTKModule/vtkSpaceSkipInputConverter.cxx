@@ -9,7 +9,7 @@
 #include "vtkNew.h"
 #include "vtkPointData.h"
 #include "vtkRectilinearGrid.h"
-#include "vtkResampleToImage.h"
+#include "vtkFloatArray.h"
 #include "vtkSMPTools.h"
 #include "vtkScalarsToColors.h"
 #include "vtkStructuredData.h"
@@ -399,6 +399,108 @@ AxisSteps StepsOf(vtkDataArray* coords)
   }
   return a;
 }
+// Where each of the `n` lattice points along an axis (first + i * step) falls in the ascending
+// `coords`: the index of its cell's lower point and the weight of the upper one, in [0, 1].
+void AxisWeights(vtkDataArray* coords, int n, double first, double step,
+  std::vector<vtkIdType>& cell, std::vector<double>& weight)
+{
+  const vtkIdType count = coords->GetNumberOfTuples();
+  cell.assign(static_cast<size_t>(n), 0);
+  weight.assign(static_cast<size_t>(n), 0.0);
+  if (count < 2)
+  {
+    return;
+  }
+  vtkIdType j = 0;
+  for (int i = 0; i < n; ++i)
+  {
+    const double x = first + i * step;
+    while (j + 2 < count && coords->GetComponent(j + 1, 0) <= x)
+    {
+      ++j;
+    }
+    const double x0 = coords->GetComponent(j, 0), x1 = coords->GetComponent(j + 1, 0);
+    cell[i] = j;
+    weight[i] = std::min(1.0, std::max(0.0, (x - x0) / (x1 - x0)));
+  }
+}
+
+// Every point array of `grid` (ghost markers aside) trilinearly interpolated within the grid's
+// cells at the points of `image` (on the grid's bounds), as float; the active scalars stay
+// active. One pass per array, z slices in parallel.
+void ResampleTrilinear(vtkRectilinearGrid* grid, vtkImageData* image)
+{
+  int dims[3], gdims[3];
+  image->GetDimensions(dims);
+  grid->GetDimensions(gdims);
+  const double* origin = image->GetOrigin();
+  const double* spacing = image->GetSpacing();
+  vtkDataArray* coords[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
+    grid->GetZCoordinates() };
+  std::vector<vtkIdType> cell[3];
+  std::vector<double> weight[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    AxisWeights(coords[a], dims[a], origin[a], spacing[a], cell[a], weight[a]);
+  }
+  // The upper neighbour's offset per axis (0 on an axis of one point).
+  const vtkIdType up[3] = { gdims[0] > 1 ? 1 : 0,
+    gdims[1] > 1 ? static_cast<vtkIdType>(gdims[0]) : 0,
+    gdims[2] > 1 ? static_cast<vtkIdType>(gdims[0]) * gdims[1] : 0 };
+  vtkPointData* in = grid->GetPointData();
+  vtkDataArray* active = in->GetScalars();
+  for (int n = 0; n < in->GetNumberOfArrays(); ++n)
+  {
+    vtkDataArray* src = in->GetArray(n);
+    if (!src || (src->GetName() && std::string(src->GetName()) == vtkDataSetAttributes::GhostArrayName()) ||
+      src->GetNumberOfTuples() != grid->GetNumberOfPoints())
+    {
+      continue;
+    }
+    const int nc = src->GetNumberOfComponents();
+    vtkNew<vtkFloatArray> dst;
+    dst->SetName(src->GetName());
+    dst->SetNumberOfComponents(nc);
+    dst->SetNumberOfTuples(static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2]);
+    float* out = dst->GetPointer(0);
+    vtkSMPTools::For(0, dims[2], [&](vtkIdType k0, vtkIdType k1) {
+      for (vtkIdType k = k0; k < k1; ++k)
+      {
+        const double wz = weight[2][k];
+        for (vtkIdType j = 0; j < dims[1]; ++j)
+        {
+          const double wy = weight[1][j];
+          const vtkIdType row = (cell[2][k] * gdims[1] + cell[1][j]) * gdims[0];
+          float* o = out + ((k * dims[1] + j) * dims[0]) * nc;
+          for (vtkIdType i = 0; i < dims[0]; ++i)
+          {
+            const double wx = weight[0][i];
+            const vtkIdType p = row + cell[0][i];
+            for (int c = 0; c < nc; ++c)
+            {
+              auto v = [&](vtkIdType q) { return src->GetComponent(q, c); };
+              const double x00 = v(p) + wx * (v(p + up[0]) - v(p));
+              const double x10 = v(p + up[1]) + wx * (v(p + up[1] + up[0]) - v(p + up[1]));
+              const double x01 = v(p + up[2]) + wx * (v(p + up[2] + up[0]) - v(p + up[2]));
+              const double x11 = v(p + up[2] + up[1]) +
+                wx * (v(p + up[2] + up[1] + up[0]) - v(p + up[2] + up[1]));
+              const double y0 = x00 + wy * (x10 - x00), y1 = x01 + wy * (x11 - x01);
+              o[i * nc + c] = static_cast<float>(y0 + wz * (y1 - y0));
+            }
+          }
+        }
+      }
+    });
+    if (src == active)
+    {
+      image->GetPointData()->SetScalars(dst);
+    }
+    else
+    {
+      image->GetPointData()->AddArray(dst);
+    }
+  }
+}
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -513,14 +615,16 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(
     }
   }
   int n[3] = { static_cast<int>(dims[0]), static_cast<int>(dims[1]), static_cast<int>(dims[2]) };
-  vtkNew<vtkResampleToImage> resample;
-  resample->SetInputDataObject(grid);
-  resample->UseInputBoundsOff();
-  resample->SetSamplingBounds(grid->GetBounds());
-  resample->SetSamplingDimensions(n);
-  resample->Update();
   auto image = vtkSmartPointer<vtkImageData>::New();
-  image->ShallowCopy(resample->GetOutput());
+  image->SetExtent(0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1);
+  double spacing[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    spacing[a] = n[a] > 1 ? (axes[a].Last - axes[a].First) / (n[a] - 1) : 1.0;
+  }
+  image->SetOrigin(axes[0].First, axes[1].First, axes[2].First);
+  image->SetSpacing(spacing);
+  ResampleTrilinear(grid, image);
   this->Image = image;
   this->Path = 2;
   char dev[32];
@@ -528,7 +632,7 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(
   warn(name + " (" + std::to_string(axes[0].Count) + " x " + std::to_string(axes[1].Count) +
     " x " + std::to_string(axes[2].Count) + " points) has non-uniform coordinates (largest " +
     "relative step deviation " + dev + ", on " + kAxis[worst] + "): drawn resampled by " +
-    "vtkResampleToImage on a uniform " + std::to_string(n[0]) + " x " + std::to_string(n[1]) +
+    "trilinear interpolation on a uniform " + std::to_string(n[0]) + " x " + std::to_string(n[1]) +
     " x " + std::to_string(n[2]) + " lattice (the smallest step per axis, at most " +
     std::to_string(static_cast<int>(kMaxResampleFactor)) + "x the grid's points); sampling " +
     "through the coordinate arrays is not done yet");

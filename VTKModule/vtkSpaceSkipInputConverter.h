@@ -108,8 +108,9 @@ private:
  *   steps; a descending array: a positive spacing and -1 in the direction matrix), the grid's
  *   point, cell and field data shallow-copied (no copy of the scalars). Drawn as that image.
  * - Otherwise (strictly monotonic coordinates): one warning naming the grid and its largest
- *   relative step deviation, then the grid resampled by vtkResampleToImage (trilinear within
- *   the grid's cells) on a uniform lattice over its bounds with the smallest step per axis,
+ *   relative step deviation, then every point array of the grid resampled (trilinear within
+ *   the grid's cells, as float: what vtkResampleToImage gives, without its per-point cell
+ *   search) on a uniform lattice over its bounds with the smallest step per axis,
  *   coarsened so that the lattice holds at most kMaxResampleFactor times the grid's points.
  * - Coordinates that are not strictly monotonic, or non-uniform descending ones: `problem`,
  *   nothing drawn.

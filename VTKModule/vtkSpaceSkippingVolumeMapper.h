@@ -25,7 +25,7 @@
  * vtkRectilinearGrid input (alone or as blocks): uniformly spaced coordinates (each step within
  * a relative 1e-6 of the mean) are drawn as the image of the same points, the grid's arrays
  * shared, not copied (a descending array: a mirrored direction matrix); non-uniform ones with
- * one warning, resampled by vtkResampleToImage on a uniform lattice (the smallest step per axis,
+ * one warning, resampled trilinearly on a uniform lattice (the smallest step per axis,
  * at most 4x the grid's points) once per change of the grid. Sampling through the coordinate
  * arrays themselves is not done (docs/limits.md).
  *
