@@ -381,9 +381,15 @@ AxisSteps StepsOf(vtkDataArray* coords)
   a.Last = coords->GetComponent(a.Count - 1, 0);
   if (a.Count == 1)
   {
+    a.Monotonic = std::isfinite(a.First);
     return a; // one point: any step; the image's spacing 1
   }
   a.Mean = (a.Last - a.First) / static_cast<double>(a.Count - 1);
+  if (!std::isfinite(a.Mean) || a.Mean == 0)
+  {
+    a.Monotonic = false; // a NaN or infinite end, or both ends equal
+    return a;
+  }
   double previous = a.First;
   for (vtkIdType i = 1; i < a.Count; ++i)
   {
@@ -544,7 +550,7 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(
     if (!axes[a].Monotonic)
     {
       this->Problem = std::string("vtkRectilinearGrid: its ") + kAxis[a] +
-        " coordinates are not strictly monotonic: nothing drawn";
+        " coordinates are not finite and strictly monotonic: nothing drawn";
       problem = this->Problem;
       return nullptr;
     }

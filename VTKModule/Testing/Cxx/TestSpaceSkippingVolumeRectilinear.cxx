@@ -198,6 +198,23 @@ int TestSpaceSkippingVolumeRectilinear(int argc, char* argv[])
   ours->SetScalarModeToDefault();
   messages->Clear();
 
+  // Coordinates that are not finite and strictly monotonic: one error each, nothing drawn.
+  for (double bad : { std::numeric_limits<double>::quiet_NaN(),
+         std::numeric_limits<double>::infinity(), 0.0 })
+  {
+    auto broken = MakeGrid(
+      image, [&](int a, int i) { return a == 1 && i == ext[2] + 5 ? bad : double(i); }, index);
+    ours->SetInputData(uniform); // a drawn frame between: the same problem is said again
+    scene.Shot();
+    messages->Clear();
+    ours->SetInputData(broken);
+    auto shot = scene.Shot();
+    check(messages->ErrorCount == 1 && messages->Errors.find("strictly monotonic") != std::string::npos &&
+        sstest::CountNonBackground(shot, sstest::kNavy) == 0,
+      "y coordinate " + std::to_string(bad) + " at index 5: one error, nothing drawn");
+  }
+  messages->Clear();
+
   // Non-uniform x (steps growing by a factor ~3 across the grid): drawn resampled, one warning.
   auto stretched = MakeGrid(
     image,
