@@ -130,6 +130,8 @@ public:
   int GetPath() const { return this->Path; }
   /// The last image made (null when none).
   vtkImageData* GetImage() const { return this->Image; }
+  /// Lets go of the last image (the input is no longer a grid); the next From makes one again.
+  void Release() { *this = vtkSpaceSkipRectilinearImage(); }
 
 private:
   vtkSmartPointer<vtkImageData> Image;

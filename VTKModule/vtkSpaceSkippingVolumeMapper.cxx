@@ -439,6 +439,10 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
     }
     resampled = d.Rectilinear.GetPath() == 2;
   }
+  else if (d.Rectilinear.GetImage())
+  {
+    d.Rectilinear.Release(); // a grid's image (a resampled copy) is not kept for an image input
+  }
   d.RenderImage(ren, vol, renWin, cam, image, resampled);
 }
 
