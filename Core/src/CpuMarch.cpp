@@ -42,7 +42,7 @@ inline LaneSetup setupLane(const FrameView& f, int px, int py) {
   }
   const float t0 = a + lead;
   // Every run of the ray lies in [a, b): its sample indices are at most this one's.
-  const int64_t kEnd = int64_t(ceilf((b - t0) / f.dt));
+  const int64_t kEnd = sampleIndexCeil((b - t0) / f.dt);
   constexpr int64_t kExact = int64_t(1) << 24;  // float(k) exact in a float lane
   if (kEnd > kExact) {
     s.kind = LaneSetup::Scalar;
@@ -90,8 +90,8 @@ struct LaneRuns {
   bool next(float t0, float dt, int64_t& kBegin, int64_t& kEnd) {
     float a, b;
     while (run(a, b)) {
-      kBegin = int64_t(ceilf((a - t0) / dt));
-      kEnd = int64_t(ceilf((b - t0) / dt));
+      kBegin = sampleIndexCeil((a - t0) / dt);
+      kEnd = sampleIndexCeil((b - t0) / dt);
       if (kBegin < nextK) kBegin = nextK;
       if (kEnd > nextK) nextK = kEnd;
       if (kBegin < kEnd) return true;

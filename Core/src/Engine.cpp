@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cfloat>
 #include <cmath>
 #include <iostream>
 #include <cstdio>
@@ -672,7 +673,9 @@ void fillBlend(Impl& d, FrameView& f, const MarchFrame& frame) {
   lo = scaled(lo);
   hi = scaled(hi);
   f.normLo = float(lo);
-  f.normScale = hi > lo ? float(1.0 / (hi - lo)) : 0.f;
+  // At most float's largest: a range narrower than 1/FLT_MAX (values near 1e-308) gave an
+  // infinite scale and NaN pixels ((v - lo) * inf with v == lo).
+  f.normScale = hi > lo ? float(std::min(1.0 / (hi - lo), double(FLT_MAX))) : 0.f;
   f.avgLo = float(std::max(scaled(r.averageRange[0]), -double(HUGE_VALF)));
   f.avgHi = float(std::min(scaled(r.averageRange[1]), double(HUGE_VALF)));
   std::vector<double> iso = r.isoValues;

@@ -446,3 +446,24 @@ TEST(Extremes, ScalarRangeParallelSkipsNonFinite) {
   Volume nan = filled(vec3l{4, 4, 4}, VoxelType::Float64, std::nan(""));
   EXPECT_FALSE(nan.scalarRange(lo, hi));
 }
+
+// Found by fuzz_render (issue 41): a double volume whose values lie near DBL_MIN (2.644e-308, the
+// engine's value exponent 1021) drew NaN pixels in MIP and MinIP (an infinite normalising
+// scale); the seed is Testing/Fuzz/corpus/render/nan_image_double_value_2.6e-308_minip.
+TEST(Extremes, ValuesNearDoubleMinimumDrawFiniteInEveryBlendMode) {
+  for (double value : {2.644e-308, 2.3e-308, 1e-300}) {
+    Volume v = filled(vec3l{2, 2, 2}, VoxelType::Float64, value);
+    reinterpret_cast<double*>(v.mutableData())[0] = 0.5 * value;
+    auto tf = TransferFunction::preset("ramp", 0.5 * value, value);
+    for (BlendMode m : {BlendMode::Composite, BlendMode::MaximumIntensity, BlendMode::MinimumIntensity,
+                        BlendMode::Additive, BlendMode::AverageIntensity}) {
+      RenderParams rp;
+      rp.blend = m;
+      for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid}) {
+        Image img = test::renderWith(v, tf, test::builder(k), 30, 20, false, 16, BackendKind::CPU, rp);
+        EXPECT_FALSE(hasNonFinite(img)) << "value " << value << " blend " << int(m) << " builder " << int(k);
+        EXPECT_GT(test::coverage(img), 0.01) << "value " << value << " blend " << int(m);
+      }
+    }
+  }
+}

@@ -11,6 +11,14 @@
 
 namespace spaceskip {
 
+/// Index of the first lattice sample at or after (t - t0) / dt = x: ceil(x) as int64_t, with x
+/// clamped to +-2^62 first (a far origin or extreme spacings can give 1e30 and more; converting
+/// that to an integer is undefined) and NaN taken as 0.
+SS_FUNC int64_t sampleIndexCeil(float x) {
+  constexpr float kLimit = 4.611686e18f;  // 2^62
+  return x == x ? int64_t(ceilf(ss_clamp(x, -kLimit, kLimit))) : int64_t(0);
+}
+
 /// Blend modes whose result a brick can change although the TF gives it no opacity (MIP, MinIP:
 /// the extreme sample is mapped after the march; average: transparent samples count), or whose
 /// skipping test depends on the ray (isosurface). They march the range grid with the ray-dependent
@@ -297,8 +305,8 @@ struct IntervalMarcher {
   /// The samples of interval [a, b) not taken yet: k in [kBegin, kEnd). Marks them as taken.
   SS_FUNC void range(float a, float b, int64_t& kBegin, int64_t& kEnd) {
     const float dt = f->dt;
-    kBegin = int64_t(ceilf((a - t0) / dt));
-    kEnd = int64_t(ceilf((b - t0) / dt));
+    kBegin = sampleIndexCeil((a - t0) / dt);
+    kEnd = sampleIndexCeil((b - t0) / dt);
     if (kBegin < nextK) kBegin = nextK;
     if (kEnd > nextK) nextK = kEnd;
   }
@@ -604,7 +612,7 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py, 
       if (segments > 1) {
         m.t0 = a + lead;
         anchored = true;
-        const int64_t k0 = int64_t(ceilf((a - m.t0) / f.dt)), n = int64_t(ceilf((b - m.t0) / f.dt)) - k0;
+        const int64_t k0 = sampleIndexCeil((a - m.t0) / f.dt), n = sampleIndexCeil((b - m.t0) / f.dt) - k0;
         if (segment > 0) sa = m.t0 + float(k0 + n * segment / segments) * f.dt;
         if (segment < segments - 1) sb = m.t0 + float(k0 + n * (segment + 1) / segments) * f.dt;
       }
