@@ -173,8 +173,9 @@ run_tests() {  # BACKEND LOGNAME [WINDOW] (BACKEND "asis": each test's own Backe
     "$ongpu tests kept an image on the GPU (interop); renderers: $(grep -o 'GL_RENDERER [^,]*' "$work/$name" | sort | uniq -c | tr '\n' ';')" >> "$work/$name"
   [ $fail -eq 0 ] || status=1
 }
-summarize_tests() {  # LOGNAME
-  grep -E "^SUMMARY|rc=|SpaceSkip: backend|Backend|PSNR|max diff|check failed|ERROR|Warning|error|RSS|device bytes" \
+summarize_tests() {  # LOGNAME (the summary first: the details are cut at 400 lines)
+  grep -E "^SUMMARY" "$work/$1"
+  grep -E "rc=|SpaceSkip: backend|Backend|PSNR|max diff|check failed|ERROR|Warning|error|RSS|device bytes" \
     "$work/$1" | head -400
 }
 if has tests && ! late; then
@@ -235,8 +236,8 @@ window_bench() {  # SHAPE N [--vtk-gpu] [--egl]
 }
 vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
-# The benchmark's window: NVIDIA's GLX finds no config on Xvfb, so first try a
-# vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl), else the tests' X window.
+# The benchmark's window: first a vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl),
+# else the tests' X window.
 if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor || has bench-oldnew; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json

@@ -33,8 +33,8 @@
 // edit_cut_ms / edit_back_ms split edit_ms into the edits that raise the threshold to
 // --edit-cut (they empty bricks) and those that lower it back (they occupy bricks).
 // --egl: a vtkGenericOpenGLRenderWindow on an EGL pbuffer context (libEGL.so.1, e.g. NVIDIA's
-// headless EGL) instead of an X window: Debian's VTK has no EGL window, and NVIDIA's GLX finds no
-// config on Xvfb. GLEW's GLX part still wants an X display (Xvfb): see glXGetCurrentDisplay below.
+// headless EGL) instead of an X window: Debian's VTK has no EGL window (SpaceSkipEglWindow.h makes
+// one; GLEW's GLX part still wants an X display, Xvfb).
 #include "vtkCamera.h"
 #include "vtkColorTransferFunction.h"
 #include "vtkGPUVolumeRayCastMapper.h"
