@@ -36,6 +36,25 @@ void expectBuildersEqualNaive(const Volume& v, const TransferFunction& tf, const
   }
 }
 
+
+// The transfer functions every builder test draws `v` with: the ramp over its range (tf), the
+// same with a 2-D box from 0.02 of the range, where the 1-D ramp is transparent so that a 1-D
+// occupancy would lose it (tf2), and with a gradient opacity that fades flat regions out (go).
+struct GradientCases {
+  TransferFunction tf, tf2, go;
+};
+GradientCases gradientCases(const Volume& v) {
+  double lo = 0, hi = 1;
+  EXPECT_TRUE(v.scalarRange(lo, hi));
+  GradientCases c;
+  c.tf = TransferFunction::preset("ramp", lo, hi, 256);
+  c.tf2 = c.tf;
+  setBox(c.tf2, 48, 24, 0.02f, 0.9f, 0.05f, 0.6f, 0.7f);
+  c.go = c.tf;
+  c.go.gradientOpacity.resize(1024);
+  for (size_t i = 0; i < c.go.gradientOpacity.size(); ++i) c.go.gradientOpacity[i] = float(i) / 1023.f;
+  return c;
+}
 }  // namespace
 
 TEST(GradientTF, EveryBuilderEqualsNaiveWith2DTableAndGradientOpacity) {
@@ -43,21 +62,12 @@ TEST(GradientTF, EveryBuilderEqualsNaiveWith2DTableAndGradientOpacity) {
     Volume v = generateVolume(shape, vec3l{40, 42, 37});
     v.spacing[0] = 0.8;  // anisotropic: the gradient's per-axis normalisation matters
     v.spacing[2] = 1.3;
-    double lo, hi;
-    ASSERT_TRUE(v.scalarRange(lo, hi));
-    TransferFunction tf = TransferFunction::preset("ramp", lo, hi, 256);
-    TransferFunction tf2 = tf;
-    // From 0.02 of the range: where the 1-D ramp is transparent (so the 1-D occupancy would lose it).
-    setBox(tf2, 48, 24, 0.02f, 0.9f, 0.05f, 0.6f, 0.7f);
+    const auto [tf, tf2, go] = gradientCases(v);
     for (bool shade : {false, true}) {
       RenderParams rp;
       rp.shade = shade;
       expectBuildersEqualNaive(v, tf2, rp, (std::string(shape) + " 2-D" + (shade ? " shaded" : "")).c_str());
     }
-    TransferFunction go = tf;
-    go.gradientOpacity.resize(1024);
-    for (size_t i = 0; i < go.gradientOpacity.size(); ++i)
-      go.gradientOpacity[i] = float(i) / 1023.f;  // flat regions fade out
     expectBuildersEqualNaive(v, go, RenderParams{}, (std::string(shape) + " gradient opacity").c_str());
     // Both change the image (the tests above could not pass by ignoring them).
     const Image plain = test::renderWith(v, tf, test::builder(BuilderKind::Grid), 30, 20, true, 48);
@@ -134,18 +144,11 @@ TEST(GradientTF, CudaBuildersEqualCpuNaive) {
   for (const char* shape : {"vessels", "nbody"}) {
     Volume v = generateVolume(shape, vec3l{64, 61, 67});
     v.spacing[1] = 0.7;
-    double lo, hi;
-    ASSERT_TRUE(v.scalarRange(lo, hi));
-    TransferFunction tf = TransferFunction::preset("ramp", lo, hi, 256);
-    TransferFunction tf2 = tf;
-    setBox(tf2, 48, 24, 0.02f, 0.9f, 0.05f, 0.6f, 0.7f);
+    const auto [tf, tf2, go] = gradientCases(v);
     RenderParams rp, shaded;
     shaded.shade = true;
     test::expectCudaBuildersEqualCpuNaive(v, tf2, rp, std::string(shape) + " 2-D");
     test::expectCudaBuildersEqualCpuNaive(v, tf2, shaded, std::string(shape) + " 2-D shaded");
-    TransferFunction go = tf;
-    go.gradientOpacity.resize(1024);
-    for (size_t i = 0; i < go.gradientOpacity.size(); ++i) go.gradientOpacity[i] = float(i) / 1023.f;
     test::expectCudaBuildersEqualCpuNaive(v, go, rp, std::string(shape) + " gradient opacity");
   }
 }

@@ -269,3 +269,35 @@ class Checker:
             sys.stdout.flush()
             os._exit(1)
         print("all checks passed")
+
+
+class VersusStock:
+    """One display drawn as Space Skipping Volume and as ParaView's own Volume in `view`, the
+    frames saved as PREFIX_NAME_ss.png / PREFIX_NAME_stock.png."""
+
+    def __init__(self, view, disp, ok, prefix):
+        self.view, self.disp, self.ok, self.prefix = view, disp, ok, prefix
+
+    def shoot(self, name, kind):
+        self.disp.SetRepresentationType(kind)
+        tag = "ss" if kind != "Volume" else "stock"
+        return read_png(render_to(self.view, "%s_%s_%s.png" % (self.prefix, name, tag)))
+
+    def both(self, name):
+        """Both images (ours, stock), ours shown after; checks that ours draws and matches the
+        stock image (PSNR >= 40 dB)."""
+        ours, stock = self.shoot(name, "Space Skipping Volume"), self.shoot(name, "Volume")
+        self.disp.SetRepresentationType("Space Skipping Volume")
+        p = psnr(ours, stock)
+        lit = lit_fraction(ours)
+        print("%s: lit %.3f, PSNR Space Skipping Volume vs Volume %.2f dB" % (name, lit, p))
+        self.ok.check(lit > 0.02, "%s draws something (%.1f%% of the pixels)" % (name, 100 * lit))
+        self.ok.check(p >= 40.0, "%s: matches ParaView's Volume (PSNR %.2f >= 40 dB)" % (name, p))
+        return ours, stock
+
+    def changes(self, what, a, b, max_psnr=30.0):
+        """Checks that a setting changed both images: a and b are both()'s (ours, stock) pairs."""
+        ours, stock = psnr(a[0], b[0]), psnr(a[1], b[1])
+        print("  %s: PSNR ours %.2f dB, ParaView's Volume %.2f dB" % (what, ours, stock))
+        self.ok.check(ours < max_psnr and stock < max_psnr,
+                      "%s changes the image (ours %.1f, stock %.1f dB)" % (what, ours, stock))

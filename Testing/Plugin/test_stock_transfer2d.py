@@ -46,28 +46,8 @@ tf2d.Boxes = box
 tf2d.SMProxy.InvokeCommand("Build")  # what the GUI's 2-D editor does after an edit
 
 
-def shoot(name, kind):
-    disp.SetRepresentationType(kind)
-    tag = "ss" if kind != "Volume" else "stock"
-    return ssptest.read_png(ssptest.render_to(view, "transfer2d_%s_%s.png" % (name, tag)))
-
-
-def both(name):
-    ours, stock = shoot(name, "Space Skipping Volume"), shoot(name, "Volume")
-    disp.SetRepresentationType("Space Skipping Volume")
-    p = ssptest.psnr(ours, stock)
-    lit = ssptest.lit_fraction(ours)
-    print("%s: lit %.3f, PSNR Space Skipping Volume vs Volume %.2f dB" % (name, lit, p))
-    ok.check(lit > 0.02, "%s draws something (%.1f%% of the pixels)" % (name, 100 * lit))
-    ok.check(p >= 40.0, "%s: matches ParaView's Volume (PSNR %.2f >= 40 dB)" % (name, p))
-    return ours, stock
-
-
-def changes(what, a, b, max_psnr=30.0):
-    ours, stock = ssptest.psnr(a[0], b[0]), ssptest.psnr(a[1], b[1])
-    print("  %s: PSNR ours %.2f dB, ParaView's Volume %.2f dB" % (what, ours, stock))
-    ok.check(ours < max_psnr and stock < max_psnr,
-             "%s changes the image (ours %.1f, stock %.1f dB)" % (what, ours, stock))
+versus = ssptest.VersusStock(view, disp, ok, "transfer2d")
+shoot, both, changes = versus.shoot, versus.both, versus.changes
 
 
 disp.UseTransfer2D = 0

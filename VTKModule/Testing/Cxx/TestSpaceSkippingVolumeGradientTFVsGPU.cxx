@@ -42,16 +42,11 @@ vtkSmartPointer<vtkImageData> MakeBox2D(int w, int h, double x0, double x1, doub
 
 int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
 {
-  auto image = sstest::MakeWavelet(64);
-  double range[2];
-  image->GetScalarRange(range);
-  const double lo = range[0], hi = range[1];
-  const double sampleDistance = 0.5;
-
-  auto gpu = sstest::ReferenceGPUMapper(image, sampleDistance);
-  auto ours = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::Grid, sampleDistance, false);
-  sstest::Scene scene(ours, 256, 256);
-  scene.View(35, 25, 1.6, true);
+  sstest::VsGPUScene vs;
+  const double lo = vs.Lo, hi = vs.Hi;
+  vtkGPUVolumeRayCastMapper* gpu = vs.Gpu;
+  vtkSpaceSkippingVolumeMapper* ours = vs.Ours;
+  sstest::Scene& scene = vs.Stage;
   vtkVolumeProperty* prop = scene.Property;
   vtkVolume* volume = scene.Volume;
   vtkRenderer* ren = scene.Renderer;
@@ -88,9 +83,7 @@ int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
   };
   const Case cases[] = { { "1d", plain }, { "2d", twoD }, { "2d-shade", twoDShaded },
     { "gradient-opacity", gradient } };
-  double worst = std::numeric_limits<double>::infinity();
   vtkSmartPointer<vtkImageData> plainImage;
-  int failures = 0;
   for (const Case& c : cases)
   {
     vtkNew<vtkVolumeProperty> fresh;
@@ -105,18 +98,7 @@ int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
     volume->SetMapper(ours);
     win->Render();
     auto b = sstest::Capture(win);
-    const double psnr = sstest::PrintComparison(c.name, a, b);
-    std::cout << "\n";
-    const vtkIdType drawn = sstest::CountNonBackground(b, sstest::kBlack);
-    const std::string prefix = dir + "/TestSpaceSkippingVolumeGradientTFVsGPU-" + c.name;
-    sstest::WritePNG(a, prefix + "-gpu.png");
-    sstest::WritePNG(b, prefix + "-ours.png");
-    worst = std::min(worst, psnr);
-    if (drawn < 1000 || psnr < kMinPSNR)
-    {
-      std::cout << "  FAILED\n";
-      ++failures;
-    }
+    vs.Judge(dir, "TestSpaceSkippingVolumeGradientTFVsGPU", c.name, a, b, kMinPSNR);
     if (!plainImage)
     {
       plainImage = b;
@@ -129,11 +111,11 @@ int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
       if (sstest::MaxDiff(plainImage, b) < 20)
       {
         std::cout << "  FAILED: the same image as without it\n";
-        ++failures;
+        ++vs.Failures;
       }
     }
   }
-  std::cout << "worst PSNR " << worst << " dB (threshold " << kMinPSNR << ")\n";
-  SS_CHECK(failures == 0);
+  std::cout << "worst PSNR " << vs.Worst << " dB (threshold " << kMinPSNR << ")\n";
+  SS_CHECK(vs.Failures == 0);
   return EXIT_SUCCESS;
 }

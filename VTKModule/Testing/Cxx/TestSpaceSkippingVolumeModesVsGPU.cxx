@@ -32,17 +32,11 @@ void SetupLowProperty(vtkVolumeProperty* prop, double lo, double hi)
 
 int TestSpaceSkippingVolumeModesVsGPU(int argc, char* argv[])
 {
-  auto image = sstest::MakeWavelet(64);
-  double range[2];
-  image->GetScalarRange(range);
-  const double lo = range[0], hi = range[1];
-  const double sampleDistance = 0.5;
-
-  auto gpu = sstest::ReferenceGPUMapper(image, sampleDistance);
-  auto ours = sstest::NewMapper(image, vtkSpaceSkippingVolumeMapper::Grid, sampleDistance, false);
-  sstest::Scene scene(ours, 256, 256);
-  // Zoom (the view angle) and the turns commute: the order of the calls does not matter.
-  scene.View(35, 25, 1.6, true);
+  sstest::VsGPUScene vs;
+  const double lo = vs.Lo, hi = vs.Hi;
+  vtkGPUVolumeRayCastMapper* gpu = vs.Gpu;
+  vtkSpaceSkippingVolumeMapper* ours = vs.Ours;
+  sstest::Scene& scene = vs.Stage;
   vtkVolumeProperty* prop = scene.Property;
   vtkVolume* volume = scene.Volume;
   vtkRenderer* ren = scene.Renderer;
@@ -97,9 +91,7 @@ int TestSpaceSkippingVolumeModesVsGPU(int argc, char* argv[])
     { "isosurface-shade-perspective", vtkVolumeMapper::ISOSURFACE_BLEND, isoShaded, true },
     { "isosurface-perspective", vtkVolumeMapper::ISOSURFACE_BLEND, iso, true },
   };
-  double worst = std::numeric_limits<double>::infinity();
   vtkSmartPointer<vtkImageData> compositeImage;
-  int failures = 0;
   for (const Case& c : cases)
   {
     vtkNew<vtkVolumeProperty> fresh; // no state left over from the previous case
@@ -111,18 +103,7 @@ int TestSpaceSkippingVolumeModesVsGPU(int argc, char* argv[])
     ren->ResetCameraClippingRange();
     auto a = RenderWith(win, volume, gpu, c.blend);
     auto b = RenderWith(win, volume, ours, c.blend);
-    const double psnr = sstest::PrintComparison(c.name, a, b);
-    std::cout << "\n";
-    const vtkIdType drawn = sstest::CountNonBackground(b, sstest::kBlack);
-    const std::string prefix = dir + "/TestSpaceSkippingVolumeModesVsGPU-" + c.name;
-    sstest::WritePNG(a, prefix + "-gpu.png");
-    sstest::WritePNG(b, prefix + "-ours.png");
-    worst = std::min(worst, psnr);
-    if (drawn < 1000 || psnr < kMinPSNR)
-    {
-      std::cout << "  FAILED\n";
-      ++failures;
-    }
+    vs.Judge(dir, "TestSpaceSkippingVolumeModesVsGPU", c.name, a, b, kMinPSNR);
     if (!compositeImage)
     {
       compositeImage = b;
@@ -130,10 +111,10 @@ int TestSpaceSkippingVolumeModesVsGPU(int argc, char* argv[])
     else if (sstest::MaxDiff(compositeImage, b) < 20)
     {
       std::cout << "  FAILED: the same image as composite\n";
-      ++failures;
+      ++vs.Failures;
     }
   }
-  std::cout << "worst PSNR " << worst << " dB (threshold " << kMinPSNR << ")\n";
-  SS_CHECK(failures == 0);
+  std::cout << "worst PSNR " << vs.Worst << " dB (threshold " << kMinPSNR << ")\n";
+  SS_CHECK(vs.Failures == 0);
   return EXIT_SUCCESS;
 }
