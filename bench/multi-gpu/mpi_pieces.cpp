@@ -1,0 +1,283 @@
+// One MPI rank per GPU: each rank renders its slab of one volume with the engine (the whole
+// volume's sample lattice, its own cells only: VolumePiece.h), the ranks composite the float
+// images by direct send (each rank blends one band of rows from every rank in visibility
+// order, PieceOrder.h) and rank 0 gathers the bands. Frames are waited for; the frame time is
+// the slowest rank's render + download, the exchange, the blend and the gather.
+//
+// This is the benchmark's stand-in for ParaView's engine (pvbatch with float compositing does
+// the same steps: each rank draws its piece into a float image, the images are blended in
+// visibility order), made because pvbatch and its closure (414 libraries, 650 MB) cannot travel
+// to the GPU machines in one call. Not part of the product.
+//
+//   mpiexec -n N spaceskip_mpi_pieces [--shape nbody] [--dims 2048] [--size 1024] [--frames 30]
+//       [--builder Auto] [--backend auto|cpu|cuda] [--tf ramp] [--check] [--png out.png]
+// --check: rank 0 also renders the whole volume alone and prints the largest difference of
+// the composited image from it (8-bit units).
+#include "spaceskip/Camera.h"
+#include "spaceskip/Engine.h"
+#include "spaceskip/Generators.h"
+#include "spaceskip/ImageIO.h"
+#include "spaceskip/PieceOrder.h"
+#include "spaceskip/Volume.h"
+
+#include <mpi.h>
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+#include <cuda_runtime.h>
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+using namespace spaceskip;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Args {
+  std::string shape = "nbody", builder = "Auto", backend = "auto", tf = "ramp", png;
+  int64_t dims = 256;
+  int size = 512, frames = 20;
+  bool check = false;
+};
+
+Args parse(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    std::string k = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "%s needs a value\n", k.c_str());
+        MPI_Abort(MPI_COMM_WORLD, 2);
+      }
+      return argv[++i];
+    };
+    if (k == "--shape") a.shape = next();
+    else if (k == "--dims") a.dims = std::atoll(next().c_str());
+    else if (k == "--size") a.size = std::atoi(next().c_str());
+    else if (k == "--frames") a.frames = std::atoi(next().c_str());
+    else if (k == "--builder") a.builder = next();
+    else if (k == "--backend") a.backend = next();
+    else if (k == "--tf") a.tf = next();
+    else if (k == "--png") a.png = next();
+    else if (k == "--check") a.check = true;
+    else {
+      std::fprintf(stderr, "unknown option %s\n", k.c_str());
+      MPI_Abort(MPI_COMM_WORLD, 2);
+    }
+  }
+  if (a.dims < 8 || a.size < 8 || a.frames < 1) {
+    std::fprintf(stderr, "--dims and --size must be >= 8, --frames >= 1\n");
+    MPI_Abort(MPI_COMM_WORLD, 2);
+  }
+  return a;
+}
+
+double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+BackendKind backendOf(const std::string& s) {
+  if (s == "cpu") return BackendKind::CPU;
+  if (s == "cuda") return BackendKind::CUDA;
+  return BackendKind::Auto;
+}
+
+/// Premultiplied front-to-back "over": back is added where front leaves light through.
+void over(vec4f* acc, const vec4f* back, size_t n) {
+  for (size_t i = 0; i < n; ++i) {
+    const float t = 1.f - acc[i].w;
+    acc[i].x += t * back[i].x;
+    acc[i].y += t * back[i].y;
+    acc[i].z += t * back[i].z;
+    acc[i].w += t * back[i].w;
+  }
+}
+
+int to8(float v) { return int(std::lround(std::min(1.f, std::max(0.f, v)) * 255.f)); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const Args a = parse(argc, argv);
+
+  // The node-local rank picks the GPU (ranks of one host share its GPUs round-robin).
+  MPI_Comm node;
+  MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
+  int localRank = 0;
+  MPI_Comm_rank(node, &localRank);
+  int device = -1;
+  std::string deviceName = "cpu";
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+  int count = 0;
+  if (a.backend != "cpu" && cudaGetDeviceCount(&count) == cudaSuccess && count > 0) {
+    device = localRank % count;
+    cudaSetDevice(device);
+    cudaDeviceProp prop{};
+    cudaGetDeviceProperties(&prop, device);
+    char bus[32] = {};
+    cudaDeviceGetPCIBusId(bus, sizeof bus, device);
+    deviceName = std::string(prop.name) + " " + bus;
+  }
+#endif
+
+  // Every rank makes the whole volume (the generators are deterministic) and draws a slab of
+  // it along z: cells [z0, z1), its points with one ghost layer on each side.
+  const auto t0 = Clock::now();
+  Volume whole = generateVolume(a.shape, vec3l{a.dims, a.dims, a.dims});
+  double lo = 0, hi = 1;
+  if (!whole.scalarRange(lo, hi)) lo = 0, hi = 1;
+  const TransferFunction tf = TransferFunction::preset(a.tf, lo, hi);
+  const int64_t cells = whole.dims.z - 1;
+  const int64_t z0 = cells * rank / ranks, z1 = cells * (rank + 1) / ranks;
+  const int64_t p0 = std::max<int64_t>(z0 - 1, 0), p1 = std::min<int64_t>(z1 + 1, whole.dims.z - 1);
+  Volume piece = whole;
+  piece.storage.reset();
+  piece.dims.z = p1 - p0 + 1;
+  piece.origin[2] = whole.origin[2] + whole.spacing[2] * double(p0);
+  piece.data = static_cast<const unsigned char*>(whole.data) +
+               size_t(p0) * size_t(whole.dims.x * whole.dims.y) * voxelSize(whole.type);
+  VolumePiece vp;
+  vp.wholeDims = whole.dims;
+  std::copy(whole.origin, whole.origin + 3, vp.wholeOrigin);
+  vp.offset = vec3l{0, 0, p0};
+  vp.ownedLo = vec3l{0, 0, z0};
+  vp.ownedHi = vec3l{whole.dims.x - 1, whole.dims.y - 1, z1};
+
+  Engine engine(backendOf(a.backend), [rank](const std::string& m) {
+    std::fprintf(stderr, "[rank %d] %s\n", rank, m.c_str());
+  });
+  BuildParams bp;
+  if (!parseBuilder(a.builder, bp.builder)) {
+    if (rank == 0) std::fprintf(stderr, "unknown builder %s\n", a.builder.c_str());
+    MPI_Abort(MPI_COMM_WORLD, 2);
+  }
+  engine.setBuildParams(bp);
+  engine.setVolume(piece);
+  engine.setPiece(vp);
+  engine.setTransferFunction(tf);
+
+  double b6[6];
+  whole.worldBounds(b6);
+  const int w = a.size, h = a.size;
+  auto camera = [&](int f) { return orbitCamera(b6, 360.0 * f / a.frames, 15, 1, false, double(w) / h); };
+
+  // Bands of rows: rank r blends rows [rowLo(r), rowLo(r + 1)).
+  auto rowLo = [&](int r) { return int(int64_t(h) * r / ranks); };
+  std::vector<int> counts(ranks), displs(ranks);
+  for (int r = 0; r < ranks; ++r) {
+    counts[r] = (rowLo(r + 1) - rowLo(r)) * w * 4;
+    displs[r] = rowLo(r) * w * 4;
+  }
+  const int myRows = rowLo(rank + 1) - rowLo(rank);
+  std::vector<vec4f> recv(size_t(myRows) * w * ranks), band(size_t(myRows) * w);
+  std::vector<int> recvCounts(ranks, myRows * w * 4), recvDispls(ranks);
+  for (int r = 0; r < ranks; ++r) recvDispls[r] = r * myRows * w * 4;
+  std::vector<PieceBox> boxes(ranks);
+  for (int r = 0; r < ranks; ++r)
+    boxes[r] = {0.0, double(whole.dims.x - 1), 0.0, double(whole.dims.y - 1), double(cells * r / ranks),
+                double(cells * (r + 1) / ranks)};
+  Image img, final;
+  if (rank == 0) final.width = w, final.height = h, final.rgba.resize(size_t(w) * h);
+
+  struct Times {
+    double render = 0, exchange = 0, blend = 0, gather = 0, frame = 0;
+  };
+  auto frame = [&](int f, Times& t) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    const auto s0 = Clock::now();
+    const Camera cam = camera(f);
+    engine.render(cam, w, h, img);  // waited for: the image is on the host
+    const auto s1 = Clock::now();
+    MPI_Alltoallv(img.rgba.data(), counts.data(), displs.data(), MPI_FLOAT, recv.data(), recvCounts.data(),
+                  recvDispls.data(), MPI_FLOAT, MPI_COMM_WORLD);
+    const auto s2 = Clock::now();
+    // The view direction in the volume's index space (spacing 1, axis-aligned generators).
+    const double dir[3] = {-cam.view.m[2], -cam.view.m[6], -cam.view.m[10]};
+    const double eye[3] = {0, 0, 0};
+    const std::vector<size_t> order = visibilityOrder(boxes, eye, dir, true);
+    std::fill(band.begin(), band.end(), vec4f{0, 0, 0, 0});
+    for (auto it = order.rbegin(); it != order.rend(); ++it) { size_t r = *it; over(band.data(), recv.data() + size_t(r) * myRows * w, band.size()); }
+    const auto s3 = Clock::now();
+    MPI_Gatherv(band.data(), myRows * w * 4, MPI_FLOAT, rank == 0 ? final.rgba.data() : nullptr, counts.data(),
+                displs.data(), MPI_FLOAT, 0, MPI_COMM_WORLD);
+    const auto s4 = Clock::now();
+    t.render += seconds(s0, s1), t.exchange += seconds(s1, s2), t.blend += seconds(s2, s3);
+    t.gather += seconds(s3, s4), t.frame += seconds(s0, s4);
+  };
+
+  Times warm;
+  const auto firstStart = Clock::now();
+  frame(0, warm);  // first frame: upload, ranges, classification, build
+  const double first = seconds(firstStart, Clock::now());
+  const double setup = seconds(t0, firstStart);
+  for (int i = 0; i < 3; ++i) frame(0, warm);  // Auto measures its candidates
+  Times t;
+  for (int f = 0; f < a.frames; ++f) frame(f, t);
+  // The slowest rank's render is what the frame waited for.
+  double renderMax = 0, renderMin = 0;
+  MPI_Reduce(&t.render, &renderMax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+  MPI_Reduce(&t.render, &renderMin, 1, MPI_DOUBLE, MPI_MIN, 0, MPI_COMM_WORLD);
+  const double kernel = engine.frameStats().deviceSeconds;
+
+  // Each rank's device and builder, in rank order.
+  char line[256];
+  std::snprintf(line, sizeof line, "rank %d: local rank %d, device %d (%s), builder %s, slab z cells [%lld, %lld)",
+                rank, localRank, device, deviceName.c_str(), builderName(engine.buildStats().builder),
+                (long long)z0, (long long)z1);
+  std::vector<char> lines(rank == 0 ? size_t(ranks) * sizeof line : 0);
+  MPI_Gather(line, sizeof line, MPI_CHAR, lines.data(), sizeof line, MPI_CHAR, 0, MPI_COMM_WORLD);
+
+  if (rank == 0) {
+    for (int r = 0; r < ranks; ++r) std::printf("%s\n", lines.data() + size_t(r) * sizeof line);
+    const double n = a.frames;
+    std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s\n", ranks, a.shape.c_str(),
+                (long long)a.dims, w, h, a.frames, engine.backendName());
+    std::printf("setup_s %.3f first_frame_s %.4f\n", setup, first);
+    std::printf("frame_ms %.3f fps %.1f render_ms(rank0) %.3f render_ms(max) %.3f render_ms(min) %.3f "
+                "exchange_ms %.3f blend_ms %.3f gather_ms %.3f last_kernel_ms %.3f\n",
+                1e3 * t.frame / n, n / t.frame, 1e3 * t.render / n, 1e3 * renderMax / n, 1e3 * renderMin / n,
+                1e3 * t.exchange / n, 1e3 * t.blend / n, 1e3 * t.gather / n, 1e3 * kernel);
+    if (!a.png.empty()) savePng(final, a.png);
+  }
+
+  if (a.check) {
+    // The last frame's composite against the whole volume drawn alone (rank 0).
+    int bad = 0;
+    if (rank == 0) {
+      Engine ref(backendOf(a.backend));
+      ref.setBuildParams(bp);
+      ref.setVolume(whole);
+      ref.setTransferFunction(tf);
+      Image serial;
+      ref.render(camera(a.frames - 1), w, h, serial);
+      int maxDiff = 0;
+      size_t off = 0;
+      for (size_t i = 0; i < serial.rgba.size(); ++i) {
+        const vec4f& p = serial.rgba[i];
+        const vec4f& q = final.rgba[i];
+        const int d = std::max({std::abs(to8(p.x) - to8(q.x)), std::abs(to8(p.y) - to8(q.y)),
+                                std::abs(to8(p.z) - to8(q.z)), std::abs(to8(p.w) - to8(q.w))});
+        maxDiff = std::max(maxDiff, d);
+        off += d > 1;
+      }
+      std::printf("check: %d ranks vs the whole volume alone: max |diff| %d/255, pixels > 1/255: %zu\n", ranks,
+                  maxDiff, off);
+      bad = maxDiff > 1;
+    }
+    MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    MPI_Comm_free(&node);
+    MPI_Finalize();
+    return bad ? 1 : 0;
+  }
+  MPI_Comm_free(&node);
+  MPI_Finalize();
+  return 0;
+}
