@@ -38,6 +38,12 @@ if [ "${SPACESKIP_PIP_VTK:-1}" != 0 ]; then
   echo "   (25.9 dB < 40: VTK 9.5 lights 4 dependent components by component 3's gradient, the"
   echo "   mapper by component 0's as VTK 9.2 does; docs/rendering.md, docs/results/pip-vtk)"
   bash "$root/scripts/pip-vtk/build.sh" -R SpaceSkipping -E 'TestSpaceSkippingVolumeRGBA$'
+  # The `spaceskip` wheel (PythonWheel/, scikit-build-core) in a fresh venv beside vtk + PyVista
+  # from PyPI, five PyVista lines vs PyVista's 'gpu' mapper (>= 40 dB). It needs VTK's wrapping
+  # executables, i.e. SPACESKIP_PIP_VTK_SOURCE; without it wheel.sh says NOT BUILT and why.
+  # Cost with it (2-core dev VM, 2026-11-27): ~150 s wall, most of it compiling Core + module.
+  echo "== the spaceskip wheel + PyVista from PyPI (scripts/pip-vtk/wheel.sh)"
+  bash "$root/scripts/pip-vtk/wheel.sh"
 else
   echo "== VTK from pip: skipped (SPACESKIP_PIP_VTK=0); scripts/pip-vtk/build.sh runs it"
 fi
