@@ -5,6 +5,8 @@
 #include "vtkLogger.h"
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLRenderWindow.h"
+#include "vtkOpenGLShaderCache.h"
+#include "vtkOpenGLState.h"
 #include "vtkRenderer.h"
 #include "vtkSpaceSkipOpenGL.h"
 #include "vtkSpaceSkipSettings.h"
@@ -19,6 +21,8 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
+#include <vector>
 
 namespace
 {
@@ -32,13 +36,137 @@ constexpr int kBackendCUDA = 2;
 }
 
 //------------------------------------------------------------------------------
+// Every message and progress step calls out to the application, which may run its event loop
+// there (ParaView's progress bar: Qt paints its widgets): counted, so that the frame puts the
+// window's GL state back before it touches the framebuffer again (WindowState).
 vtkSpaceSkipImageRenderer::vtkSpaceSkipImageRenderer(
   MessageFunction warnOnce, MessageFunction fail, ProgressFunction progress)
-  : Warn(std::move(warnOnce))
-  , Fail(std::move(fail))
-  , Progress(std::move(progress))
+  : Warn([this, f = std::move(warnOnce)](const std::string& m) {
+    ++this->Callouts;
+    f(m);
+  })
+  , Fail([this, f = std::move(fail)](const std::string& m) {
+    ++this->Callouts;
+    f(m);
+  })
+  , Progress([this, f = std::move(progress)](double fraction, const char* step) {
+    ++this->Callouts;
+    if (f)
+    {
+      f(fraction, step);
+    }
+  })
 {
 }
+
+//------------------------------------------------------------------------------
+// The window's GL state as VTK's state cache had it when the frame began: the framebuffer
+// bindings, viewport, scissor box, blending, depth and colour masks, clear colour, active
+// texture unit. Restore() puts it back after call-outs: an application that painted in this
+// context (Qt's QOpenGLWidget) or made another one current left GL out of step with the cache,
+// and the frame would draw into its framebuffer, or nowhere (a view without the volume).
+class vtkSpaceSkipImageRenderer::WindowState
+{
+public:
+  WindowState(vtkOpenGLRenderWindow* w, const unsigned long& callouts)
+    : Window(w)
+    , Callouts(callouts)
+    , Seen(callouts)
+  {
+    this->Capture();
+  }
+  ~WindowState()
+  {
+    this->Restore();
+    this->Release();
+  }
+  WindowState(const WindowState&) = delete;
+  WindowState& operator=(const WindowState&) = delete;
+
+  /// After call-outs (none: nothing to do): the window's context current again, the cache read
+  /// back from GL, then the captured state applied through it.
+  void Restore()
+  {
+    if (this->Callouts == this->Seen || !this->Window)
+    {
+      return;
+    }
+    this->Seen = this->Callouts;
+    this->Window->MakeCurrent();
+    vtkOpenGLState* ostate = this->Window->GetState();
+    ostate->Reset();
+    // The shader cache's current program may no longer be the bound one: bind on next use.
+    this->Window->GetShaderCache()->ReleaseCurrentShader();
+    this->Release();
+    this->Capture();
+  }
+
+private:
+  void Capture()
+  {
+    vtkOpenGLState* s = this->Window ? this->Window->GetState() : nullptr;
+    if (!s)
+    {
+      return;
+    }
+    s->PushFramebufferBindings();
+    this->Pushed = true;
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglViewport>(s));
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglScissor>(s));
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglBlendFuncSeparate>(s));
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglDepthMask>(s));
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglDepthFunc>(s));
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglColorMask>(s));
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglClearColor>(s));
+    this->Savers.emplace_back(new Saver<vtkOpenGLState::ScopedglActiveTexture>(s));
+    for (unsigned int cap : { GL_BLEND, GL_DEPTH_TEST, GL_SCISSOR_TEST, GL_CULL_FACE, GL_STENCIL_TEST })
+    {
+      this->Savers.emplace_back(new EnableSaver(s, cap));
+    }
+  }
+  // Applies the captured state: each saver sets its value back (through the cache) as it goes,
+  // in reverse order of capture as nested scopes would; the framebuffer bindings last.
+  void Release()
+  {
+    while (!this->Savers.empty())
+    {
+      this->Savers.pop_back();
+    }
+    if (this->Pushed)
+    {
+      this->Window->GetState()->PopFramebufferBindings();
+      this->Pushed = false;
+    }
+  }
+
+  struct AnySaver
+  {
+    virtual ~AnySaver() = default;
+  };
+  template <class T>
+  struct Saver : AnySaver
+  {
+    explicit Saver(vtkOpenGLState* s)
+      : Value(s)
+    {
+    }
+    T Value;
+  };
+  struct EnableSaver : AnySaver
+  {
+    EnableSaver(vtkOpenGLState* s, unsigned int cap)
+      : Value(s, cap)
+    {
+    }
+    vtkOpenGLState::ScopedglEnableDisable Value;
+  };
+
+  vtkOpenGLRenderWindow* Window;
+  const unsigned long& Callouts;
+  unsigned long Seen;
+  bool Pushed = false;
+  std::vector<std::unique_ptr<AnySaver>> Savers;
+};
 
 //------------------------------------------------------------------------------
 spaceskip::Counters vtkSpaceSkipImageRenderer::Counts() const
@@ -111,6 +239,7 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
   vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam, vtkImageData* input, vtkDataArray* scalars,
   int cellFlag, const vtkSpaceSkipSettings& s, const FrameMode& mode)
 {
+  WindowState window(renWin, this->Callouts);
   // Input conversion, first half: what to draw, or why nothing.
   std::string problem;
   if (!this->Input.Select(input, scalars, cellFlag, s.VectorMode, s.VectorComponent,
@@ -146,9 +275,10 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
     {
       return false;
     }
-    this->RenderFrame(renWin, vtkSpaceSkipCompositor::SceneHasDepth(ren), camera, x0, y0, width,
-      height, s, mode);
+    this->RenderFrame(renWin, window, vtkSpaceSkipCompositor::SceneHasDepth(ren), camera, x0, y0,
+      width, height, s, mode);
     this->Deferred = mode.Defer;
+    window.Restore();
     return mode.Defer || this->Composite(renWin, input, camera, width, height, s.EightBitComposite);
   }
   catch (const std::exception& e)
@@ -161,8 +291,8 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
 //------------------------------------------------------------------------------
 // The engine's work: whatever the changes left to do (ranges, upload, classification, build),
 // the depth of what is drawn, the frame; then what ran.
-void vtkSpaceSkipImageRenderer::RenderFrame(vtkOpenGLRenderWindow* renWin, bool sceneHasDepth,
-  const spaceskip::Camera& camera, int x0, int y0, int width, int height,
+void vtkSpaceSkipImageRenderer::RenderFrame(vtkOpenGLRenderWindow* renWin, WindowState& window,
+  bool sceneHasDepth, const spaceskip::Camera& camera, int x0, int y0, int width, int height,
   const vtkSpaceSkipSettings& s, const FrameMode& mode)
 {
   spaceskip::Engine& engine = *this->Engine;
@@ -178,6 +308,7 @@ void vtkSpaceSkipImageRenderer::RenderFrame(vtkOpenGLRenderWindow* renWin, bool 
   // Depth of the opaque geometry already drawn, read from the framebuffer being rendered (not
   // when the scene has nothing but volumes: the buffer holds the far plane only).
   t0 = std::chrono::steady_clock::now();
+  window.Restore(); // the depth is read from the frame's framebuffer
   f.DepthRead = sceneHasDepth;
   this->FrameDepth = sceneHasDepth ? this->Compositor.ReadDepth(renWin, x0, y0, width, height) : nullptr;
   if (sceneHasDepth && !this->FrameDepth)

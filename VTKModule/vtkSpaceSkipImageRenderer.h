@@ -79,13 +79,17 @@ public:
 
 private:
   bool UpdateEngine(int backend);
-  void RenderFrame(vtkOpenGLRenderWindow* renWin, bool sceneHasDepth, const spaceskip::Camera& camera,
+  class WindowState;
+  void RenderFrame(vtkOpenGLRenderWindow* renWin, WindowState& window, bool sceneHasDepth,
+    const spaceskip::Camera& camera,
     int x0, int y0, int width, int height, const vtkSpaceSkipSettings& s, const FrameMode& mode);
   bool Composite(vtkOpenGLRenderWindow* renWin, vtkImageData* input,
     const spaceskip::Camera& camera, int width, int height, bool eightBit);
   void ReportPaths();
   spaceskip::Counters Counts() const;
 
+  // Call-outs to the application so far (messages, progress): see WindowState.
+  unsigned long Callouts = 0;
   MessageFunction Warn;
   MessageFunction Fail;
   ProgressFunction Progress;

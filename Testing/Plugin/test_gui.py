@@ -68,6 +68,14 @@ ok.check(stats.get("FrameCount", 0) >= 1 and stats.get("BuildCount", 0) >= 1,
                                                                 stats.get("BuildCount")))
 # First contact: the representation chosen on a fresh display draws at once (the colour array
 # picked as for ParaView's Volume) and the statistics panel is filled after the first render.
+# The frames drawn in the GUI's own window (not only SaveScreenshot's): the mapper's progress
+# events run Qt's event loop mid-frame, which paints behind VTK's GL state cache; a frame that did
+# not put the window's GL state back drew nothing in the view (ParaView, with its VTK's OpenGL
+# error reporting, logs "Error in cache state" and "OpenGL errors detected" then).
+with open(os.path.join(out, "gui_paraview.log"), errors="replace") as f:
+    gl_log = f.read()
+gl_errors = [l for l in gl_log.splitlines() if "Error in cache state" in l or "OpenGL errors detected" in l]
+ok.check(not gl_errors, "no GL state errors in the GUI's window (%d: %s)" % (len(gl_errors), gl_errors[:2]))
 first = result.get("first", {})
 fstats = first.get("stats", {})
 ok.check(first.get("color_array", ["", ""])[1] == ssptest.ARRAY,
