@@ -359,6 +359,21 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin,
   void* stream, int width, int height, const int rect[4], bool eightBit)
 {
 #ifdef SPACESKIP_HAVE_CUDA
+  // Interop only where the window's GL and the engine's CUDA device are one GPU (one rank per
+  // GPU may bind a CUDA device other than the one the X screen's GL runs on): checked once.
+  if (!this->GLDeviceChecked)
+  {
+    this->GLDeviceChecked = true;
+    if (!this->GLOnCudaDevice())
+    {
+      vtkVLogF(vtkLogger::VERBOSITY_INFO,
+        "vtkSpaceSkippingVolumeMapper: CUDA-GL interop unavailable (%s); the image goes "
+        "through host memory",
+        this->InteropProblem.c_str());
+      this->InteropFailed = true;
+      return false;
+    }
+  }
   if (this->BlendIntoFramebuffer(renWin, image, stream, width, height, rect, eightBit))
   {
     this->Direct = true;
@@ -385,6 +400,78 @@ bool vtkSpaceSkipCompositor::CopyDeviceImage(vtkOpenGLRenderWindow* renWin,
   this->ReleaseInterop();
   return false;
 }
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipCompositor::BindCudaDevice(int asked, int& used, int& count, std::string& problem)
+{
+  used = -1;
+  count = 0;
+#ifdef SPACESKIP_HAVE_CUDA
+  int n = 0;
+  cudaError_t e = cudaGetDeviceCount(&n);
+  if (e != cudaSuccess || n < 1)
+  {
+    cudaGetLastError(); // not the engine's error to find
+    problem = e != cudaSuccess ? std::string("no CUDA device (") + cudaGetErrorString(e) + ")"
+                               : std::string("no CUDA device");
+    return false;
+  }
+  int current = 0;
+  if (cudaGetDevice(&current) != cudaSuccess)
+  {
+    cudaGetLastError();
+    current = 0;
+  }
+  const int want = asked < 0 ? current : asked % n;
+  if (want != current && (e = cudaSetDevice(want)) != cudaSuccess)
+  {
+    cudaGetLastError();
+    problem = std::string("cudaSetDevice(") + std::to_string(want) + "): " + cudaGetErrorString(e);
+    return false;
+  }
+  used = want;
+  count = n;
+  problem.clear();
+  return true;
+#else
+  (void)asked;
+  problem = "built without CUDA";
+  return false;
+#endif
+}
+
+//------------------------------------------------------------------------------
+#ifdef SPACESKIP_HAVE_CUDA
+bool vtkSpaceSkipCompositor::GLOnCudaDevice()
+{
+  int cudaDevice = 0;
+  if (cudaGetDevice(&cudaDevice) != cudaSuccess)
+  {
+    cudaGetLastError();
+    this->InteropProblem = "no current CUDA device";
+    return false;
+  }
+  unsigned int n = 0;
+  int devices[16];
+  const cudaError_t e = cudaGLGetDevices(&n, devices, 16, cudaGLDeviceListAll);
+  if (e != cudaSuccess || n == 0)
+  {
+    // Not NVIDIA's GL (Mesa) or no answer: the interop paths find out and say which.
+    cudaGetLastError();
+    return true;
+  }
+  for (unsigned int i = 0; i < n && i < 16; ++i)
+  {
+    if (devices[i] == cudaDevice)
+    {
+      return true;
+    }
+  }
+  this->InteropProblem = "the window's OpenGL runs on CUDA device " + std::to_string(devices[0]) +
+    ", the engine on CUDA device " + std::to_string(cudaDevice);
+  return false;
+}
+#endif
 
 //------------------------------------------------------------------------------
 bool vtkSpaceSkipCompositor::Draw(vtkOpenGLRenderWindow* renWin, const spaceskip::Image& image,

@@ -53,6 +53,15 @@ public:
   /// default on); off: the texture path (a measurement switch of the window benchmark).
   void SetCudaBlend(bool on) { this->CudaBlend = on; }
 
+  /**
+   * Binds the calling thread to CUDA device `asked` modulo the number of devices (asked < 0:
+   * leaves the thread's current device, CUDA's default 0) before the engine allocates on it;
+   * `used` and `count` tell which of how many. False (and nothing changed) without CUDA or
+   * without a device (`problem` says why). One rank per GPU: the representation asks for the
+   * node-local MPI rank.
+   */
+  static bool BindCudaDevice(int asked, int& used, int& count, std::string& problem);
+
   /// Whether the image may stay on the device for CUDA-GL interop (GPUComposite on, not failed).
   bool CanUseDeviceImage(bool gpuComposite) const { return gpuComposite && !this->InteropFailed; }
 
@@ -121,6 +130,11 @@ private:
   vtkWeakPointer<vtkOpenGLRenderWindow> ResourceWindow;
   unsigned long WindowObserver = 0;
   // Defined with CUDA only.
+  // Whether the window's OpenGL (current context) runs on the calling thread's CUDA device
+  // (cudaGLGetDevices); false with InteropProblem set when it runs on another GPU (true when
+  // CUDA cannot tell, e.g. Mesa's GL: the interop paths then fail and say so).
+  bool GLOnCudaDevice();
+  bool GLDeviceChecked = false;
   bool BlendIntoFramebuffer(vtkOpenGLRenderWindow* renWin, const spaceskip::DeviceImageView& image,
     void* stream, int w, int h, const int rect[4], bool eightBit);
   bool CopyToInteropTexture(vtkOpenGLRenderWindow* renWin, const void* image, void* stream, int w,

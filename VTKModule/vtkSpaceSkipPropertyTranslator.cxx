@@ -23,11 +23,14 @@
 #include "vtkSpaceSkipSettings.h"
 #include "vtkVolume.h"
 #include "vtkVolumeMapper.h"
+#include "vtkVariant.h"
 #include "vtkVolumeProperty.h"
 
 #include "spaceskip/Engine.h"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <limits>
 #include <array>
 #include <vector>
@@ -277,9 +280,6 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
     }
     warned = warned || used;
   };
-  unsupported(vol->GetProperty()->GetInterpolationType() == VTK_NEAREST_INTERPOLATION,
-    this->WarnedNearest,
-    "nearest interpolation is not supported; rendering with trilinear interpolation");
   vtkVolumeProperty* prop = vol->GetProperty();
   unsupported(prop->GetTransferFunctionMode() == vtkVolumeProperty::TF_2D && !Usable2D(prop), this->Warned2D,
     "2-D transfer function mode without a 2-D transfer function of 4-component scalars (one slice): "
@@ -299,6 +299,9 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
   rp.sampleDistance = s.SampleDistance;
   rp.ertThreshold = s.EarlyRayTermination ? kErtThreshold : 2.0;
   rp.jitter = s.UseJittering;
+  // vtkVolumeProperty's InterpolationType: nearest samples the nearest voxel (the skipping is the
+  // same: that voxel is one of a trilinear sample's corners).
+  rp.nearest = vol->GetProperty()->GetInterpolationType() == VTK_NEAREST_INTERPOLATION;
   // The engine's own values (vtkSpaceSkippingVolumeMapper::FilterModeTypes, 1: HardwareFilter);
   // the CPU backend samples exactly whatever this says.
   rp.filter = s.FilterMode == static_cast<int>(spaceskip::FilterMode::Hardware)
@@ -334,6 +337,7 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
   rp.firstSampleOffset = s.UseJittering ? 0.0 : 1.0;
   this->SetBlendAndShading(rp, s, ren, vol, scalarRange, warnOnce);
   engine.setRenderParams(rp);
+  UpdateLabels(engine, s.LabelMap, s.LabelSampling, s.LabelEdits, vol->GetProperty(), scalarRange);
 }
 
 //------------------------------------------------------------------------------
@@ -512,4 +516,94 @@ void vtkSpaceSkipPropertyTranslator::Reset()
   this->ColorKey = this->OpacityKey = nullptr;
   this->ColorMTime = this->OpacityMTime = 0;
   this->HaveTF = false;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipPropertyTranslator::UpdateLabels(spaceskip::Engine& engine, bool labelMap,
+  int labelSampling, const vtkSpaceSkipLabelEdits& edits, vtkVolumeProperty* prop,
+  const double scalarRange[2])
+{
+  spaceskip::RenderParams rp = engine.renderParams();
+  const spaceskip::LabelSampling sampling =
+    labelSampling == 0 ? spaceskip::LabelSampling::Nearest : spaceskip::LabelSampling::Blend;
+  if (rp.labelMap != labelMap || rp.labelSampling != sampling)
+  {
+    rp.labelMap = labelMap;
+    rp.labelSampling = sampling;
+    engine.setRenderParams(rp);
+  }
+  if (!labelMap)
+  {
+    return;
+  }
+  vtkColorTransferFunction* ctf = prop ? prop->GetRGBTransferFunction(0) : nullptr;
+  vtkPiecewiseFunction* otf = prop ? prop->GetScalarOpacity(0) : nullptr;
+  std::map<int, spaceskip::Label> labels;
+  auto base = [&](int id) {
+    spaceskip::Label l;
+    l.id = id;
+    double rgb[3] = { 1, 1, 1 };
+    if (ctf)
+    {
+      ctf->GetColor(id, rgb);
+    }
+    l.r = float(rgb[0]);
+    l.g = float(rgb[1]);
+    l.b = float(rgb[2]);
+    l.opacity = otf ? float(otf->GetValue(id)) : 1.f;
+    return l;
+  };
+  if (ctf && ctf->GetIndexedLookup())
+  {
+    for (int i = 0; i < ctf->GetNumberOfAnnotatedValues(); ++i)
+    {
+      bool ok = false;
+      const double v = ctf->GetAnnotatedValue(i).ToDouble(&ok);
+      if (!ok || !(v >= -32768 && v <= 65535) || v != std::floor(v))
+      {
+        continue; // not an id an 8- or 16-bit label map can hold
+      }
+      spaceskip::Label l = base(int(v));
+      double rgba[4] = { 1, 1, 1, 1 };
+      ctf->GetIndexedColor(i, rgba);
+      l.r = float(rgba[0]);
+      l.g = float(rgba[1]);
+      l.b = float(rgba[2]);
+      labels[l.id] = l;
+    }
+  }
+  for (const auto& e : edits)
+  {
+    spaceskip::Label l = labels.count(e.first) ? labels[e.first] : base(e.first);
+    const vtkSpaceSkipLabelEdit& x = e.second;
+    if (x.HasColor)
+    {
+      l.r = float(x.Color[0]);
+      l.g = float(x.Color[1]);
+      l.b = float(x.Color[2]);
+    }
+    if (x.HasOpacity)
+    {
+      l.opacity = float(x.Opacity);
+    }
+    if (x.HasVisible)
+    {
+      l.visible = x.Visible;
+    }
+    labels[e.first] = l;
+  }
+  if (labels.empty() && scalarRange[0] <= scalarRange[1] && scalarRange[1] - scalarRange[0] < 65536)
+  {
+    for (double v = std::ceil(scalarRange[0]); v <= scalarRange[1]; v += 1)
+    {
+      labels[int(v)] = base(int(v));
+    }
+  }
+  spaceskip::LabelTable table;
+  table.unitDistance = prop ? prop->GetScalarOpacityUnitDistance(0) : 1.0;
+  for (const auto& l : labels)
+  {
+    table.labels.push_back(l.second);
+  }
+  engine.setLabelTable(table);
 }

@@ -7,6 +7,7 @@
 #include "vtkType.h" // For vtkMTimeType
 
 #include <functional> // For WarnFunction
+#include <map>        // For vtkSpaceSkipLabelEdits
 #include <string>     // For the warning texts
 #include <vector>     // For the sampled tables
 
@@ -24,6 +25,24 @@ struct BuildParams;
 struct Camera;
 struct RenderParams;
 }
+
+/// A label map's mapper-level settings for one label id (vtkSpaceSkippingVolumeMapper's
+/// SetLabelColor, SetLabelOpacity, SetLabelVisibility): what was set overrides what the volume
+/// property gives that label.
+struct vtkSpaceSkipLabelEdit
+{
+  double Color[3] = { 1, 1, 1 };
+  double Opacity = 1;
+  bool Visible = true;
+  bool HasColor = false, HasOpacity = false, HasVisible = false;
+  bool operator==(const vtkSpaceSkipLabelEdit& o) const
+  {
+    return Color[0] == o.Color[0] && Color[1] == o.Color[1] && Color[2] == o.Color[2] &&
+      Opacity == o.Opacity && Visible == o.Visible && HasColor == o.HasColor &&
+      HasOpacity == o.HasOpacity && HasVisible == o.HasVisible;
+  }
+};
+using vtkSpaceSkipLabelEdits = std::map<int, vtkSpaceSkipLabelEdit>;
 
 class vtkSpaceSkipPropertyTranslator
 {
@@ -53,6 +72,17 @@ public:
    */
   void UpdateParameters(spaceskip::Engine& engine, const vtkSpaceSkipSettings& settings,
     vtkRenderer* ren, vtkVolume* vol, const double scalarRange[2], const WarnFunction& warnOnce);
+
+  /**
+   * Label map (vtkSpaceSkippingVolumeMapper::LabelMap): the labels are the ids of `edits` and,
+   * when the property's colour function has IndexedLookup on, its annotated values (ParaView's
+   * categorical colour map); with neither, every integer of `scalarRange`. A label's colour is
+   * its indexed colour (IndexedLookup) or the colour function at its id, its opacity the scalar
+   * opacity function at its id, visible; `edits` override each part they set. Values without a
+   * label are transparent. Sets RenderParams::labelMap and labelSampling too.
+   */
+  static void UpdateLabels(spaceskip::Engine& engine, bool labelMap, int labelSampling,
+    const vtkSpaceSkipLabelEdits& edits, vtkVolumeProperty* prop, const double scalarRange[2]);
 
   /**
    * The engine's camera: the volume's matrix is folded into the view, so the engine marches in

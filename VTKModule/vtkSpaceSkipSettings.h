@@ -9,6 +9,7 @@
 #include "vtkType.h"           // For vtkIdType
 
 #include "spaceskip/Tuning.h" // For Tuning
+#include "vtkSpaceSkipPropertyTranslator.h" // For vtkSpaceSkipLabelEdits
 
 #include <algorithm> // For std::copy_n
 #include <string>    // For ArrayName
@@ -38,6 +39,9 @@ struct vtkSpaceSkipSettings
   double WholeOrigin[3] = { 0, 0, 0 };
   double WholeScalarRange[2] = { 1, 0 };
   spaceskip::Tuning Tuning;
+  bool LabelMap = false;        // label maps (issue 37)
+  int LabelSampling = 1;
+  vtkSpaceSkipLabelEdits LabelEdits;
 
   // vtkVolumeMapper's (and vtkAbstractMapper's) settings the mapper reads.
   int BlendMode = 0;
@@ -78,6 +82,9 @@ struct vtkSpaceSkipSettings
     m->GetWholeOrigin(s.WholeOrigin);
     m->GetWholeScalarRange(s.WholeScalarRange);
     s.Tuning = m->GetTuning();
+    s.LabelMap = m->GetLabelMap() != 0;
+    s.LabelSampling = m->GetLabelSampling();
+    s.LabelEdits = m->GetLabelEdits();
     s.BlendMode = m->GetBlendMode();
     std::copy_n(m->GetAverageIPScalarRange(), 2, s.AverageIPScalarRange);
     s.ScalarMode = m->GetScalarMode();
@@ -116,6 +123,9 @@ struct vtkSpaceSkipSettings
     to->SetUseJittering(s.UseJittering);
     to->SetDeviceMemoryBudget(s.DeviceMemoryBudget);
     to->SetTuning(s.Tuning);
+    to->SetLabelMap(s.LabelMap);
+    to->SetLabelSampling(s.LabelSampling);
+    to->SetLabelEdits(s.LabelEdits);
     to->SetVectorMode(s.VectorMode);
     to->SetVectorComponent(s.VectorComponent);
     to->SetBlendModeOverride(s.BlendModeOverride);

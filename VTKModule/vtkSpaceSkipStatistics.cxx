@@ -69,6 +69,7 @@ vtkSpaceSkipStatistics vtkSpaceSkipStatistics::Combine(
   s.BuilderUsed = Join(blocks, &vtkSpaceSkipStatistics::BuilderUsed);
   s.BuilderChoice = Join(blocks, &vtkSpaceSkipStatistics::BuilderChoice);
   s.Residency = Join(blocks, &vtkSpaceSkipStatistics::Residency);
+  s.CudaDevice = Join(blocks, &vtkSpaceSkipStatistics::CudaDevice);
   return s;
 }
 
@@ -78,6 +79,7 @@ void vtkSpaceSkipStatistics::Print(std::ostream& os, vtkIndent indent) const
   os << indent << "CompositePathUsed: " << this->CompositePath << "\n";
   os << indent << "CompositeBlendUsed: " << this->CompositeBlend << "\n";
   os << indent << "BackendUsed: " << this->BackendUsed << "\n";
+  os << indent << "CudaDeviceUsed: " << this->CudaDevice << "\n";
   os << indent << "BuilderUsed: " << this->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->BuildSeconds << "\n";
   os << indent << "LastRenderSeconds: " << this->RenderSeconds << "\n";

@@ -40,6 +40,7 @@ struct vtkSpaceSkipStatistics
   std::string Residency = "none";
   std::string CompositePath = "none";
   std::string CompositeBlend = "none";
+  std::string CudaDevice = "none"; // "device N of M" when the CUDA backend drew
 
   // How often each stage ran since the mapper was created.
   int Builds = 0;

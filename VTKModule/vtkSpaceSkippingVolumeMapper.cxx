@@ -15,6 +15,7 @@
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkRectilinearGrid.h"
 #include "vtkRenderer.h"
+#include "vtkSpaceSkipCompositor.h"
 #include "vtkSpaceSkipImageRenderer.h"
 #include "vtkSpaceSkipInputConverter.h"
 #include "vtkSpaceSkipMultiBlockVolumeMapper.h"
@@ -124,6 +125,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   // across the engines that backend switches create.
   std::set<std::string> Said;
   spaceskip::Tuning Tuning; // SetTuning
+  vtkSpaceSkipLabelEdits LabelEdits; // SetLabelColor, SetLabelOpacity, SetLabelVisibility
   vtkSpaceSkipStatistics Asked; // the last statistics asked for (the getters' strings live here)
 
   // Float compositing across processes (SetPieceExchange), and the image it hands back.
@@ -145,6 +147,12 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   double TableRange[2] = { 0, 1 };
   int Owned[6] = { 0, 0, 0, 0, 0, 0 };
 
+  // CudaDevice: the device this mapper's engine was bound to (-1: not yet) and its report.
+  int BoundDevice = -1;
+  int AskedDevice = -1;
+  std::string DeviceReport;
+  void BindDevice(int asked, int backend);
+
   // Reports a problem once (until the next different one); the caller then draws nothing.
   void Fail(const std::string& msg)
   {
@@ -163,6 +171,20 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   {
     this->Asked = this->Composite ? this->Composite->GetStatistics(deviceTimes)
                                   : this->Image.Statistics(deviceTimes);
+    if (!this->Composite)
+    {
+      const bool cuda = this->Asked.BackendUsed.find("cuda") != std::string::npos;
+      if (cuda && this->DeviceReport.empty())
+      {
+        int used = -1, count = 0; // CudaDevice -1: the thread's current device, as it is
+        std::string problem;
+        if (vtkSpaceSkipCompositor::BindCudaDevice(-1, used, count, problem))
+        {
+          this->DeviceReport = "device " + std::to_string(used) + " of " + std::to_string(count);
+        }
+      }
+      this->Asked.CudaDevice = cuda && !this->DeviceReport.empty() ? this->DeviceReport : "none";
+    }
     return this->Asked;
   }
 };
@@ -362,6 +384,65 @@ const spaceskip::Tuning& vtkSpaceSkippingVolumeMapper::GetTuning() const
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::SetLabelColor(int id, double r, double g, double b)
+{
+  vtkSpaceSkipLabelEdit& e = this->Internals->LabelEdits[id];
+  if (!e.HasColor || e.Color[0] != r || e.Color[1] != g || e.Color[2] != b)
+  {
+    e.HasColor = true;
+    e.Color[0] = r;
+    e.Color[1] = g;
+    e.Color[2] = b;
+    this->Modified();
+  }
+}
+
+void vtkSpaceSkippingVolumeMapper::SetLabelOpacity(int id, double opacity)
+{
+  vtkSpaceSkipLabelEdit& e = this->Internals->LabelEdits[id];
+  if (!e.HasOpacity || e.Opacity != opacity)
+  {
+    e.HasOpacity = true;
+    e.Opacity = opacity;
+    this->Modified();
+  }
+}
+
+void vtkSpaceSkippingVolumeMapper::SetLabelVisibility(int id, vtkTypeBool visible)
+{
+  vtkSpaceSkipLabelEdit& e = this->Internals->LabelEdits[id];
+  if (!e.HasVisible || e.Visible != (visible != 0))
+  {
+    e.HasVisible = true;
+    e.Visible = visible != 0;
+    this->Modified();
+  }
+}
+
+void vtkSpaceSkippingVolumeMapper::RemoveAllLabels()
+{
+  if (!this->Internals->LabelEdits.empty())
+  {
+    this->Internals->LabelEdits.clear();
+    this->Modified();
+  }
+}
+
+const std::map<int, vtkSpaceSkipLabelEdit>& vtkSpaceSkippingVolumeMapper::GetLabelEdits() const
+{
+  return this->Internals->LabelEdits;
+}
+
+void vtkSpaceSkippingVolumeMapper::SetLabelEdits(const std::map<int, vtkSpaceSkipLabelEdit>& edits)
+{
+  if (edits != this->Internals->LabelEdits)
+  {
+    this->Internals->LabelEdits = edits;
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::SetPieceExchange(const std::shared_ptr<PieceExchange>& exchange)
 {
   if (this->Internals->Exchange != exchange)
@@ -385,10 +466,42 @@ vtkSpaceSkippingVolumeMapper::GetPieceExchange() const
 }
 
 //------------------------------------------------------------------------------
+// The rendering thread on the CUDA device (CudaDevice) before the engine allocates on it, and
+// again every frame (other code on the thread may switch). The CPU backend: nothing at all.
+void vtkSpaceSkippingVolumeMapper::vtkInternals::BindDevice(int asked, int backend)
+{
+  if (backend == vtkSpaceSkippingVolumeMapper::CPU || (asked < 0 && this->BoundDevice < 0))
+  {
+    return; // as before: no CUDA call for this
+  }
+  if (this->BoundDevice >= 0 && asked >= 0 && asked != this->AskedDevice)
+  {
+    this->Warn("CudaDevice " + std::to_string(asked) + " asked after this mapper's engine was made on CUDA device " +
+      std::to_string(this->BoundDevice) + ": it stays there");
+  }
+  this->AskedDevice = asked;
+  int used = -1, count = 0;
+  std::string problem;
+  if (!vtkSpaceSkipCompositor::BindCudaDevice(this->BoundDevice >= 0 ? this->BoundDevice : asked, used, count, problem))
+  {
+    return; // no CUDA: the engine finds out and falls back as before
+  }
+  this->BoundDevice = used;
+  this->DeviceReport = "device " + std::to_string(used) + " of " + std::to_string(count);
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSpaceSkippingVolumeMapper::GetCudaDeviceUsed()
+{
+  return this->Internals->Statistics(false).CudaDevice.c_str();
+}
+
+//------------------------------------------------------------------------------
 // With a piece exchange (MPI) and a piece of a larger image, RenderExchanged(); else the input
 // drawn here.
 void vtkSpaceSkippingVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol)
 {
+  this->Internals->BindDevice(this->CudaDevice, this->Backend);
   if (this->Internals->Exchange && ren && HasExtent(this->WholeExtent))
   {
     this->RenderExchanged(ren, vol);

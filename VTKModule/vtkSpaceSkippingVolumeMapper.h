@@ -40,10 +40,12 @@
 #include "vtkSpaceSkipPieceExchange.h" // For PieceImage, PieceExchange
 #include "vtkVolumeMapper.h"
 
+#include <map>    // For GetLabelEdits
 #include <memory> // For std::unique_ptr
 #include <string> // For WarnOnce
 
 class vtkRenderer;
+struct vtkSpaceSkipLabelEdit;
 class vtkVolume;
 class vtkWindow;
 #ifndef __VTK_WRAP__
@@ -260,6 +262,22 @@ public:
   vtkBooleanMacro(GPUComposite, vtkTypeBool);
   const char* GetCompositePathUsed();
   const char* GetCompositeBlendUsed();
+  ///@}
+
+  ///@{
+  /**
+   * The CUDA device the CUDA backend runs on: -1 (default) the rendering thread's current
+   * device, as before (CUDA's default, device 0); N >= 0: device N modulo the number of devices.
+   * One rank per GPU: ParaView's representation sets the node-local MPI rank. The rendering
+   * thread is bound to it before the engine allocates, and every frame after (other code on
+   * that thread may switch devices); the first device bound stays this mapper's (its engine's
+   * memory lives there), a later change is said once and ignored. The CPU backend never touches
+   * CUDA for it. GetCudaDeviceUsed(): "none" (the last frame was not the CUDA backend's), else
+   * "device N of M".
+   */
+  vtkSetMacro(CudaDevice, int);
+  vtkGetMacro(CudaDevice, int);
+  const char* GetCudaDeviceUsed();
   /**
    * The rectangle of the renderer's viewport the last frame copied and blended (x, y, width,
    * height in pixels): where the volume's box projects (width or height 0 when it projects
@@ -411,6 +429,44 @@ public:
   int GetOpacityTableSampleCount();
   ///@}
 
+  ///@{
+  /**
+   * Label map: the scalars (one component of 8- or 16-bit integers; other types are drawn as an
+   * ordinary volume, with one warning) are label ids, each drawn with its own colour and opacity;
+   * values without a label are transparent, and sampling never draws a label that is not among
+   * the voxels around the sample, so no border shows the colours of the ids between its two
+   * labels. The labels: when the volume property's colour function has IndexedLookup on, its
+   * annotated values with their indexed colours (ParaView's categorical colour map); the ids
+   * given to SetLabelColor, SetLabelOpacity or SetLabelVisibility, which override what they set;
+   * with neither, every integer of the scalar range. A label's opacity is the scalar opacity
+   * function at its id unless set here. Hiding a label or changing which labels have opacity re-
+   * classifies bricks over their label sets (no voxel pass): as cheap as an opacity edit. Blend
+   * mode composite only. Off by default.
+   */
+  vtkSetMacro(LabelMap, vtkTypeBool);
+  vtkGetMacro(LabelMap, vtkTypeBool);
+  vtkBooleanMacro(LabelMap, vtkTypeBool);
+  /// NearestLabel: the nearest voxel's label (blocky borders); BlendedLabel (default): of the 8
+  /// voxels around the sample, the label whose trilinear weights sum highest (smooth borders).
+  enum LabelSamplingTypes
+  {
+    NearestLabel = 0,
+    BlendedLabel = 1
+  };
+  vtkSetClampMacro(LabelSampling, int, NearestLabel, BlendedLabel);
+  vtkGetMacro(LabelSampling, int);
+  void SetLabelColor(int id, double r, double g, double b);
+  void SetLabelOpacity(int id, double opacity);
+  void SetLabelVisibility(int id, vtkTypeBool visible);
+  /// Forgets the labels set on the mapper (the property's stay).
+  void RemoveAllLabels();
+  ///@}
+#ifndef __VTK_WRAP__
+  /// The labels set on the mapper, by id (vtkSpaceSkipPropertyTranslator.h).
+  const std::map<int, vtkSpaceSkipLabelEdit>& GetLabelEdits() const;
+  void SetLabelEdits(const std::map<int, vtkSpaceSkipLabelEdit>& edits);
+#endif
+
   void Render(vtkRenderer* ren, vtkVolume* vol) override;
   void ReleaseGraphicsResources(vtkWindow*) override;
 
@@ -483,6 +539,7 @@ protected:
   vtkTypeBool EightBitComposite = 1;
   vtkTypeBool GPUComposite = 1;
   vtkTypeBool UseJittering = 0;
+  int CudaDevice = -1;
   vtkIdType DeviceMemoryBudget = 0;
   int VectorMode = 1; // vtkScalarsToColors::COMPONENT
   int VectorComponent = 0;
@@ -490,6 +547,8 @@ protected:
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   double WholeOrigin[3] = { 0, 0, 0 };
   double WholeScalarRange[2] = { 1, 0 };
+  vtkTypeBool LabelMap = 0;
+  int LabelSampling = BlendedLabel;
 
   /// vtkImageData, and composite data sets of them (see GetBounds()).
   int FillInputPortInformation(int port, vtkInformation* info) override;

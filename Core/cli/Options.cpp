@@ -29,11 +29,11 @@ const std::set<std::string>& valueOptions() {
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
       "--shade", "--cuda-block", "--scale", "--datasets", "--time-limit", "--memory-budget",
-      "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes"};
+      "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes", "--label-map", "--hide-labels"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
-  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper", "--no-in-core"};
+  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper", "--no-in-core", "--nearest"};
   return s;
 }
 
@@ -242,6 +242,13 @@ RenderParams renderParams(const Options& o) {
   r.sampleDistance = o.getDouble("--sample-distance", 0, 0, 1e300);
   r.ertThreshold = o.getDouble("--ert", 2, 0, 1e300);
   r.jitter = o.has("--jitter");
+  r.nearest = o.has("--nearest");
+  if (o.has("--label-map")) {
+    const std::string m = o.get("--label-map", "blend");
+    if (m != "nearest" && m != "blend") throw bad("--label-map", m, "is not nearest or blend");
+    r.labelMap = true;
+    r.labelSampling = m == "nearest" ? LabelSampling::Nearest : LabelSampling::Blend;
+  }
   std::string f = o.get("--filter", "exact");
   if (f == "exact") r.filter = FilterMode::Exact;
   else if (f == "hardware") r.filter = FilterMode::Hardware;
@@ -278,6 +285,33 @@ RenderParams renderParams(const Options& o) {
     }
   }
   return r;
+}
+
+LabelTable labelTable(const Options& o, const Volume& v) {
+  LabelTable t;
+  double lo = 0, hi = -1;
+  if (!isLabelType(v.type) || v.components != 1 || !v.scalarRange(lo, hi)) return t;
+  std::set<int64_t> hidden;
+  if (o.has("--hide-labels"))
+    for (const std::string& id : split(o.get("--hide-labels", ""), ','))
+      hidden.insert(parseIntArg(id, "--hide-labels", -32768, 65535));
+  for (int id = int(lo); id <= int(hi); ++id) {
+    if (id == 0) continue;  // the background
+    Label l;
+    l.id = id;
+    // Hues by the golden ratio: neighbouring ids far apart in colour.
+    const double h = std::fmod(id * 0.618033988749895, 1.0) * 6.0;
+    const double x = 1.0 - std::fabs(std::fmod(h, 2.0) - 1.0);
+    const double rgb[6][3] = {{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}};
+    const double* c = rgb[int(h) % 6];
+    l.r = float(0.2 + 0.8 * c[0]);
+    l.g = float(0.2 + 0.8 * c[1]);
+    l.b = float(0.2 + 0.8 * c[2]);
+    l.opacity = 0.5f;
+    l.visible = hidden.count(id) == 0;
+    t.labels.push_back(l);
+  }
+  return t;
 }
 
 BackendKind backendKind(const Options& o) {

@@ -71,6 +71,9 @@ int poolBrick(const Options& o);
 /// `spec` is NAME[:SUFFIX]... (bench variants); suffixes override --leaf/--mls/--bins/--brick:
 /// shallow, deep, mlsN, binsN, brickN.
 BuildParams buildParams(const Options& o, const std::string& spec);
+/// --label-map's labels for `v`: every id of its value range but 0, colours far apart for
+/// neighbouring ids, opacity 0.5, --hide-labels hidden (empty for volumes that are no label map).
+LabelTable labelTable(const Options& o, const Volume& v);
 RenderParams renderParams(const Options& o);
 BackendKind backendKind(const Options& o);
 /// The engine's knobs: the environment's (Environment.h), then --cuda-block WxH (32..256

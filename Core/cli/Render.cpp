@@ -25,6 +25,7 @@ int cmdRender(const Options& o) {
   engine.setTransferFunction(makeTF(o, v));
   engine.setBuildParams(buildParams(o, o.get("--builder", "auto")));
   engine.setRenderParams(renderParams(o));
+  if (o.has("--label-map")) engine.setLabelTable(labelTable(o, v));
   auto t1 = Clock::now();
   engine.update();
   double prep = since(t1);

@@ -71,6 +71,10 @@ options:
   --ert T  --jitter  --filter exact|hardware
   --blend composite|mip|minip|average|additive|iso   --iso V1,V2,...  (iso values)
   --shade on|AMBIENT,DIFFUSE,SPECULAR,POWER  gradient shading with a headlight (on: 0,0.7,0.2,10)
+  --nearest          nearest-voxel sampling instead of trilinear
+  --label-map nearest|blend  8/16-bit integer voxels as label ids: every id but 0 a label of its
+                     own colour, opacity 0.5 (render); blend: smooth borders, never a label that
+                     is not among the 8 voxels around a sample   --hide-labels ID1,ID2,...
   --compare REF.png  print max difference and PSNR against a reference image
   --max-diff N       with --compare: exit 3 when the max difference exceeds N/255
   --memory-budget N[K|M|G|T]  the most memory the voxels may take on the device (default: free

@@ -467,6 +467,37 @@ SubMasks BrickClassification::downloadMasks(cudaStream_t stream) {
   return out;
 }
 
+bool BrickClassification::setOccupancy(OccupancyGrid o, cudaStream_t stream) {
+  if (int64_t(o.occ.size()) != numBricks() || o.brick != brick)
+    throw BackendError("label classification: the occupancy does not match the volume's bricks");
+  bool changed = !haveOcc, grewNow = !haveOcc;
+  if (haveOcc) {
+    const OccupancyGrid& prev = occupancy(stream);  // the host copy (downloaded once per classification)
+    for (size_t i = 0; i < o.occ.size(); ++i) {
+      if (o.occ[i] == prev.occ[i]) continue;
+      changed = true;
+      if (o.occ[i]) {
+        grewNow = true;
+        break;
+      }
+    }
+  }
+  const auto waitStart = std::chrono::steady_clock::now();
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_occ[1 - cur].get(), o.occ.data(), o.occ.size(), cudaMemcpyHostToDevice, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
+  cur = 1 - cur;
+  grew = grewNow;
+  if (changed) ++generation;
+  haveOcc = true;
+  occupied = o.occupied;
+  haveSub_ = false;  // no masks: a label edit reads no voxel
+  masksReady_ = false;
+  hostOcc_ = std::move(o);
+  hostOccValid_ = true;
+  return changed;
+}
+
 const OccupancyGrid& BrickClassification::occupancy(cudaStream_t stream) {
   if (!hostOccValid_) {
     hostOcc_ = OccupancyGrid{};

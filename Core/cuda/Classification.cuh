@@ -44,6 +44,9 @@ class BrickClassification {
   void setRanges(const Volume& vol, const RangeGrid& r, cudaStream_t stream);
   /// Classifies against `tf`'s opacity and `cc`; true when the occupancy changed (or is the first).
   bool classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream);
+  /// Takes an occupancy classified on the host (a label map's, LabelMap.h: no sub-brick masks);
+  /// true when it differs from the current one (or is the first). Waits for its upload.
+  bool setOccupancy(OccupancyGrid o, cudaStream_t stream);
   /// The occupancy on the host (downloaded once per classification).
   const OccupancyGrid& occupancy(cudaStream_t stream);
 

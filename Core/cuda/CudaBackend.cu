@@ -65,6 +65,13 @@ class CudaBackend final : public Backend {
     distMarksStale_ = true;
     return changed;
   }
+  bool classifyLabels(const LabelSets& ls, const std::vector<uint8_t>& drawn, const CropClip& cc) override {
+    // Over the label sets on the host (no voxel read), the occupancy uploaded.
+    const bool changed = cls_.setOccupancy(spaceskip::classifyLabels(ls, drawn, cc), stream_);
+    classifiedSinceRender_ = true;
+    distMarksStale_ = true;
+    return changed;
+  }
   double subMaskShare() const override { return cls_.subMasks() ? cls_.setFraction : 1.0; }
   // Sparse residency loads the bricks the current occupancy needs: a structure that visits
   // more would sample bricks that are not resident.
@@ -167,6 +174,8 @@ class CudaBackend final : public Backend {
       f.traversal = TraversalKind::Grid;
       f.grid = GridView{nullptr, bdims_, brick_, nullptr, cls_.d_vmin.get(), cls_.d_vmax.get()};
     }
+    if (pool_.active() && f.sampling != kSampleTrilinear)
+      throw BackendError("nearest and label-map sampling need the whole volume in device memory");
     if (pool_.active())
       pool_.update(poolNeedFor(f.blend, f.shade != 0 || f.gtf.mode != 0, tf_, f.avgLo, f.avgHi), cls_.d_occ[cls_.cur].get(),
                    cls_.generation, cls_.d_vmin.get(), cls_.d_vmax.get(), bdims_, brick_, stream_);

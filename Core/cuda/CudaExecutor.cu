@@ -125,7 +125,7 @@ template <class Sampler>
 RenderKernelPtr<Sampler> renderKernelFor(const FrameView& f) {
   // Dependent components: one kernel reading the traversal from the frame (a rare mode: six
   // voxel types times four traversals more would double this file's compile time).
-  if constexpr (IsChannelSampler<Sampler>::value)
+  if constexpr (IsChannelSampler<Sampler>::value || IsNearestSampler<Sampler>::value)
     return renderKernel<Sampler, -1, false>;
   // Sparse residency: the plain frames' kernels per traversal (the speed that matters), one
   // kernel reading the traversal from the frame for the other modes.
@@ -237,6 +237,12 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
     dispatchVoxelType(v.type, [&](auto t) {
       using T = decltype(t);
       launch(f, pool->sampler<T>(), grid, block, 0, stream);
+    });
+  } else if (f.sampling != kSampleTrilinear && v.components == 1) {  // nearest, label maps (render/LabelSampler.h)
+    dispatchVoxelType(v.type, [&](auto t) {
+      using T = decltype(t);
+      launch(f, NearestSampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z, f.sampling}, grid, block, 0,
+             stream);
     });
   } else if (v.components > 1) {  // dependent components (render/Components.h): exact sampling only
     dispatchVoxelType(v.type, [&](auto t) {

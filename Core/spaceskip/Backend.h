@@ -3,6 +3,7 @@
 #pragma once
 #include "Classification.h"
 #include "DeviceImageCopy.h"
+#include "LabelMap.h"
 #include "Tree.h"
 #include "Tuning.h"
 #include "Types.h"
@@ -25,6 +26,13 @@ class Backend {
   /// Re-classifies bricks against the TF opacity and what `cc` leaves drawn (bricks no drawn
   /// sample can reach are empty); returns true when the occupancy changed.
   virtual bool classify(const TransferFunction& tf, const CropClip& cc) = 0;
+  /// A label map (LabelMap.h): re-classifies bricks over their label sets `s` (no voxel read):
+  /// a brick is occupied when one of its labels is drawn (drawn[value - s.lo]) and `cc` leaves
+  /// some of it drawn. No sub-brick masks. Returns true when the occupancy changed.
+  virtual bool classifyLabels(const LabelSets& s, const std::vector<uint8_t>& drawn, const CropClip& cc) = 0;
+  /// Whether the last classify() or classifyLabels() read voxels (the CPU backend's sub-brick
+  /// masks): Counters::voxelPasses.
+  virtual bool lastClassifyReadVoxels() const { return false; }
   /// True when the last classify() changed the occupancy only by emptying bricks (every brick
   /// occupied now was occupied before): a structure built before it still covers every
   /// occupied brick, so drawing with it stays lossless (it only visits bricks that are empty now).

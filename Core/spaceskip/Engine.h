@@ -6,6 +6,7 @@
 #include "Camera.h"
 #include "Classification.h"
 #include "DeviceImageCopy.h"
+#include "LabelMap.h"
 #include "Tree.h"
 #include "TransferFunction.h"
 #include "Tuning.h"
@@ -56,6 +57,14 @@ class Engine {
   /// so with `colorMayDiffer` / `opacityMayDiffer` false, and that part is not compared (it must
   /// then equal the engine's; Counters::colorCompares/opacityCompares count the compares).
   void setTransferFunction(TransferFunction tf, bool colorMayDiffer = true, bool opacityMayDiffer = true);
+  /// Label maps (RenderParams::labelMap, LabelMap.h): each label's colour, opacity and
+  /// visibility. Which labels are drawn (visible, opacity > 0) decides the occupancy: a change of
+  /// that re-classifies bricks over their label sets (no voxel read; a rebuild only when the
+  /// occupancy changes), an opacity or colour change re-makes the table alone.
+  void setLabelTable(const LabelTable& t);
+  const LabelTable& labelTable() const;
+  /// Whether the last update() drew a label map (labelMap asked for, on 8- or 16-bit integers).
+  bool labelMapActive() const;
   void setBuildParams(const BuildParams& p);
   void setRenderParams(const RenderParams& p);
   /// The volume is one piece of a larger one (MPI; VolumePiece.h): rays, planes and the sample

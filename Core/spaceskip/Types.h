@@ -37,6 +37,16 @@ enum class BuilderKind : int {
 enum class LeafCriterion : int { Shallow, Deep, Empty };
 enum class BackendKind : int { Auto, CPU, CUDA };
 enum class FilterMode : int { Exact, Hardware };
+/// How a label map is sampled (RenderParams::labelSampling; render/LabelSampler.h, LabelMap.h).
+enum class LabelSampling : int {
+  /// The label of the voxel nearest the sample: blocky borders, one voxel a step.
+  Nearest = 0,
+  /// Of the labels of the 8 voxels around the sample, the one whose trilinear weights sum
+  /// highest (argmax of the interpolated indicator functions): smooth borders; a label/background
+  /// border lies where that label's own binary volume interpolates to 1/2. Never a label that is
+  /// not among the 8 corners.
+  Blend = 1
+};
 
 const char* builderName(BuilderKind b);
 /// Accepts CLI names (naive, grid, lbvh, lbvh-cpu, kdtree-cpu, kdtree-gpu, kdtree-gpu-fast, hybrid,
@@ -145,6 +155,16 @@ struct RenderParams {
   /// i (N+1)/N - 1/2 per axis (N cells), up to half a voxel off the plane (ParaView's images);
   /// false: at the plane point itself.
   bool sliceAsVTK = true;
+
+  /// Nearest-voxel sampling instead of trilinear (vtkVolumeProperty's InterpolationType
+  /// NEAREST), one-component volumes; the skipping is unchanged (the nearest voxel is one of a
+  /// trilinear sample's corners).
+  bool nearest = false;
+  /// Label map (LabelMap.h): the volume's 8- or 16-bit integer values are label ids drawn with
+  /// Engine::setLabelTable's colours and opacities (composite blending; the transfer function
+  /// is kept for when this is off). Other voxel types: said once, drawn as an ordinary volume.
+  bool labelMap = false;
+  LabelSampling labelSampling = LabelSampling::Blend;
 };
 /// At most this many clipping planes (VTK's mappers take six).
 constexpr int kMaxClipPlanes = 6;
@@ -232,6 +252,11 @@ struct Counters {
   int autoProbeFrames = 0;
   /// Whole-table compares of Engine::setTransferFunction (the parts its caller said may differ).
   int colorCompares = 0, opacityCompares = 0;
+  /// Passes over the voxels: value ranges, label sets (labelSets) and the CPU backend's
+  /// sub-brick masks after a classification. A label table edit makes none.
+  int voxelPasses = 0;
+  /// Label maps: per-brick label sets computed (once per volume and brick size).
+  int labelSets = 0;
 };
 
 struct Image {

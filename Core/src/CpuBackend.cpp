@@ -50,11 +50,29 @@ class CpuBackend final : public Backend {
       if (o.occ[i] && !occ_.occ[i]) onlyEmptied_ = false;
     occ_ = std::move(o);
     sub_ = computeSubMasks(volume_, occ_, tf, tuning_);
+    readVoxels_ = !sub_.mask.empty();
     markDistances();  // a field kept across the edit takes the new states' marks
     tf_ = tf;
     if (changed) ++generation_;
     return changed;
   }
+
+  bool classifyLabels(const LabelSets& ls, const std::vector<uint8_t>& drawn, const CropClip& cc) override {
+    OccupancyGrid o = spaceskip::classifyLabels(ls, drawn, cc);
+    const bool sameDims = o.dims.x == occ_.dims.x && o.dims.y == occ_.dims.y && o.dims.z == occ_.dims.z &&
+                          o.occ.size() == occ_.occ.size();
+    const bool changed = !sameDims || o.occ != occ_.occ;
+    onlyEmptied_ = sameDims && !pool_.active();
+    for (size_t i = 0; onlyEmptied_ && i < o.occ.size(); ++i)
+      if (o.occ[i] && !occ_.occ[i]) onlyEmptied_ = false;
+    occ_ = std::move(o);
+    sub_ = SubMasks{};  // no masks for label maps: an edit reads no voxel
+    readVoxels_ = false;
+    markDistances();
+    if (changed) ++generation_;
+    return changed;
+  }
+  bool lastClassifyReadVoxels() const override { return readVoxels_; }
 
   bool lastClassifyOnlyEmptied() const override { return onlyEmptied_; }
   double subMaskShare() const override { return sub_.mask.empty() ? 1.0 : sub_.share; }
@@ -119,7 +137,7 @@ class CpuBackend final : public Backend {
     out.height = f.height;
     out.rgba.assign(size_t(f.width) * size_t(f.height), vec4f{0, 0, 0, 0});
     overflow_ = false;
-    if (pool_.active()) {
+    if (pool_.active() && f.sampling == kSampleTrilinear) {  // nearest and label frames sample in core
       try {
         pool_.update(poolNeedFor(f.blend, f.shade != 0 || f.gtf.mode != 0, tf_, f.avgLo, f.avgHi), occ_.occ.data(), generation_,
                      ranges_.vmin.data(), ranges_.vmax.data(), ranges_.dims, ranges_.brick);
@@ -143,6 +161,11 @@ class CpuBackend final : public Backend {
 
   template <class T>
   void run(const FrameView& f, Image& out) {
+    if (f.sampling != kSampleTrilinear && volume_.components == 1) {  // nearest, label maps (LabelSampler.h)
+      tiles(f, out, NearestSampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y,
+                                      volume_.dims.z, f.sampling});
+      return;
+    }
     if (pool_.active() && !overflow_) {
       tiles(f, out, pool_.view().sampler<T>());
       return;
@@ -215,6 +238,7 @@ class CpuBackend final : public Backend {
   std::vector<uint8_t> dist_;  ///< DistanceGrid's field over occ_
   SubMasks sub_;  ///< sub-brick masks and brick states of occ_ (Classification.h); empty: none
   Tuning tuning_;  ///< setTuning: the sub-brick mask knobs
+  bool readVoxels_ = false;    ///< the last classification computed sub-brick masks (lastClassifyReadVoxels)
   bool onlyEmptied_ = false;   ///< the last classify() only emptied bricks (lastClassifyOnlyEmptied)
   Tree tree_;
   TraversalKind traversal_ = TraversalKind::Naive;

@@ -505,6 +505,7 @@ HWY_EXPORT(TargetName);
 bool packetMarchable(const FrameView& f, VoxelType type, int components, int64_t nx, int64_t ny, int64_t nz) {
 #ifdef SPACESKIP_HAVE_HWY
   if (!isPlainFrame(f) || f.lattice.active || f.alphaIn || f.sampleCount || f.grid.vmin) return false;
+  if (f.sampling != 0) return false;  // nearest and label sampling (render/LabelSampler.h)
   if (components != 1 || type == VoxelType::Float64) return false;
   // 32-bit gathers: float32 by index, the others by byte offset (voxel index * size + 1).
   if (nx < 2 || ny < 2 || nz < 2 || nx * ny * nz * int64_t(voxelSize(type)) >= (int64_t(1) << 31) - 4) return false;

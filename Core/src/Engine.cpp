@@ -98,6 +98,65 @@ struct Engine::Impl {
   bool haveVolume = false;
   TransferFunction tf;
   bool haveTF = false;
+  // Label maps (RenderParams::labelMap, LabelMap.h). While `labelOn`, `tf` is the label table's
+  // (labelTransferFunction) and the caller's transfer function waits in `userTF`.
+  LabelTable labels;
+  bool labelOn = false, labelSetsDirty = true, labelTFDirty = true, labelTFValid = false;
+  LabelSets labelSets;
+  std::vector<uint8_t> drawn;  ///< per value of labelSets' range: a visible label of opacity > 0
+  TransferFunction userTF;
+  bool haveUserTF = false;
+
+  bool wantsLabels() const {
+    return render.labelMap && haveVolume && volume.components == 1 && isLabelType(volume.type);
+  }
+  /// Enters or leaves label-map drawing as RenderParams::labelMap and the volume ask.
+  void syncLabelMode() {
+    if (render.labelMap && haveVolume && !wantsLabels())
+      warn("label map: needs one component of 8- or 16-bit integers; drawn as an ordinary volume");
+    const bool want = wantsLabels();
+    if (want == labelOn) return;
+    if (want) {
+      userTF = tf;
+      haveUserTF = haveTF;
+      labelTFValid = false;
+      labelTFDirty = true;
+    } else {
+      tf = userTF;
+      haveTF = haveUserTF;
+    }
+    labelOn = want;
+    opacityDirty = tableDirty = true;
+  }
+  /// The label table as a transfer function, and what its edit needs: a change of which labels
+  /// are drawn re-classifies (over the label sets), an opacity change re-makes the table only, a
+  /// colour change updates it.
+  void refreshLabelTF() {
+    if (!labelOn) return;
+    if (labelSetsDirty) {
+      report(0.2, "label sets");
+      labelSets = computeLabelSets(volume, build.brick);
+      ++counters.labelSets;
+      ++counters.voxelPasses;
+      labelSetsDirty = false;
+      labelTFValid = false;
+      labelTFDirty = true;
+    }
+    if (!labelTFDirty) return;
+    TransferFunction t = labelTransferFunction(labels, labelSets.lo, labelSets.hi);
+    std::vector<uint8_t> dr = drawnLabels(labels, labelSets.lo, labelSets.hi);
+    if (!labelTFValid || dr != drawn || t.table.size() != tf.table.size() || t.rangeMin != tf.rangeMin)
+      opacityDirty = true;
+    else if (!t.sameOpacity(tf))
+      tableDirty = true;
+    else if (!t.sameColor(tf))
+      colorDirty = true;
+    tf = std::move(t);
+    haveTF = true;
+    drawn = std::move(dr);
+    labelTFDirty = false;
+    labelTFValid = true;
+  }
   BuildParams build;
   RenderParams render;
   int64_t memoryBudget = 0;  ///< setMemoryBudget (0: the backend's default)
@@ -205,6 +264,10 @@ struct Engine::Impl {
   /// Dependent components composite (the only mode vtkGPUVolumeRayCastMapper defines colour and
   /// opacity for from several components): other blend modes are drawn composite, with a warning.
   BlendMode blendMode() {
+    if (labelOn && render.blend != BlendMode::Composite) {
+      warn("blend mode " + std::to_string(int(render.blend)) + " with a label map is not supported: drawn as composite");
+      return BlendMode::Composite;
+    }
     if (volume.components > 1 && render.blend != BlendMode::Composite) {
       warn("blend mode " + std::to_string(int(render.blend)) + " with " + std::to_string(volume.components) +
            " dependent components is not supported: drawn as composite");
@@ -305,16 +368,21 @@ struct Engine::Impl {
       report(0.0, "value ranges");
       backend->setVolume(volume, build.brick);
       ++counters.rangeGrids;
+      ++counters.voxelPasses;
       rangesDirty = false;
+      labelSetsDirty = true;  // computed when a label map is drawn (refreshLabelTF)
       opacityDirty = true;
       buildDirty = true;
     }
+    refreshLabelTF();
     // A TF (or crop/clip) edit: no contender is built on the frame that shows it.
     if (opacityDirty || colorDirty || cropClipDirty) autoBuilder.edited();
     if (!opacityDirty && !cropClipDirty) return false;
     report(0.3, "classification");
     auto t0 = Clock::now();
-    const bool changed = backend->classify(gradientTablesUsed() ? classificationTF(scaledTF()) : scaledTF(), cropClip);
+    const bool changed = labelOn ? backend->classifyLabels(labelSets, drawn, cropClip)
+                                 : backend->classify(gradientTablesUsed() ? classificationTF(scaledTF()) : scaledTF(), cropClip);
+    if (backend->lastClassifyReadVoxels()) ++counters.voxelPasses;
     stats.classifySeconds = since(t0);
     stats.classifyWaitSeconds = backend->lastClassifyWaitSeconds();
     ++counters.classifications;
@@ -376,7 +444,8 @@ struct Engine::Impl {
 
   void update() {
     if (!haveVolume) throw std::runtime_error("no volume set");
-    if (!haveTF) throw std::runtime_error("no transfer function set");
+    syncLabelMode();
+    if (!haveTF && !labelOn) throw std::runtime_error("no transfer function set");
     const bool isAuto = build.builder == BuilderKind::Auto;
     const bool refineNow = autoBuilder.standingIn();  // the last frame stood in: build the kept one now
     const bool newRanges = rangesDirty;
@@ -466,6 +535,11 @@ void Engine::setVolume(const Volume& v) {
 void Engine::setTransferFunction(TransferFunction tf, bool colorMayDiffer, bool opacityMayDiffer) {
   if (tf.table.empty()) throw std::invalid_argument("empty transfer-function table");
   Impl& d = *impl_;
+  if (d.labelOn) {  // drawing a label map: kept for when that ends (syncLabelMode)
+    d.userTF = std::move(tf);
+    d.haveUserTF = true;
+    return;
+  }
   // A table of another size, or the first one, is new as a whole whatever the caller says.
   const bool whole = !d.haveTF || tf.table.size() != d.tf.table.size();
   bool opacity = whole;
@@ -484,6 +558,14 @@ void Engine::setTransferFunction(TransferFunction tf, bool colorMayDiffer, bool 
   d.tf = std::move(tf);
   d.haveTF = true;
 }
+
+void Engine::setLabelTable(const LabelTable& t) {
+  if (t == impl_->labels) return;
+  impl_->labels = t;
+  impl_->labelTFDirty = true;
+}
+const LabelTable& Engine::labelTable() const { return impl_->labels; }
+bool Engine::labelMapActive() const { return impl_->labelOn; }
 
 void Engine::setBuildParams(const BuildParams& p) {
   // bins 1 would mean no candidate plane at all; rejected rather than silently clamped, since 0
@@ -842,6 +924,13 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   fillBlend(d, f, frame);
   fillComponents(d, f);
   fillGradientTF(d, f);
+  // Nearest and label-map sampling (render/LabelSampler.h).
+  if (d.labelOn)
+    f.sampling = d.render.labelSampling == LabelSampling::Nearest ? kLabelNearest : kLabelBlend;
+  else if (d.render.nearest && d.volume.components == 1)
+    f.sampling = kSampleNearest;
+  else if (d.render.nearest)
+    d.warn("nearest sampling with dependent components is not supported: sampled trilinearly");
   std::vector<unsigned> counts;
   if (d.render.countSamples) {
     counts.assign(size_t(width) * size_t(height), 0u);

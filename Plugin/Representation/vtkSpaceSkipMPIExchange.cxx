@@ -2,6 +2,7 @@
 
 #include "vtkMPICommunicator.h"
 #include "vtkMPIController.h"
+#include "vtkMPI.h"
 
 #include <algorithm>
 #include <thread>
@@ -92,6 +93,34 @@ std::shared_ptr<vtkSpaceSkipMPIExchange> vtkSpaceSkipMPIExchange::New(
 
 //------------------------------------------------------------------------------
 vtkSpaceSkipMPIExchange::~vtkSpaceSkipMPIExchange() = default;
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipMPIExchange::NodeLocalRank(vtkMultiProcessController* controller, int& local, int& ranksOnNode)
+{
+  local = 0;
+  ranksOnNode = 1;
+  auto* mpi = vtkMPIController::SafeDownCast(controller);
+  auto* comm = mpi ? vtkMPICommunicator::SafeDownCast(mpi->GetCommunicator()) : nullptr;
+  if (!comm || !comm->GetMPIComm() || !comm->GetMPIComm()->GetHandle())
+  {
+    return false;
+  }
+  MPI_Comm node = MPI_COMM_NULL;
+  if (MPI_Comm_split_type(*comm->GetMPIComm()->GetHandle(), MPI_COMM_TYPE_SHARED,
+        mpi->GetLocalProcessId(), MPI_INFO_NULL, &node) != MPI_SUCCESS ||
+    node == MPI_COMM_NULL)
+  {
+    return false;
+  }
+  const bool ok = MPI_Comm_rank(node, &local) == MPI_SUCCESS && MPI_Comm_size(node, &ranksOnNode) == MPI_SUCCESS;
+  MPI_Comm_free(&node);
+  if (!ok)
+  {
+    local = 0;
+    ranksOnNode = 1;
+  }
+  return ok;
+}
 
 //------------------------------------------------------------------------------
 void vtkSpaceSkipMPIExchange::GiveUp(const std::string& why)

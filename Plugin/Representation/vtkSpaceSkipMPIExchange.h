@@ -42,6 +42,14 @@ public:
     vtkMultiProcessController* controller, WarnFunction warn);
   ~vtkSpaceSkipMPIExchange() override;
 
+  /**
+   * This rank's number among the ranks of its node (those that share memory with it:
+   * MPI_Comm_split_type with MPI_COMM_TYPE_SHARED) and how many they are; one rank per GPU binds
+   * CUDA device `local` (modulo the devices). Collective over `controller`'s ranks; false (0 of
+   * 1) when it is not an MPI controller or MPI fails.
+   */
+  static bool NodeLocalRank(vtkMultiProcessController* controller, int& local, int& ranksOnNode);
+
   using PieceImage = vtkSpaceSkippingVolumeMapper::PieceImage;
   void Begin() override;
   int Finish(int width, int height, std::vector<PieceImage>& mine,

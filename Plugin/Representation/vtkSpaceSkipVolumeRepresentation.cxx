@@ -316,6 +316,15 @@ void vtkSpaceSkipVolumeRepresentation::UpdateExchange(vtkMultiProcessController*
     GatherBounds(controller, this->DataBounds, whole);
     this->SpaceSkipMapper->SetWholeBounds(whole);
   }
+  if (parallel && this->NodeRank < 0)
+  {
+    // One rank per GPU: each rank's CUDA backend on the device of its node-local rank
+    // (modulo the node's devices). Collective, once.
+    int local = 0, onNode = 1;
+    this->NodeRank = vtkSpaceSkipMPIExchange::NodeLocalRank(controller, local, onNode) ? local : 0;
+    this->RanksOnNode = onNode;
+    this->SpaceSkipMapper->SetCudaDevice(this->NodeRank);
+  }
   const bool want = this->FloatCompositing && parallel;
   if (want && !this->Exchange)
   {
@@ -355,7 +364,50 @@ int vtkSpaceSkipVolumeRepresentation::ProcessViewRequest(
     // one whose piece is out of the tile.
     outInfo->Set(vtkPVRenderView::RENDER_EMPTY_IMAGES(), 1);
   }
+  if ((request_type == vtkPVView::REQUEST_UPDATE() || request_type == vtkPVView::REQUEST_RENDER()) &&
+    this->SpaceSkipMapper->GetPieceExchange() && this->GetVisibility())
+  {
+    this->KeepFXAAOffVolumes(this->GetView());
+  }
   return 1;
+}
+
+//------------------------------------------------------------------------------
+// The view's settings reach every rank alike (the proxy pushes them to all), and so does this
+// request: every rank turns FXAA off together.
+void vtkSpaceSkipVolumeRepresentation::KeepFXAAOffVolumes(vtkView* view)
+{
+  auto* rv = vtkPVRenderView::SafeDownCast(view);
+  if (!rv || !rv->GetUseFXAA())
+  {
+    return;
+  }
+  rv->SetUseFXAA(false);
+  this->TurnedFXAAOff = true;
+  if (!this->WarnedFXAA)
+  {
+    vtkMultiProcessController* c = vtkMultiProcessController::GetGlobalController();
+    if (!c || c->GetLocalProcessId() == 0)
+    {
+      vtkWarningMacro(<< "FXAA is off in this view while the Space Skipping Volume is composited "
+                         "across processes: ParaView applies FXAA to the composited frame, "
+                         "volumes included (serially it smooths no volume), which drew up to "
+                         "121/255 away from the serial image");
+    }
+  }
+  this->WarnedFXAA = true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipVolumeRepresentation::RemoveFromView(vtkView* view)
+{
+  auto* rv = vtkPVRenderView::SafeDownCast(view);
+  if (rv && this->TurnedFXAAOff)
+  {
+    rv->SetUseFXAA(true); // the user's setting, as it was before this representation
+  }
+  this->TurnedFXAAOff = false;
+  return this->Superclass::RemoveFromView(view);
 }
 
 //------------------------------------------------------------------------------
@@ -528,6 +580,18 @@ const char* vtkSpaceSkipVolumeRepresentation::GetBuilderUsed()
 const char* vtkSpaceSkipVolumeRepresentation::GetBackendUsed()
 {
   return CopyText(this->SpaceSkipMapper->GetBackendUsed(), this->BackendUsedName);
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSpaceSkipVolumeRepresentation::GetCudaDeviceUsed()
+{
+  std::string text = this->SpaceSkipMapper->GetCudaDeviceUsed();
+  if (text != "none" && this->NodeRank >= 0)
+  {
+    text += " (node rank " + std::to_string(this->NodeRank) + " of " + std::to_string(this->RanksOnNode) + ")";
+  }
+  this->CudaDeviceUsedName = text;
+  return this->CudaDeviceUsedName.c_str();
 }
 
 //------------------------------------------------------------------------------

@@ -80,6 +80,9 @@ public:
   double GetLeafCount();
   double GetOccupancy();
   const char* GetBackendUsed();
+  /// The CUDA device the mapper drew with ("none" when not the CUDA backend): "device N of M",
+  /// under MPI followed by "(node rank r of k)" (one rank per GPU).
+  const char* GetCudaDeviceUsed();
   const char* GetBuilderUsed();
   const char* GetBuilderChoice();
   const char* GetResidency();
@@ -101,7 +104,8 @@ protected:
   void UpdateMapperParameters() override;
 
   /// With float compositing under MPI: asks the view to draw every rank in every frame
-  /// (RENDER_EMPTY_IMAGES), as the exchange needs.
+  /// (RENDER_EMPTY_IMAGES), as the exchange needs, and keeps the view's FXAA off (see
+  /// KeepFXAAOffVolumes).
   int ProcessViewRequest(vtkInformationRequestKey* request_type, vtkInformation* inInfo,
     vtkInformation* outInfo) override;
   int FloatCompositing = 1;
@@ -109,6 +113,10 @@ protected:
   // Creates the exchange and gathers the bounds of all ranks' data (DataBounds, set first) for
   // the mapper (collective: every rank's RequestData).
   void UpdateExchange(vtkMultiProcessController* controller);
+  /// Under MPI: this rank's number among its node's ranks (-1: not asked yet), given to the
+  /// mapper as its CUDA device (one rank per GPU), and how many ranks share the node.
+  int NodeRank = -1;
+  int RanksOnNode = 1;
 
   ///@{
   /// In pieces (MPI): one ghost layer is requested and kept (the base class crops it away), the
@@ -130,9 +138,23 @@ protected:
   /// Use Transfer 2D with a second array (not the gradient) was said (once).
   bool WarnedSecondArray = false;
 
+  ///@{
+  /// FXAA under MPI: serially VTK's renderer applies FXAA before it draws volumes (volumes are
+  /// never smoothed); ParaView 5.11's parallel (IceT) path applies it to the composited frame,
+  /// volumes included, so a volume under `mpiexec -n N pvbatch` differed from the serial image
+  /// by up to 121/255 over the whole object (ParaView's own Volume alike). With the float
+  /// exchange on, the representation turns the view's FXAA off on every rank (said once) and
+  /// gives it back when it leaves the view; the exchange's image is then the serial one.
+  void KeepFXAAOffVolumes(vtkView* view);
+  bool RemoveFromView(vtkView* view) override;
+  bool TurnedFXAAOff = false;
+  bool WarnedFXAA = false;
+  ///@}
+
   /// The base class re-assigns the mapper to the actor on every render; owned by VolumeMapper.
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
   std::string BackendUsedName;
+  std::string CudaDeviceUsedName;
   std::string BuilderUsedName;
   std::string BuilderChoiceText;
   std::string ResidencyText;

@@ -7,7 +7,11 @@ Usage: pvbatch parallel_scene.py OUT.png [builder] [scene]
            planes where the pieces meet), "shell" (the plugin tests' 64^3 reference scene) or
            "vtpd=PATH" (the MNI scene read from a partitioned data set file: its partitions go
            to the ranks as they are), "rect" (the MNI scene, each piece as the
-           vtkRectilinearGrid of its points)
+           vtkRectilinearGrid of its points), "raw16=PATH" (the MNI head as 16-bit CT-like values,
+           v * 12 + 24, read from a little-endian raw file by ParaView's Image Reader as a new
+           user would: 'unsigned short', DataByteOrder, DataExtent), "vti=PATH" (the same 16-bit
+           head from a .vti file, XML Image Data Reader). With raw16 and vti the view keeps
+           ParaView's default FXAA (on), as a new user's does.
 Prints how the data was distributed (the ranks that hold a piece of the volume)."""
 import os
 import sys
@@ -54,6 +58,15 @@ if scene == "shell":
 else:
     if scene.startswith("vtpd="):
         reader = XMLPartitionedDatasetReader(FileName=[scene[5:]])
+    elif scene.startswith("raw16="):
+        reader = ImageReader(FileNames=[scene[6:]])
+        reader.DataScalarType = "unsigned short"
+        reader.DataByteOrder = "LittleEndian"
+        reader.DataExtent = [0, 98, 0, 116, 0, 94]
+        reader.DataSpacing = [2.0, 2.0, 2.0]
+        reader.DataOrigin = [-98.0, -134.0, -72.0]
+    elif scene.startswith("vti="):
+        reader = XMLImageDataReader(FileName=[scene[4:]])
     else:
         reader = ImageReader(FileNames=[os.path.join(ssptest.env("SPACESKIP_DATA"),
                                                      "mni152_t1_99x117x95_uint8.raw")])
@@ -74,11 +87,16 @@ else:
     ColorBy(disp, ("POINTS", ssptest.ARRAY))
     # Skin and bone faint, grey and white matter stronger: the cut planes between the pieces run
     # through every kind of tissue, seen obliquely.
+    # The 16-bit scenes hold v * 12 + 24 of the 8-bit head: the same functions over those values.
+    ct = scene.startswith(("raw16=", "vti="))
+
+    def hu(points):
+        return [v * 12.0 + 24.0 if ct and i % 4 == 0 else v for i, v in enumerate(points)]
     ssptest.set_transfer_functions(
-        lut_points=[0.0, 0.05, 0.05, 0.2, 70.0, 0.85, 0.45, 0.2, 140.0, 0.95, 0.9, 0.75,
-                    243.0, 1.0, 1.0, 1.0],
-        opacity_points=[0.0, 0.0, 0.5, 0.0, 30.0, 0.0, 0.5, 0.0, 80.0, 0.03, 0.5, 0.0,
-                        160.0, 0.12, 0.5, 0.0, 243.0, 0.3, 0.5, 0.0])
+        lut_points=hu([0.0, 0.05, 0.05, 0.2, 70.0, 0.85, 0.45, 0.2, 140.0, 0.95, 0.9, 0.75,
+                       243.0, 1.0, 1.0, 1.0]),
+        opacity_points=hu([0.0, 0.0, 0.5, 0.0, 30.0, 0.0, 0.5, 0.0, 80.0, 0.03, 0.5, 0.0,
+                           160.0, 0.12, 0.5, 0.0, 243.0, 0.3, 0.5, 0.0]))
     disp.ScalarOpacityUnitDistance = 10.0
     if not stock:
         disp.Builder = builder
@@ -90,7 +108,11 @@ else:
     view.CameraParallelProjection = 0
 # FXAA (on by default in 5.11) smooths the serial image's silhouettes but not the composited
 # MPI image alike (24/255 along every silhouette, ParaView's own Volume too): off for both.
-view.UseFXAA = 0
+# The 16-bit reader scenes keep ParaView's default (on), as a new user's view does: under MPI
+# ParaView applies FXAA to the composited frame, volumes included, and the representation turns
+# it off while it composites (vtkSpaceSkipVolumeRepresentation::KeepFXAAOffVolumes).
+if not scene.startswith(("raw16=", "vti=")):
+    view.UseFXAA = 0
 if stock:
     # ParaView's own volume mapper on the same scene.
     disp.SetRepresentationType("Volume")

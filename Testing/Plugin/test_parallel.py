@@ -27,8 +27,21 @@ With --rectilinear every rank's piece of the head is a vtkRectilinearGrid of its
 draws each piece as the image of its points, so the same limits apply (measured 2026-11-27,
 2-core machine: 95.58 / 96.25 dB at 2 / 3 ranks, max 1/255; the serial grid's image equals
 the serial image's).
+With --imagereader the ranks read a 16-bit CT-like head (the MNI head as v * 12 + 24, written
+by this test as a little-endian raw file) through ParaView's Image Reader as a new user would
+('unsigned short', DataByteOrder, DataExtent), in a view with ParaView's default FXAA (on);
+--vti reads the same volume from a .vti file (XML Image Data Reader). This was the held case of
+issue 35: 2 ranks differed from serial pvbatch by up to 32/255 here (up to 71/255 in the
+report) over the whole object, ParaView's own Volume alike. The readers and pieces were not the
+cause (each rank's piece arrives with its ghost layer, the table spans the whole range): under
+MPI ParaView applies FXAA to the composited frame, volumes included, where serially VTK's
+renderer applies it before it draws volumes. The representation turns the view's FXAA off while
+it composites across ranks. Measured 2026-11-27 on the 2-core machine, 2 ranks: before that
+(FXAA left on), --imagereader Grid and --vti KdTreeCPU alike 60.18 dB, max 8/255, 0.946 % of
+the pixels off at all (0.612 % by more than 1/255): both fail; after it 98.01 dB, max 1/255,
+0.003 % of the pixels off at all (none by more than 1/255), both readers.
 Usage: pvpython test_parallel.py MPIEXEC PVBATCH [--partitioned] [--8bit] [--rectilinear]
-       [builder [ranks...]]
+       [--imagereader] [--vti] [builder [ranks...]]
   builder "stock": ParaView's own Volume representation, reported only (no limit checked)."""
 import os
 import re
@@ -42,9 +55,11 @@ import ssptest
 xretry_marks = ("bad X server connection",
                 "require remote rendering which, however, is not available")
 
-args = [a for a in sys.argv[1:] if a not in ("--partitioned", "--8bit", "--rectilinear")]
+args = [a for a in sys.argv[1:]
+        if a not in ("--partitioned", "--8bit", "--rectilinear", "--imagereader", "--vti")]
 partitioned = "--partitioned" in sys.argv
 rectilinear = "--rectilinear" in sys.argv
+ct_reader = "raw16" if "--imagereader" in sys.argv else ("vti" if "--vti" in sys.argv else None)
 if "--8bit" in sys.argv:
     os.environ["SPACESKIP_FLOAT_COMPOSITING"] = "0"  # ParaView's 8-bit compositing (the fallback)
 mpiexec, pvbatch = args[0], args[1]
@@ -131,9 +146,42 @@ def write_partitioned():
     return path
 
 
-mpi_scene = ["vtpd=" + write_partitioned()] if partitioned else (["rect"] if rectilinear else [])
-serial = image("parallel_serial_%s%s.png" % (builder, "_rect" if rectilinear else ""))
-rc, _ = run([pvbatch, scene, serial, builder] + (["rect"] if rectilinear else []), 150)
+def write_ct16(kind):
+    """The MNI head as 16-bit CT-like values (v * 12 + 24, 24..2940), as a little-endian raw
+    file (kind "raw16") or a .vti with the array "ImageFile" (kind "vti"); returns the scene."""
+    import numpy
+    v = numpy.fromfile(os.path.join(ssptest.env("SPACESKIP_DATA"), "mni152_t1_99x117x95_uint8.raw"),
+                       dtype=numpy.uint8).astype(numpy.uint16) * 12 + 24
+    if kind == "raw16":
+        path = ssptest.temp_path("parallel_ct16_99x117x95_le.raw")
+        v.astype("<u2").tofile(path)
+    else:
+        from vtkmodules.vtkCommonDataModel import vtkImageData
+        from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
+        from vtkmodules.util.numpy_support import numpy_to_vtk
+        img = vtkImageData()
+        img.SetExtent(0, 98, 0, 116, 0, 94)
+        img.SetSpacing(2, 2, 2)
+        img.SetOrigin(-98, -134, -72)
+        a = numpy_to_vtk(v, deep=1)
+        a.SetName(ssptest.ARRAY)
+        img.GetPointData().SetScalars(a)
+        path = ssptest.temp_path("parallel_ct16.vti")
+        w = vtkXMLImageDataWriter()
+        w.SetInputData(img)
+        w.SetFileName(path)
+        ok.check(w.Write() == 1, "wrote the 16-bit head (%s)" % path)
+    return "%s=%s" % (kind, path)
+
+
+if ct_reader:
+    mpi_scene = [write_ct16(ct_reader)]
+else:
+    mpi_scene = ["vtpd=" + write_partitioned()] if partitioned else (["rect"] if rectilinear else [])
+tag = "_" + ct_reader if ct_reader else ("_rect" if rectilinear else "")
+serial = image("parallel_serial_%s%s.png" % (builder, tag))
+serial_scene = mpi_scene if ct_reader else (["rect"] if rectilinear else [])
+rc, _ = run([pvbatch, scene, serial, builder] + serial_scene, 150)
 ok.check(rc == 0 and os.path.exists(serial), "serial pvbatch rendered (rc %d)" % rc)
 a = ssptest.read_png(serial) if os.path.exists(serial) else None
 if a is not None:
@@ -147,8 +195,7 @@ for name in ("DISPLAY", "PYTHONPATH", "SPACESKIP_PLUGIN", "SPACESKIP_DATA", "SPA
     if name in os.environ:
         env_args += ["-x", name]
 for n in ranks:
-    mpi = image("parallel_mpi%d_%s%s.png" % (n, builder, "_partitioned" if partitioned else
-                                             ("_rect" if rectilinear else "")))
+    mpi = image("parallel_mpi%d_%s%s.png" % (n, builder, "_partitioned" if partitioned else tag))
     rc, info = run(["timeout", "150", mpiexec, "--allow-run-as-root", "--oversubscribe",
                     "-n", str(n)] + env_args + [pvbatch, scene, mpi, builder] + mpi_scene, 170)
     ok.check(rc == 0 and os.path.exists(mpi), "mpiexec -n %d pvbatch rendered (rc %d)" % (n, rc))
@@ -163,9 +210,9 @@ for n in ranks:
     b = ssptest.read_png(mpi)
     p = ssptest.psnr(a, b)
     diff = abs(a - b).max(axis=2)
-    print("SPACESKIP_PARALLEL_RESULT %s%s serial vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
+    print("SPACESKIP_PARALLEL_RESULT %s%s%s serial vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
           "%.3f%% of pixels differ by more than 1, %.3f%% by any" % (
-              builder, " partitioned" if partitioned else "", n, p, diff.max(), 100.0 * (diff > 1).mean(), 100.0 * (diff > 0).mean()))
+              builder, " partitioned" if partitioned else "", " " + ct_reader if ct_reader else "", n, p, diff.max(), 100.0 * (diff > 1).mean(), 100.0 * (diff > 0).mean()))
     if check and float_compositing:
         ok.check(diff.max() <= 1, "%d ranks == serial within 1/255 (max %d/255, PSNR %.2f dB)"
                  % (n, diff.max(), p))

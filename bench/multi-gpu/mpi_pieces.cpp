@@ -204,7 +204,7 @@ int main(int argc, char** argv) {
     const double eye[3] = {0, 0, 0};
     const std::vector<size_t> order = visibilityOrder(boxes, eye, dir, true);
     std::fill(band.begin(), band.end(), vec4f{0, 0, 0, 0});
-    for (auto it = order.rbegin(); it != order.rend(); ++it) { size_t r = *it; over(band.data(), recv.data() + size_t(r) * myRows * w, band.size()); }
+    for (size_t r : order) over(band.data(), recv.data() + r * myRows * w, band.size());  // front first
     const auto s3 = Clock::now();
     MPI_Gatherv(band.data(), myRows * w * 4, MPI_FLOAT, rank == 0 ? final.rgba.data() : nullptr, counts.data(),
                 displs.data(), MPI_FLOAT, 0, MPI_COMM_WORLD);

@@ -77,6 +77,8 @@ SS_FUNC vec4f classifySample(const FrameView& f, const Sampler& s, vec3f p) {
     }
     return vec4f{directColor(f, s.sampleChannel(p, 0), 0), directColor(f, s.sampleChannel(p, 1), 1),
                  directColor(f, s.sampleChannel(p, 2), 2), a};
+  } else if constexpr (IsNearestSampler<Sampler>::value) {
+    return s.labels() ? labelLookup(f.tf, s.sample(p)) : lookup(f.tf, s.sample(p));
   } else {
     return lookup(f.tf, s.sample(p));
   }

@@ -134,6 +134,10 @@ struct FrameView {
   /// their own); the image is the same either way.
   int sampleBatch;
   GradientTFView gtf;  ///< 2-D transfer function / gradient opacity (mode 0: neither)
+  /// How voxels are sampled (render/LabelSampler.h): 0 trilinear (the default); 1 the nearest
+  /// voxel's value; 2, 3 a label map, its nearest label or the argmax of the corners' label
+  /// weights, drawn through labelLookup. One-component volumes; the executors pick the sampler.
+  int sampling;
 };
 
 }  // namespace spaceskip

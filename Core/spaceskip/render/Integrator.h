@@ -74,6 +74,7 @@ struct ArraySampler {
 
 }  // namespace spaceskip
 
+#include "LabelSampler.h"  // needs voxelValue and ArraySampler
 #include "Components.h"  // needs voxelValue and ArraySampler
 #include "GradientTF.h"
 
@@ -141,10 +142,26 @@ struct IntervalMarcher {
   /// central differences one voxel apart (to world space through the inverse transpose of
   /// index->world), two-sided diffuse, specular from the reflected light vector, white light,
   /// specular not tinted, the result clamped to [0, 1].
+  /// A label map (LabelSampler.h) is lit by the gradient of the sampled label's interpolated
+  /// indicator: its border is the surface, whatever the ids of the labels on either side.
   SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p) const {
-    const float gx = gradientSample(*f, *s, p + vec3f{1, 0, 0}) - gradientSample(*f, *s, p - vec3f{1, 0, 0});
-    const float gy = gradientSample(*f, *s, p + vec3f{0, 1, 0}) - gradientSample(*f, *s, p - vec3f{0, 1, 0});
-    const float gz = gradientSample(*f, *s, p + vec3f{0, 0, 1}) - gradientSample(*f, *s, p - vec3f{0, 0, 1});
+    float gx, gy, gz;
+    if constexpr (IsNearestSampler<Sampler>::value) {
+      if (s->labels()) {
+        const float l = s->sample(p);
+        gx = s->indicator(p + vec3f{1, 0, 0}, l) - s->indicator(p - vec3f{1, 0, 0}, l);
+        gy = s->indicator(p + vec3f{0, 1, 0}, l) - s->indicator(p - vec3f{0, 1, 0}, l);
+        gz = s->indicator(p + vec3f{0, 0, 1}, l) - s->indicator(p - vec3f{0, 0, 1}, l);
+        return shadeGradient(rgb, p, gx, gy, gz);
+      }
+    }
+    gx = gradientSample(*f, *s, p + vec3f{1, 0, 0}) - gradientSample(*f, *s, p - vec3f{1, 0, 0});
+    gy = gradientSample(*f, *s, p + vec3f{0, 1, 0}) - gradientSample(*f, *s, p - vec3f{0, 1, 0});
+    gz = gradientSample(*f, *s, p + vec3f{0, 0, 1}) - gradientSample(*f, *s, p - vec3f{0, 0, 1});
+    return shadeGradient(rgb, p, gx, gy, gz);
+  }
+  /// shadeColor for the index-space central differences (gx, gy, gz).
+  SS_FUNC vec3f shadeGradient(vec3f rgb, vec3f p, float gx, float gy, float gz) const {
     const float* M = f->worldToIndex;
     vec3f n{M[0] * gx + M[4] * gy + M[8] * gz, M[1] * gx + M[5] * gy + M[9] * gz, M[2] * gx + M[6] * gy + M[10] * gz};
     const float len = length(n);
