@@ -393,6 +393,9 @@ public:
     bool interactive = false)
   {
     this->Volume->SetMapper(mapper);
+    // Trilinear, as ParaView's Volume and SetupProperty (vtkVolumeProperty's own default, nearest,
+    // is honoured by the mapper and samples differently).
+    this->Property->SetInterpolationTypeToLinear();
     this->Volume->SetProperty(this->Property);
     this->Renderer->SetBackground(bg[0], bg[1], bg[2]);
     this->Renderer->AddVolume(this->Volume);

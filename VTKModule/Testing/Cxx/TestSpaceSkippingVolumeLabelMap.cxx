@@ -112,14 +112,12 @@ int TestSpaceSkippingVolumeLabelMap(int argc, char* argv[])
     step->AddPoint(9, 1);
     prop->SetColor(ramp);
     prop->SetScalarOpacity(step);
-    prop->SetInterpolationTypeToLinear(); // nearest sampling would invent no colour either
     mapper->LabelMapOff();
     const vtkIdType bad = Unexplained(scene.Shot(), explained);
     std::cout << "ordinary volume: unexplained " << bad << "\n";
     SS_CHECK(bad > 100);
     prop->SetColor(ctf);
     prop->SetScalarOpacity(otf);
-    prop->SetInterpolationTypeToNearest(); // as before (the label map samples labels either way)
     mapper->LabelMapOn();
   }
 
