@@ -13,7 +13,7 @@ namespace
 const char* const kNumberNames[vtkSpaceSkipStatisticsInformation::NumberCount] = {
   "LastBuildSeconds", "LastClassifySeconds", "LastRenderSeconds", "SampleDistanceUsed",
   "NodeCount", "LeafCount", "Occupancy", "TreeHeight", "BuildCount", "ClassifyCount",
-  "ColorUpdateCount", "FrameCount"
+  "ColorUpdateCount", "FrameCount", "LabelMapUsed"
 };
 const char* const kTextNames[vtkSpaceSkipStatisticsInformation::TextCount] = { "BackendUsed",
   "BuilderUsed", "BuilderChoice", "Residency" };
@@ -56,7 +56,8 @@ void vtkSpaceSkipStatisticsInformation::CopyFromObject(vtkObject* object)
     rep->GetLastRenderSeconds(), rep->GetSampleDistanceUsed(), rep->GetNodeCount(),
     rep->GetLeafCount(), rep->GetOccupancy(), static_cast<double>(rep->GetTreeHeight()),
     static_cast<double>(rep->GetBuildCount()), static_cast<double>(rep->GetClassifyCount()),
-    static_cast<double>(rep->GetColorUpdateCount()), static_cast<double>(rep->GetFrameCount()) };
+    static_cast<double>(rep->GetColorUpdateCount()), static_cast<double>(rep->GetFrameCount()),
+    static_cast<double>(rep->GetLabelMapUsed()) };
   this->Texts = { rep->GetBackendUsed(), rep->GetBuilderUsed(), rep->GetBuilderChoice(),
     rep->GetResidency() };
 }

@@ -34,7 +34,7 @@ public:
   void CopyFromStream(const vtkClientServerStream* stream) override;
 
   /// Numeric statistics, by the names of their properties (NumberNames).
-  static constexpr int NumberCount = 12;
+  static constexpr int NumberCount = 13;
   static const char* GetNumberName(int i);
   double GetNumber(int i) const { return this->Numbers[i]; }
   /// String statistics, by the names of their properties.

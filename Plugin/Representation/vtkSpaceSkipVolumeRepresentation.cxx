@@ -2,8 +2,10 @@
 #include "vtkSpaceSkipVolumeRepresentation.h"
 
 #include "vtkColorTransferFunction.h"
+#include "vtkCellData.h"
 #include "vtkCommunicator.h"
 #include "vtkDataArray.h"
+#include "vtkDataSet.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
@@ -144,6 +146,55 @@ bool GatherLattice(vtkMultiProcessController* controller, const std::vector<vtkI
   return true;
 }
 
+// The array `info` names (FIELD_NAME, FIELD_ASSOCIATION) in `data`: an image or rectilinear grid,
+// or the first partition that has it; null if none.
+vtkDataArray* FindDrawnArray(vtkDataObject* data, vtkInformation* info)
+{
+  const char* name = info && info->Has(vtkDataObject::FIELD_NAME())
+    ? info->Get(vtkDataObject::FIELD_NAME())
+    : nullptr;
+  if (!data || !name || !name[0])
+  {
+    return nullptr;
+  }
+  const bool cells = info->Has(vtkDataObject::FIELD_ASSOCIATION()) &&
+    info->Get(vtkDataObject::FIELD_ASSOCIATION()) == vtkDataObject::FIELD_ASSOCIATION_CELLS;
+  auto fromSet = [&](vtkDataSet* ds) -> vtkDataArray* {
+    if (!ds)
+    {
+      return nullptr;
+    }
+    return cells ? ds->GetCellData()->GetArray(name) : ds->GetPointData()->GetArray(name);
+  };
+  if (auto* ds = vtkDataSet::SafeDownCast(data))
+  {
+    return fromSet(ds);
+  }
+  if (auto* pds = vtkPartitionedDataSet::SafeDownCast(data))
+  {
+    for (unsigned int i = 0; i < pds->GetNumberOfPartitions(); ++i)
+    {
+      if (vtkDataArray* a = fromSet(pds->GetPartition(i)))
+      {
+        return a;
+      }
+    }
+  }
+  return nullptr;
+}
+
+// One component of 8- or 16-bit integers: what the mapper draws as a label map.
+bool IsLabelArray(vtkDataArray* a)
+{
+  if (!a || a->GetNumberOfComponents() != 1)
+  {
+    return false;
+  }
+  const int t = a->GetDataType();
+  return t == VTK_UNSIGNED_CHAR || t == VTK_CHAR || t == VTK_SIGNED_CHAR ||
+    t == VTK_UNSIGNED_SHORT || t == VTK_SHORT;
+}
+
 // The bounds of all ranks' data (collective; uninitialized when no rank has data).
 void GatherBounds(vtkMultiProcessController* controller, const double local[6], double global[6])
 {
@@ -206,6 +257,7 @@ void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
                        "gradient magnitude, as with Use Gradient For Transfer 2D");
   }
   this->WarnedSecondArray = this->WarnedSecondArray || secondArray;
+  this->UpdateLabelMap();
   // Same rule as the base class for vtkSmartVolumeMapper: with independent components the
   // colour map's vector mode and component, else component 0.
   vtkVolumeProperty* prop = this->Property;
@@ -231,6 +283,52 @@ void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
     range[1] = this->WholeRanges[2 * c + 1];
   }
   this->SpaceSkipMapper->SetWholeScalarRange(range);
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::UpdateLabelMap()
+{
+  bool on = this->LabelMapMode == LabelMapOn;
+  if (this->LabelMapMode == LabelMapAuto)
+  {
+    // Auto: a categorical colour map ("Interpret Values As Categories") on an integer array the
+    // mapper can draw as labels. Other types stay ordinary volumes, without the mapper's warning.
+    vtkVolumeProperty* prop = this->Property;
+    vtkColorTransferFunction* ctf = prop ? prop->GetRGBTransferFunction(0) : nullptr;
+    on = ctf && ctf->GetIndexedLookup() &&
+      IsLabelArray(FindDrawnArray(this->Cache, this->GetInputArrayInformation(0)));
+  }
+  this->SpaceSkipMapper->SetLabelMap(on);
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::SetLabelMapMode(int mode)
+{
+  mode = std::min(std::max(mode, 0), 2);
+  if (this->LabelMapMode != mode)
+  {
+    this->LabelMapMode = mode;
+    this->UpdateLabelMap();
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::GetLabelMapUsed()
+{
+  return this->SpaceSkipMapper->GetLabelMap() ? 1 : 0;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::SetLabelSampling(int sampling)
+{
+  this->SpaceSkipMapper->SetLabelSampling(sampling);
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipVolumeRepresentation::GetLabelSampling()
+{
+  return this->SpaceSkipMapper->GetLabelSampling();
 }
 
 //------------------------------------------------------------------------------

@@ -67,6 +67,22 @@ public:
   /// default) instead of ParaView's 8-bit compositing of the ranks' images (vtkSpaceSkipMPIExchange).
   void SetFloatCompositing(int on);
   vtkGetMacro(FloatCompositing, int);
+  /// Label map (docs/labelmaps.md): Off, On, or Auto (default): on when the colour map is
+  /// categorical (IndexedLookup, ParaView's "Interpret Values As Categories") and the drawn
+  /// array is one component of 8- or 16-bit integers. Decided on every render.
+  enum LabelMapModes
+  {
+    LabelMapOff = 0,
+    LabelMapOn = 1,
+    LabelMapAuto = 2
+  };
+  void SetLabelMapMode(int mode);
+  vtkGetMacro(LabelMapMode, int);
+  /// Whether the mapper draws a label map now (Auto decided).
+  int GetLabelMapUsed();
+  /// vtkSpaceSkippingVolumeMapper::NearestLabel (0) or BlendedLabel (1, default).
+  void SetLabelSampling(int sampling);
+  int GetLabelSampling();
   ///@}
 
   ///@{
@@ -134,6 +150,10 @@ protected:
   /// vtkMultiBlockVolumeMapper: the same cache of partitions for our mapper (it accepts composite
   /// input), with the outline and data size of the whole.
   int RequestPartitionedData(vtkInformation*, vtkInformationVector**, vtkInformationVector*);
+
+  int LabelMapMode = LabelMapAuto;
+  /// Sets the mapper's LabelMap from LabelMapMode, the colour map and the drawn array.
+  void UpdateLabelMap();
 
   /// Use Transfer 2D with a second array (not the gradient) was said (once).
   bool WarnedSecondArray = false;

@@ -1,0 +1,149 @@
+"""Label maps in ParaView (issue 37): a uint8 segmentation of touching blobs with far-apart ids,
+coloured through a categorical colour map ("Interpret Values As Categories", annotations and
+indexed colours), is drawn by the Space Skipping Volume's label-map mode (Label Map = Auto):
+every pixel is the background or one label's colour, with either Label Sampling. The same data
+through a continuous map of the same colours (categories off: Auto draws an ordinary volume)
+shows colours of no label, so the check can fail. Label Map Off/On override Auto. A saved state
+reloads to the same image with the label-map mode on."""
+import numpy
+from paraview.simple import *
+import ssptest
+
+ssptest.load_plugin()
+ok = ssptest.Checker()
+
+N = 40
+BLOBS = [(14, 14, 14, 8, 1), (24, 15, 15, 7, 5), (16, 25, 18, 7, 9), (26, 26, 26, 6, 2)]
+# id -> colour, far apart (and far from the black background)
+COLOURS = {1: (0.9, 0.2, 0.2), 2: (1.0, 0.9, 0.1), 5: (0.2, 0.9, 0.2), 9: (0.2, 0.3, 1.0)}
+NAMES = {1: "one", 2: "two", 5: "five", 9: "nine"}
+
+
+def write_labels(path):
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    z, y, x = numpy.mgrid[0:N, 0:N, 0:N].astype(numpy.float64)
+    data = numpy.zeros((N, N, N), numpy.uint8)
+    for cx, cy, cz, r, label in BLOBS:  # later blobs over earlier ones: touching borders
+        inside = (x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2 <= r * r
+        data[inside] = label
+    img = vtkImageData()
+    img.SetDimensions(N, N, N)
+    arr = numpy_to_vtk(data.ravel(), deep=1)
+    arr.SetName("labels")
+    img.GetPointData().SetScalars(arr)
+    w = vtkXMLImageDataWriter()
+    w.SetFileName(path)
+    w.SetInputData(img)
+    w.Write()
+
+
+def unexplained(img, colours, tol=2):
+    """Pixels whose colour is neither the black background nor one of `colours` (+-tol/255)."""
+    known = [numpy.array([0.0, 0.0, 0.0])] + [numpy.round(numpy.array(c) * 255.0) for c in colours]
+    good = numpy.zeros(img.shape[:2], bool)
+    for c in known:
+        good |= (numpy.abs(img - c) <= tol).all(axis=2)
+    return int((~good).sum())
+
+
+def shot(view, name):
+    return ssptest.read_png(ssptest.render_to(view, name))
+
+
+def label_map_used(disp):
+    disp.UpdatePropertyInformation()
+    return disp.GetPropertyValue("LabelMapUsed")
+
+
+path = ssptest.temp_path("labelmap_blobs.vti")
+write_labels(path)
+reader = XMLImageDataReader(registrationName="LabelBlobs", FileName=[path])
+view = ssptest.make_view()
+disp = Show(reader, view)
+disp.SetRepresentationType("Space Skipping Volume")
+ColorBy(disp, ("POINTS", "labels"))
+disp.Builder = "Grid"
+disp.Backend = "CPU"
+disp.Shade = 0
+disp.ScalarOpacityUnitDistance = 1.0
+c = (N - 1) / 2.0
+view.CameraFocalPoint = [c, c, c]
+view.CameraPosition = [c + 45.0, c + 30.0, c + 60.0]
+view.CameraViewUp = [0.0, 1.0, 0.0]
+view.CameraViewAngle = 30.0
+
+lut = GetColorTransferFunction("labels")
+lut.AutomaticRescaleRangeMode = "Never"
+ids = sorted(COLOURS)
+lut.RGBPoints = sum(([float(i)] + list(COLOURS[i]) for i in ids), [])
+pwf = GetOpacityTransferFunction("labels")
+pwf.Points = [0.0, 0.0, 0.5, 0.0, 0.5, 1.0, 0.5, 0.0, 9.0, 1.0, 0.5, 0.0]  # opaque from 0.5 on
+lut.InterpretValuesAsCategories = 1
+lut.Annotations = sum(([str(i), NAMES[i]] for i in ids), [])
+lut.IndexedColors = sum((list(COLOURS[i]) for i in ids), [])
+colours = [COLOURS[i] for i in ids]
+
+ok.check(disp.LabelMap == "Auto" and disp.LabelSampling == "Blended",
+         "defaults: Label Map Auto, Label Sampling Blended (%s, %s)" % (disp.LabelMap, disp.LabelSampling))
+images = {}
+for sampling in ["Nearest", "Blended"]:
+    disp.LabelSampling = sampling
+    images[sampling] = img = shot(view, "labelmap_%s.png" % sampling.lower())
+    lit, bad = ssptest.lit_fraction(img), unexplained(img, colours)
+    print("categories, %s: lit %.3f, unexplained %d" % (sampling, lit, bad))
+    ok.check(label_map_used(disp) == 1, "Auto + categorical map on uint8: label-map mode on")
+    ok.check(lit > 0.05, "%s: the labels are drawn (%.1f%% of the pixels)" % (sampling, 100 * lit))
+    ok.check(bad == 0, "%s: every pixel is the background or a label's colour (%d not)" % (sampling, bad))
+    # every label shows up
+    for i in ids:
+        col = numpy.round(numpy.array(COLOURS[i]) * 255.0)
+        n = int((numpy.abs(img - col) <= 2).all(axis=2).sum())
+        ok.check(n > 50, "%s: label %d drawn (%d pixels)" % (sampling, i, n))
+labelled = images["Blended"]
+p = ssptest.psnr(images["Nearest"], labelled)
+ok.check(p < 60.0, "Label Sampling changes the image (PSNR Nearest vs Blended %.2f dB)" % p)
+
+# Label Map Off: an ordinary volume through the indexed map, whatever Auto would say.
+disp.LabelMap = "Off"
+off = shot(view, "labelmap_forced_off.png")
+ok.check(label_map_used(disp) == 0, "Label Map Off: mode off")
+disp.LabelMap = "Auto"
+
+# Categories off: a continuous map of the same colours; Auto draws an ordinary volume, whose
+# interpolation between ids invents colours (the check above can fail).
+lut.InterpretValuesAsCategories = 0
+cont = shot(view, "labelmap_continuous.png")
+bad = unexplained(cont, colours)
+print("continuous: unexplained %d" % bad)
+ok.check(label_map_used(disp) == 0, "Auto + continuous map: label-map mode off")
+ok.check(bad > 100, "a continuous map invents colours (%d pixels of no label's colour)" % bad)
+# On forces the label map even with a continuous map (labels: every integer of the range).
+disp.LabelMap = "On"
+forced = shot(view, "labelmap_forced_on.png")
+ok.check(label_map_used(disp) == 1, "Label Map On with a continuous map: mode on")
+ok.check(ssptest.psnr(forced, cont) < 40.0, "Label Map On changes the continuous image")
+disp.LabelMap = "Auto"
+lut.InterpretValuesAsCategories = 1
+again = shot(view, "labelmap_again.png")
+p = ssptest.psnr(again, labelled)
+ok.check(label_map_used(disp) == 1 and p == float("inf"),
+         "categories back on: the label image again (PSNR %.2f dB)" % p)
+
+# A saved state reloads to the same image, label-map mode on.
+state = ssptest.temp_path("labelmap_state.pvsm")
+SaveState(state)
+ResetSession()
+ssptest.load_plugin()
+LoadState(state)
+view = GetActiveViewOrCreate("RenderView")
+disp = GetDisplayProperties(FindSource("LabelBlobs"), view)
+after = shot(view, "labelmap_state_after.png")
+diff = float(numpy.abs(after - labelled).max()) if after.shape == labelled.shape else 255.0
+ok.check(disp.Representation == "Space Skipping Volume" and disp.LabelMap == "Auto",
+         "state: Space Skipping Volume, Label Map Auto (%s, %s)" % (disp.Representation, disp.LabelMap))
+ok.check(label_map_used(disp) == 1, "state: label-map mode on after LoadState")
+ok.check(diff <= 1.0, "state: the same image (max difference %g/255)" % diff)
+ok.check(unexplained(after, colours) == 0, "state: every pixel explained")
+ok.done()
