@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <stdexcept>
@@ -179,12 +180,15 @@ void nbodyParticle(const CosmicWeb& w, uint64_t seed, int64_t i, double* x) {
   }
 }
 
-Volume nbody(vec3l dims, unsigned seed) {
+/// Points [z0, z1] of nbody(dims): the particles whose voxel lies in them, in a volume of
+/// dims.x x dims.y x (z1 - z0 + 1) (one rank's slab, without the whole volume).
+Volume nbodySlab(vec3l dims, int64_t z0, int64_t z1, unsigned seed) {
   Volume v;
-  v.allocate(dims, VoxelType::UInt8);
+  v.allocate(vec3l{dims.x, dims.y, z1 - z0 + 1}, VoxelType::UInt8);
   unsigned char* d = v.mutableData();
   const CosmicWeb web = makeWeb(seed);
-  // Voxel of each particle (in parallel), sorted, then one value per run of equal voxels.
+  // Voxel of each particle (in parallel; -1 outside the slab), sorted, then one value per run of
+  // equal voxels.
   std::vector<int64_t> vox(static_cast<size_t>(kNbodyParticles));
   tbb::parallel_for(tbb::blocked_range<int64_t>(0, kNbodyParticles), [&](const tbb::blocked_range<int64_t>& r) {
     for (int64_t i = r.begin(); i != r.end(); ++i) {
@@ -193,18 +197,20 @@ Volume nbody(vec3l dims, unsigned seed) {
       const int64_t ix = std::min(dims.x - 1, int64_t(x[0] * double(dims.x)));
       const int64_t iy = std::min(dims.y - 1, int64_t(x[1] * double(dims.y)));
       const int64_t iz = std::min(dims.z - 1, int64_t(x[2] * double(dims.z)));
-      vox[size_t(i)] = ix + dims.x * (iy + dims.y * iz);
+      vox[size_t(i)] = iz < z0 || iz > z1 ? -1 : ix + dims.x * (iy + dims.y * (iz - z0));
     }
   });
   tbb::parallel_sort(vox.begin(), vox.end());
   for (size_t i = 0; i < vox.size();) {
     size_t j = i;
     while (j < vox.size() && vox[j] == vox[i]) ++j;
-    d[vox[i]] = (unsigned char)std::min<size_t>(255, 64 + 24 * (j - i - 1));
+    if (vox[i] >= 0) d[vox[i]] = (unsigned char)std::min<size_t>(255, 64 + 24 * (j - i - 1));
     i = j;
   }
   return v;
 }
+
+Volume nbody(vec3l dims, unsigned seed) { return nbodySlab(dims, 0, dims.z - 1, seed); }
 
 Volume shell(vec3l dims) {
   Volume v;
@@ -700,6 +706,18 @@ std::vector<std::string> generatorShapes() {
           "kingsnake", "richtmyer_meshkov"};
 }
 
+Volume generateSlab(const std::string& shape, vec3l dims, int64_t z0, int64_t z1, unsigned seed) {
+  if (z0 < 0 || z1 < z0 || z1 >= dims.z) throw std::invalid_argument("slab outside the volume");
+  if (shape == "nbody") return nbodySlab(dims, z0, z1, seed);
+  const Volume whole = generateVolume(shape, dims, seed);
+  Volume v;
+  v.allocate(vec3l{dims.x, dims.y, z1 - z0 + 1}, whole.type);
+  const size_t plane = size_t(dims.x * dims.y) * voxelSize(whole.type);
+  std::memcpy(v.mutableData(), static_cast<const unsigned char*>(whole.data) + size_t(z0) * plane,
+              size_t(z1 - z0 + 1) * plane);
+  return v;
+}
+
 Volume generateVolume(const std::string& shape, vec3l dims, unsigned seed) {
   if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0) throw std::invalid_argument("dims must be positive");
   if (shape == "menger") return menger(dims);
@@ -714,8 +732,10 @@ Volume generateVolume(const std::string& shape, vec3l dims, unsigned seed) {
   if (shape == "stag_beetle") return stagBeetle(dims, seed);
   if (shape == "kingsnake") return kingsnake(dims, seed);
   if (shape == "richtmyer_meshkov") return richtmyerMeshkov(dims, seed);
+  if (const int labels = labelShapeCount(shape)) return generateLabels(dims, labels, seed);  // LabelGenerator.cpp
   std::string known;
   for (const std::string& g : generatorShapes()) known += (known.empty() ? "" : ", ") + g;
+  known += ", labels[N]";
   throw std::invalid_argument("unknown shape '" + shape + "' (" + known + ")");
 }
 

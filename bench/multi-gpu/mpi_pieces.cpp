@@ -12,7 +12,11 @@
 //   mpiexec -n N spaceskip_mpi_pieces [--shape nbody] [--dims 2048] [--size 1024] [--frames 30]
 //       [--builder Auto] [--backend auto|cpu|cuda] [--tf ramp] [--check] [--png out.png]
 // --check: rank 0 also renders the whole volume alone and prints the largest difference of
-// the composited image from it (8-bit units).
+// the composited image from it (8-bit units). --slabs: each rank makes only its slab (volumes
+// larger than one host's share or one GPU: no rank holds the whole; with --check rank 0 makes
+// it for the reference alone).
+// After the orbit every rank edits the transfer function (the ramp over the upper 3/4 of the
+// range) and back: each edit's frame is timed (classification, rebuild, render, composite).
 #include "spaceskip/Camera.h"
 #include "spaceskip/Engine.h"
 #include "spaceskip/Generators.h"
@@ -43,7 +47,7 @@ struct Args {
   std::string shape = "nbody", builder = "Auto", backend = "auto", tf = "ramp", png;
   int64_t dims = 256;
   int size = 512, frames = 20;
-  bool check = false;
+  bool check = false, slabs = false;
 };
 
 Args parse(int argc, char** argv) {
@@ -66,6 +70,7 @@ Args parse(int argc, char** argv) {
     else if (k == "--tf") a.tf = next();
     else if (k == "--png") a.png = next();
     else if (k == "--check") a.check = true;
+    else if (k == "--slabs") a.slabs = true;
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       MPI_Abort(MPI_COMM_WORLD, 2);
@@ -128,22 +133,39 @@ int main(int argc, char** argv) {
   }
 #endif
 
-  // Every rank makes the whole volume (the generators are deterministic) and draws a slab of
-  // it along z: cells [z0, z1), its points with one ghost layer on each side.
+  // Every rank makes the whole volume (the generators are deterministic; with --slabs only its
+  // slab) and draws a slab of it along z: cells [z0, z1), its points with one ghost layer on
+  // each side.
   const auto t0 = Clock::now();
-  Volume whole = generateVolume(a.shape, vec3l{a.dims, a.dims, a.dims});
-  double lo = 0, hi = 1;
-  if (!whole.scalarRange(lo, hi)) lo = 0, hi = 1;
-  const TransferFunction tf = TransferFunction::preset(a.tf, lo, hi);
-  const int64_t cells = whole.dims.z - 1;
+  const vec3l wdims{a.dims, a.dims, a.dims};
+  const int64_t cells = wdims.z - 1;
   const int64_t z0 = cells * rank / ranks, z1 = cells * (rank + 1) / ranks;
-  const int64_t p0 = std::max<int64_t>(z0 - 1, 0), p1 = std::min<int64_t>(z1 + 1, whole.dims.z - 1);
-  Volume piece = whole;
-  piece.storage.reset();
-  piece.dims.z = p1 - p0 + 1;
+  const int64_t p0 = std::max<int64_t>(z0 - 1, 0), p1 = std::min<int64_t>(z1 + 1, wdims.z - 1);
+  Volume whole, piece;
+  if (a.slabs) {
+    piece = generateSlab(a.shape, wdims, p0, p1);
+    whole.dims = wdims;  // the header only: bounds and lattice
+    whole.type = piece.type;
+    std::copy(piece.origin, piece.origin + 3, whole.origin);
+    std::copy(piece.spacing, piece.spacing + 3, whole.spacing);
+  } else {
+    whole = generateVolume(a.shape, wdims);
+    piece = whole;
+    piece.storage.reset();
+    piece.dims.z = p1 - p0 + 1;
+    piece.data = static_cast<const unsigned char*>(whole.data) +
+                 size_t(p0) * size_t(whole.dims.x * whole.dims.y) * voxelSize(whole.type);
+  }
   piece.origin[2] = whole.origin[2] + whole.spacing[2] * double(p0);
-  piece.data = static_cast<const unsigned char*>(whole.data) +
-               size_t(p0) * size_t(whole.dims.x * whole.dims.y) * voxelSize(whole.type);
+  // The transfer function spans the range over all ranks' pieces (the whole volume's).
+  double range[2] = {0, 1};
+  if (!piece.scalarRange(range[0], range[1])) range[0] = 1, range[1] = 0;
+  double lo = 0, hi = 0;
+  MPI_Allreduce(&range[0], &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&range[1], &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  if (!(hi >= lo)) lo = 0, hi = 1;
+  const TransferFunction tf = TransferFunction::preset(a.tf, lo, hi);
+  const TransferFunction edited = TransferFunction::preset(a.tf, lo + 0.25 * (hi - lo), hi);
   VolumePiece vp;
   vp.wholeDims = whole.dims;
   std::copy(whole.origin, whole.origin + 3, vp.wholeOrigin);
@@ -221,6 +243,21 @@ int main(int argc, char** argv) {
   for (int i = 0; i < 3; ++i) frame(0, warm);  // Auto measures its candidates
   Times t;
   for (int f = 0; f < a.frames; ++f) frame(f, t);
+  // Device memory in use on this rank's GPU after the orbit (the volume in core, the structure).
+  double deviceGiB = 0;
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+  size_t freeB = 0, totalB = 0;
+  if (device >= 0 && cudaMemGetInfo(&freeB, &totalB) == cudaSuccess) deviceGiB = double(totalB - freeB) / double(1ull << 30);
+#endif
+  double deviceGiBMax = 0;
+  MPI_Reduce(&deviceGiB, &deviceGiBMax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+  // A transfer-function edit and back, each edit's first frame timed (the last camera: the
+  // composite that --check compares is the original function's).
+  Times e1, e2;
+  engine.setTransferFunction(edited);
+  frame(a.frames - 1, e1);
+  engine.setTransferFunction(tf);
+  frame(a.frames - 1, e2);
   // The slowest rank's render is what the frame waited for.
   double renderMax = 0, renderMin = 0;
   MPI_Reduce(&t.render, &renderMax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
@@ -240,7 +277,9 @@ int main(int argc, char** argv) {
     const double n = a.frames;
     std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s\n", ranks, a.shape.c_str(),
                 (long long)a.dims, w, h, a.frames, engine.backendName());
-    std::printf("setup_s %.3f first_frame_s %.4f\n", setup, first);
+    std::printf("setup_s %.3f first_frame_s %.4f device_GiB(max rank) %.2f volume_GiB %.2f\n", setup, first,
+                deviceGiBMax, double(wdims.x) * double(wdims.y) * double(wdims.z) * double(voxelSize(piece.type)) / double(1ull << 30));
+    std::printf("tf_edit_frame_ms %.3f tf_edit_back_frame_ms %.3f\n", 1e3 * e1.frame, 1e3 * e2.frame);
     std::printf("frame_ms %.3f fps %.1f render_ms(rank0) %.3f render_ms(max) %.3f render_ms(min) %.3f "
                 "exchange_ms %.3f blend_ms %.3f gather_ms %.3f last_kernel_ms %.3f\n",
                 1e3 * t.frame / n, n / t.frame, 1e3 * t.render / n, 1e3 * renderMax / n, 1e3 * renderMin / n,
@@ -254,6 +293,7 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       Engine ref(backendOf(a.backend));
       ref.setBuildParams(bp);
+      if (a.slabs) whole = generateVolume(a.shape, wdims);  // the reference only
       ref.setVolume(whole);
       ref.setTransferFunction(tf);
       Image serial;

@@ -15,7 +15,7 @@ trap 'rm -rf "$stage"' EXIT
 mkdir -p "$stage/bin" "$stage/lib"
 cp "$exe" "$stage/bin/"
 for l in libtbb.so.12 libtbbmalloc.so.2 libhwy.so.1 libpng16.so.16; do
-  p=$(ldconfig -p | awk -v l="$l" '$1 == l {print $NF; exit}')
+  p=$(ldconfig -p | awk -v l="$l" '$1 == l && !done {print $NF; done = 1}')  # no early exit: SIGPIPE under pipefail
   [ -n "$p" ] && cp -L "$p" "$stage/lib/"
 done
 for p in libopenmpi3 openmpi-bin openmpi-common libpmix2 libhwloc15 libevent-core-2.1-7 \

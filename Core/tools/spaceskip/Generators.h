@@ -21,7 +21,21 @@ namespace spaceskip {
 /// turbulent mixing layer between, 50.6%, mixing along z).
 /// All uint8 except "noise" (float32). Throws std::invalid_argument for unknown shapes.
 Volume generateVolume(const std::string& shape, vec3l dims, unsigned seed = 1);
+/// Points z0..z1 (inclusive) of generateVolume(shape, dims, seed), as a volume of their own
+/// (origin and spacing untouched): one MPI rank's slab. "nbody" makes only the slab (a volume
+/// larger than any one host's share never exists whole); other shapes are made whole and cut.
+Volume generateSlab(const std::string& shape, vec3l dims, int64_t z0, int64_t z1, unsigned seed = 1);
 std::vector<std::string> generatorShapes();
+
+/// A label map (segmentation, issue 37): `labels` ellipsoidal blobs, ids 1..labels, background 0,
+/// on a jittered grid of ~1.3 cells a label with the ids shuffled (neighbours' ids unrelated),
+/// sizes log-uniform over 0.12..0.55 cells (volumes ~100x apart), each axis x0.7..1.3; uint8 for
+/// <= 255 labels, else uint16. Deterministic per seed (not per thread count); every id present when
+/// a cell is >= ~2 voxels wide (each blob's centre voxel keeps its id). Work: the painted voxels
+/// (per blob only its rows), not voxels x labels. generateVolume's "labels" (256) and "labelsN".
+Volume generateLabels(vec3l dims, int labels = 256, unsigned seed = 1);
+/// The label count of a shape "labels" (256) or "labelsN" (N in 1..65535), else 0.
+int labelShapeCount(const std::string& shape);
 
 /// Fraction of voxels a transfer function makes visible (opacity > 0 at the voxel's value,
 /// NaN transparent): the paper's "occupancy" (Fig. 1).
