@@ -77,6 +77,7 @@ int cmdRender(const Options& o);      ///< Render.cpp
 int cmdSparse(const Options& o);      ///< Sparse.cpp
 int cmdBench(const Options& o);       ///< Bench.cpp
 int cmdBenchPaper(const Options& o);  ///< Paper.cpp
+int cmdBenchLabels(const Options& o); ///< BenchLabels.cpp (bench --label-map)
 int cmdAccuracy(const Options& o);    ///< Accuracy.cpp
 
 }  // namespace spaceskip::cli

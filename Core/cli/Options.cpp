@@ -4,6 +4,7 @@
 
 #include "Environment.h"
 
+#include "spaceskip/Generators.h"
 #include "spaceskip/render/Integrator.h"
 #include "spaceskip/Parse.h"
 #include "spaceskip/VolumeIO.h"
@@ -29,7 +30,8 @@ const std::set<std::string>& valueOptions() {
       "--threads", "--tf", "--size", "--camera", "--sample-distance", "--ert", "--filter", "--compare",
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
       "--shade", "--cuda-block", "--scale", "--datasets", "--time-limit", "--memory-budget",
-      "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes", "--label-map", "--hide-labels"};
+      "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes", "--label-map", "--hide-labels",
+      "--toggles", "--visible-every"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
@@ -151,8 +153,11 @@ void parseCamera(const std::string& s, double& az, double& el, double& zoom) {
 }
 
 uint64_t checkGeneratorSize(const std::string& shape, vec3l dims, uint64_t maxBytes) {
-  // The generators emit uint8 except "noise" (float32): Generators.h.
-  const VoxelType t = shape == "noise" ? VoxelType::Float32 : VoxelType::UInt8;
+  // The generators emit uint8 except "noise" (float32) and "labels" of more than 255 labels
+  // (uint16): Generators.h.
+  const VoxelType t = shape == "noise"                ? VoxelType::Float32
+                      : labelShapeCount(shape) > 255 ? VoxelType::UInt16
+                                                      : VoxelType::UInt8;
   return checkedByteSize(dims, t, maxBytes, "generated volume '" + shape + "'");
 }
 

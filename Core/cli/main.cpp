@@ -19,7 +19,8 @@ namespace {
 const char* kUsage = R"(usage:
   spaceskip generate SHAPE --dims X Y Z [--seed N] -o FILE(.nrrd|_XxYxZ_TYPE.raw)
       SHAPE: menger nbody shell noise rm vessels, and the paper's data sets: aneurism xmas_tree
-      magnetic stag_beetle kingsnake richtmyer_meshkov
+      magnetic stag_beetle kingsnake richtmyer_meshkov; labels (256 labelled blobs, uint16) or
+      labelsN (N labels, uint8 up to 255)
   spaceskip render VOLUME -o out.png [options]
   spaceskip accuracy VOLUME [--builder B] [--size WxH] [--csv FILE] [options]
       speed/accuracy trade: sample distance 0.25-4 voxels x filter x ERT x jitter vs PSNR/SSIM
@@ -44,6 +45,14 @@ const char* kUsage = R"(usage:
       gpu_mls128 hybrid) plus ours (grid distance_grid kdtree_gpu_fast kdtree_empty auto), 1024x1024,
       rotating orthographic camera, no ERT; progress on stderr; --time-limit S stops starting new
       items after S seconds (the rest are written as skipped). Figures: scripts/plot-paper-bench.py
+
+  spaceskip bench VOLUME --label-map blend|nearest [--builder B] [--frames N] [--toggles N]
+                  [--visible-every K] [options]
+      the label-map benchmark (one VOLUME of 8/16-bit ids, e.g. gen:labels:512 or gen:labelsN:512):
+      first frame (upload, label sets, classification, build), fps with every label visible and
+      with the ids % K == 0 (default 10) against Naive, and N (default 20) hide/show toggles of one
+      label at a still view, each setLabelTable + its frame (median, max) against a plain frame,
+      with the counters (no voxel pass); exit 4 when a toggle read the voxels
 
   spaceskip sparse VOLUME --memory-budget N[K|M|G] [--pool-brick N] [--builders b1,b2] [--edit-tf PRESET]
                    [--no-in-core] [--frames N] [options]

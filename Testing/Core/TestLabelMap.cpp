@@ -4,7 +4,9 @@
 
 #include "spaceskip/LabelMap.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <tuple>
 
@@ -283,4 +285,56 @@ TEST(LabelMap, FloatVolumeFallsBack) {
   EXPECT_NE(said[0].find("label map"), std::string::npos);
   const Image plain = renderWith(v, TransferFunction::preset("ramp", 0, 1), builder(BuilderKind::Grid), 30, 20, false, 32);
   EXPECT_EQ(compareImages(img, plain).maxAbs, 0.f);
+}
+
+// The label-map benchmark's data set (generateLabels, `spaceskip bench --label-map`): the same
+// voxels for the same seed, every requested id present (uint16 above 255 labels), and a hide/show
+// toggle of one label re-classifies over the label sets without reading a voxel.
+TEST(LabelMap, GeneratedLabelsAreDeterministicWithEveryId) {
+  const vec3l d{64, 64, 64};
+  const Volume a = generateLabels(d, 256, 1), b = generateLabels(d, 256, 1), c = generateLabels(d, 256, 2);
+  ASSERT_EQ(a.type, VoxelType::UInt16);
+  const size_t bytes = size_t(a.voxelCount()) * 2;
+  EXPECT_EQ(std::memcmp(a.data, b.data, bytes), 0);
+  EXPECT_NE(std::memcmp(a.data, c.data, bytes), 0);
+  const Volume viaShape = generateVolume("labels", d);
+  EXPECT_EQ(std::memcmp(a.data, viaShape.data, bytes), 0);
+  const uint16_t* p = static_cast<const uint16_t*>(a.data);
+  std::set<int> ids(p, p + a.voxelCount());
+  EXPECT_EQ(ids.size(), 257u);  // 0 and 1..256
+  EXPECT_EQ(*ids.begin(), 0);
+  EXPECT_EQ(*ids.rbegin(), 256);
+  const int64_t background = std::count(p, p + a.voxelCount(), uint16_t(0));
+  EXPECT_GT(background, a.voxelCount() / 2);  // sparse: most of the volume is empty
+  const Volume few = generateVolume("labels40", d);
+  ASSERT_EQ(few.type, VoxelType::UInt8);
+  const uint8_t* q = static_cast<const uint8_t*>(few.data);
+  EXPECT_EQ(std::set<int>(q, q + few.voxelCount()).size(), 41u);
+}
+
+TEST(LabelMap, ToggleOnGeneratedLabelsReadsNoVoxels) {
+  const Volume v = generateLabels(vec3l{64, 64, 64}, 256, 1);
+  std::vector<int> ids;
+  for (int id = 1; id <= 256; ++id) ids.push_back(id);
+  LabelTable t = tableFor(ids, 0.5f);
+  for (Label& l : t.labels) l.visible = l.id % 10 == 0;  // the bench's tenth
+  Engine e(BackendKind::CPU);
+  const Image before = renderLabels(v, t, LabelSampling::Blend, builder(BuilderKind::Grid), 30, 20, false, 48, &e);
+  const Counters c0 = e.counters();
+  const int64_t occ0 = e.occupancy().occupied;
+  Image img;
+  t.labels[9].visible = false;  // id 10: hidden
+  e.setLabelTable(t);
+  e.render(orbit(v, 30, 20), 48, 48, img);
+  EXPECT_LT(e.occupancy().occupied, occ0);
+  t.labels[9].visible = true;  // and shown again
+  e.setLabelTable(t);
+  e.render(orbit(v, 30, 20), 48, 48, img);
+  const Counters c1 = e.counters();
+  EXPECT_EQ(c1.voxelPasses, c0.voxelPasses);
+  EXPECT_EQ(c1.labelSets, c0.labelSets);
+  EXPECT_EQ(c1.rangeGrids, c0.rangeGrids);
+  EXPECT_EQ(c1.classifications, c0.classifications + 2);
+  EXPECT_EQ(e.occupancy().occupied, occ0);
+  EXPECT_EQ(compareImages(before, img).maxAbs, 0.f);
 }
