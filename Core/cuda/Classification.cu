@@ -71,6 +71,30 @@ __global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims
   }
 }
 
+// A label map's occupancy over its bricks' label sets (LabelMap.h: brickLabelsOccupied, the
+// CPU's rule), counted and compared with `prev` as classifyKernel does.
+__global__ void labelClassifyKernel(const int64_t* offset, const uint16_t* labels, const uint8_t* drawn, vec3i bdims,
+                                    int brick, vec3i cellDims, CropClip cc, const uint8_t* prev, uint8_t* occ,
+                                    unsigned long long* occupied, int* changed, int* grew) {
+  const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
+  int o = 0, diff = 0, more = 0;
+  if (i < n) {
+    o = brickLabelsOccupied(i, offset, labels, drawn, bdims, brick, cellDims, cc) ? 1 : 0;
+    occ[i] = uint8_t(o);
+    diff = prev ? (prev[i] != o) : 1;
+    more = prev ? (o && !prev[i]) : 1;
+  }
+  const int blockCount = __syncthreads_count(o);
+  const int blockDiff = __syncthreads_or(diff);
+  const int blockMore = __syncthreads_or(more);
+  if (threadIdx.x == 0) {
+    if (blockCount) atomicAdd(occupied, (unsigned long long)blockCount);
+    if (blockDiff) atomicOr(changed, 1);
+    if (blockMore) atomicOr(grew, 1);
+  }
+}
+
 // Launch shape: a fixed grid (kMaskBlocksPerSM blocks of 256 threads per SM) whose warps take
 // the occupied bricks of `list` in turn: one warp per brick, two of its 64 parts a lane
 // (subPartSet), the mask by ballot; lane 0 writes the mask, marks the brick kBrickParts when
@@ -266,6 +290,7 @@ cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims
 void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t stream) {
   const Volume& vol = v.volume();
   haveOcc = false;
+  labelSetsOnDevice_ = false;
   setFraction = 1.0;
   brick = std::max(1, b);
   cellDims = vol.cellDims();
@@ -467,34 +492,51 @@ SubMasks BrickClassification::downloadMasks(cudaStream_t stream) {
   return out;
 }
 
-bool BrickClassification::setOccupancy(OccupancyGrid o, cudaStream_t stream) {
-  if (int64_t(o.occ.size()) != numBricks() || o.brick != brick)
-    throw BackendError("label classification: the occupancy does not match the volume's bricks");
-  bool changed = !haveOcc, grewNow = !haveOcc;
-  if (haveOcc) {
-    const OccupancyGrid& prev = occupancy(stream);  // the host copy (downloaded once per classification)
-    for (size_t i = 0; i < o.occ.size(); ++i) {
-      if (o.occ[i] == prev.occ[i]) continue;
-      changed = true;
-      if (o.occ[i]) {
-        grewNow = true;
-        break;
-      }
-    }
+bool BrickClassification::classifyLabels(const LabelSets& ls, const std::vector<uint8_t>& drawn, const CropClip& cc,
+                                         cudaStream_t stream) {
+  if (ls.size() != numBricks() || ls.brick != brick)
+    throw BackendError("label classification: the label sets do not match the volume's bricks");
+  // The sets go to the device once per volume and brick size (the engine computes them after
+  // setVolume, which forgets the device copy), the per-value flags on every edit (a few KiB).
+  if (!labelSetsOnDevice_) {
+    d_labelOffset_.reserve(ls.offset.size());
+    d_labels_.reserve(std::max<size_t>(ls.labels.size(), 1));
+    SS_CUDA_CHECK(cudaMemcpyAsync(d_labelOffset_.get(), ls.offset.data(), ls.offset.size() * sizeof(int64_t),
+                                  cudaMemcpyHostToDevice, stream));
+    if (!ls.labels.empty())
+      SS_CUDA_CHECK(cudaMemcpyAsync(d_labels_.get(), ls.labels.data(), ls.labels.size() * sizeof(uint16_t),
+                                    cudaMemcpyHostToDevice, stream));
+    SS_CUDA_CHECK(cudaStreamSynchronize(stream));  // the host vectors may go
+    labelSetsOnDevice_ = true;
   }
+  const size_t nd = std::max<size_t>(drawn.size(), 1);
+  d_drawn_.reserve(nd);
+  h_drawn_.reserve(nd);
+  if (!drawn.empty()) std::memcpy(h_drawn_.get(), drawn.data(), drawn.size());
+  SS_CUDA_CHECK(cudaMemcpyAsync(d_drawn_.get(), h_drawn_.get(), drawn.size(), cudaMemcpyHostToDevice, stream));
+  const uint8_t* prev = haveOcc ? d_occ[cur].get() : nullptr;
+  uint8_t* next = d_occ[1 - cur].get();
+  d_flags_.reserve(1);
+  SS_CUDA_CHECK(cudaMemsetAsync(d_flags_.get(), 0, sizeof(ClassifyFlags), stream));
+  const int64_t n = numBricks();
+  labelClassifyKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(
+      d_labelOffset_.get(), d_labels_.get(), d_drawn_.get(), bdims, brick, cellDims, cc, prev, next,
+      &d_flags_.get()->occupied, &d_flags_.get()->changed, &d_flags_.get()->grew);
+  SS_CUDA_CHECK(cudaPeekAtLastError());
+  auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
+  SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
   const auto waitStart = std::chrono::steady_clock::now();
-  SS_CUDA_CHECK(cudaMemcpyAsync(d_occ[1 - cur].get(), o.occ.data(), o.occ.size(), cudaMemcpyHostToDevice, stream));
   SS_CUDA_CHECK(cudaStreamSynchronize(stream));
   waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
   cur = 1 - cur;
-  grew = grewNow;
+  const bool changed = !haveOcc || flags->changed != 0;
+  grew = !haveOcc || flags->grew != 0;
   if (changed) ++generation;
   haveOcc = true;
-  occupied = o.occupied;
+  occupied = int64_t(flags->occupied);
   haveSub_ = false;  // no masks: a label edit reads no voxel
   masksReady_ = false;
-  hostOcc_ = std::move(o);
-  hostOccValid_ = true;
+  hostOccValid_ = false;
   return changed;
 }
 

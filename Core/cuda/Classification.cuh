@@ -3,6 +3,7 @@
 #pragma once
 #include "DeviceVolume.cuh"
 #include "spaceskip/Classification.h"
+#include "spaceskip/LabelMap.h"
 
 namespace spaceskip::cuda {
 
@@ -44,9 +45,10 @@ class BrickClassification {
   void setRanges(const Volume& vol, const RangeGrid& r, cudaStream_t stream);
   /// Classifies against `tf`'s opacity and `cc`; true when the occupancy changed (or is the first).
   bool classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream);
-  /// Takes an occupancy classified on the host (a label map's, LabelMap.h: no sub-brick masks);
-  /// true when it differs from the current one (or is the first). Waits for its upload.
-  bool setOccupancy(OccupancyGrid o, cudaStream_t stream);
+  /// A label map's occupancy (LabelMap.h: brickLabelsOccupied over the bricks' label sets, on
+  /// the device; no sub-brick masks, no voxel read); true when it changed (or is the first).
+  bool classifyLabels(const LabelSets& ls, const std::vector<uint8_t>& drawn, const CropClip& cc,
+                      cudaStream_t stream);
   /// The occupancy on the host (downloaded once per classification).
   const OccupancyGrid& occupancy(cudaStream_t stream);
 
@@ -140,6 +142,13 @@ class BrickClassification {
   vec3l dims_{0, 0, 0};
   int components_ = 1;
   DeviceBuffer<ClassifyFlags> d_flags_;
+  // classifyLabels: the label sets (uploaded on the first classification after setVolume) and
+  // the per-value flags.
+  DeviceBuffer<int64_t> d_labelOffset_;
+  DeviceBuffer<uint16_t> d_labels_;
+  DeviceBuffer<uint8_t> d_drawn_;
+  PinnedBuffer h_drawn_;
+  bool labelSetsOnDevice_ = false;
   PinnedBuffer h_flags_;
   OccupancyGrid hostOcc_;
   bool hostOccValid_ = false;

@@ -66,8 +66,8 @@ class CudaBackend final : public Backend {
     return changed;
   }
   bool classifyLabels(const LabelSets& ls, const std::vector<uint8_t>& drawn, const CropClip& cc) override {
-    // Over the label sets on the host (no voxel read), the occupancy uploaded.
-    const bool changed = cls_.setOccupancy(spaceskip::classifyLabels(ls, drawn, cc), stream_);
+    // Over the label sets on the device (no voxel read; LabelMap.h's rule, as the CPU backend).
+    const bool changed = cls_.classifyLabels(ls, drawn, cc, stream_);
     classifiedSinceRender_ = true;
     distMarksStale_ = true;
     return changed;
