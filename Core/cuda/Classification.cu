@@ -393,6 +393,23 @@ void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaS
   SS_CUDA_CHECK(cudaMemcpyAsync(d_vmax.get(), r.vmax.data(), nb * sizeof(float), cudaMemcpyHostToDevice, stream));
 }
 
+// After a classification kernel wrote d_occ[1 - cur] and its flags: waits for the flags, makes
+// the new occupancy current and takes its counts; `changed` as classify() returns it.
+const ClassifyFlags* BrickClassification::finishClassification(cudaStream_t stream, bool& changed) {
+  auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
+  SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
+  const auto waitStart = std::chrono::steady_clock::now();
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
+  cur = 1 - cur;
+  changed = !haveOcc || flags->changed != 0;
+  grew = !haveOcc || flags->grew != 0;
+  if (changed) ++generation;
+  haveOcc = true;
+  occupied = int64_t(flags->occupied);
+  return flags;
+}
+
 bool BrickClassification::classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream) {
   // The sparse table over the TF's (uncorrected) opacity, built as on the CPU, queried on the device.
   const OpacityRangeMax table(tf);
@@ -424,17 +441,8 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
       unsigned(std::min<int64_t>(nb / std::max<int64_t>(editMaskShare, 1), int64_t(kUniformBrick)));
   const bool onPath = haveSub_ && d_partSlot_.get() != nullptr && setFraction <= editMaskMaxShare;
   if (onPath) masksFromRanges(stream, editMaxCount);
-  auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
-  SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
-  const auto waitStart = std::chrono::steady_clock::now();
-  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-  waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
-  cur = 1 - cur;
-  const bool changed = !haveOcc || flags->changed != 0;
-  grew = !haveOcc || flags->grew != 0;
-  if (changed) ++generation;
-  haveOcc = true;
-  occupied = int64_t(flags->occupied);
+  bool changed = false;
+  const ClassifyFlags* flags = finishClassification(stream, changed);
   const bool masked = onPath && flags->listCount <= editMaxCount;
   if (masked) setFraction = setShare(flags->setParts, occupied);
   // Otherwise the masks follow on a later frame (refreshMasks): the edit's own frame marches
@@ -523,17 +531,8 @@ bool BrickClassification::classifyLabels(const LabelSets& ls, const std::vector<
       d_labelOffset_.get(), d_labels_.get(), d_drawn_.get(), bdims, brick, cellDims, cc, prev, next,
       &d_flags_.get()->occupied, &d_flags_.get()->changed, &d_flags_.get()->grew);
   SS_CUDA_CHECK(cudaPeekAtLastError());
-  auto* flags = static_cast<ClassifyFlags*>(h_flags_.get());
-  SS_CUDA_CHECK(cudaMemcpyAsync(flags, d_flags_.get(), sizeof(ClassifyFlags), cudaMemcpyDeviceToHost, stream));
-  const auto waitStart = std::chrono::steady_clock::now();
-  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
-  waitSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - waitStart).count();
-  cur = 1 - cur;
-  const bool changed = !haveOcc || flags->changed != 0;
-  grew = !haveOcc || flags->grew != 0;
-  if (changed) ++generation;
-  haveOcc = true;
-  occupied = int64_t(flags->occupied);
+  bool changed = false;
+  finishClassification(stream, changed);
   haveSub_ = false;  // no masks: a label edit reads no voxel
   masksReady_ = false;
   hostOccValid_ = false;

@@ -142,6 +142,7 @@ class BrickClassification {
   vec3l dims_{0, 0, 0};
   int components_ = 1;
   DeviceBuffer<ClassifyFlags> d_flags_;
+  const ClassifyFlags* finishClassification(cudaStream_t stream, bool& changed);
   // classifyLabels: the label sets (uploaded on the first classification after setVolume) and
   // the per-value flags.
   DeviceBuffer<int64_t> d_labelOffset_;
