@@ -13,6 +13,9 @@
 
 namespace spaceskip::cuda {
 
+/// Threads in a render block at most (Tuning::blockX x blockY; the kernels' launch bounds).
+constexpr int kMaxRenderThreads = 256;
+
 class CudaExecutor {
  public:
   /// Reads the SM count.

@@ -73,7 +73,7 @@ caps = [l.strip() for l in w.ReportCapabilities().splitlines()
 print(w.GetClassName() + ": " + "; ".join(caps))
 PY
 set +e
-(cd "$build" && ctest "${ctest_args[@]}" --output-on-failure -j1 --timeout 600) 2>&1 | tee "$build/pip-vtk-ctest.log"
+(cd "$build" && ctest "${ctest_args[@]}" --output-on-failure -j1 --timeout 300) 2>&1 | tee "$build/pip-vtk-ctest.log"
 rc=${PIPESTATUS[0]}
 set -e
 step "done: ctest exit $rc; VTK $ver from pip; log $build/pip-vtk-ctest.log"
