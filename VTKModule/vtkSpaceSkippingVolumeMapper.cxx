@@ -419,6 +419,22 @@ void vtkSpaceSkippingVolumeMapper::SetLabelVisibility(int id, vtkTypeBool visibl
   }
 }
 
+void vtkSpaceSkippingVolumeMapper::RemoveLabelVisibility(int id)
+{
+  auto it = this->Internals->LabelEdits.find(id);
+  if (it == this->Internals->LabelEdits.end() || !it->second.HasVisible)
+  {
+    return;
+  }
+  it->second.HasVisible = false;
+  it->second.Visible = true;
+  if (!it->second.HasColor && !it->second.HasOpacity)
+  {
+    this->Internals->LabelEdits.erase(it);
+  }
+  this->Modified();
+}
+
 void vtkSpaceSkippingVolumeMapper::RemoveAllLabels()
 {
   if (!this->Internals->LabelEdits.empty())

@@ -458,6 +458,8 @@ public:
   void SetLabelColor(int id, double r, double g, double b);
   void SetLabelOpacity(int id, double opacity);
   void SetLabelVisibility(int id, vtkTypeBool visible);
+  /// Forgets SetLabelVisibility for `id` (its colour and opacity set here stay).
+  void RemoveLabelVisibility(int id);
   /// Forgets the labels set on the mapper (the property's stay).
   void RemoveAllLabels();
   ///@}

@@ -332,6 +332,31 @@ int vtkSpaceSkipVolumeRepresentation::GetLabelSampling()
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::HideLabel(int id)
+{
+  if (std::find(this->HiddenLabels.begin(), this->HiddenLabels.end(), id) == this->HiddenLabels.end())
+  {
+    this->HiddenLabels.push_back(id);
+    this->SpaceSkipMapper->SetLabelVisibility(id, 0);
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipVolumeRepresentation::ShowAllLabels()
+{
+  for (int id : this->HiddenLabels)
+  {
+    this->SpaceSkipMapper->RemoveLabelVisibility(id);
+  }
+  if (!this->HiddenLabels.empty())
+  {
+    this->HiddenLabels.clear();
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
 int vtkSpaceSkipVolumeRepresentation::RequestUpdateExtent(
   vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {

@@ -83,6 +83,10 @@ public:
   /// vtkSpaceSkippingVolumeMapper::NearestLabel (0) or BlendedLabel (1, default).
   void SetLabelSampling(int sampling);
   int GetLabelSampling();
+  /// Hidden Labels: label ids the label map does not draw (the mapper's SetLabelVisibility);
+  /// ParaView sets the list as ShowAllLabels then HideLabel per id.
+  void HideLabel(int id);
+  void ShowAllLabels();
   ///@}
 
   ///@{
@@ -152,6 +156,7 @@ protected:
   int RequestPartitionedData(vtkInformation*, vtkInformationVector**, vtkInformationVector*);
 
   int LabelMapMode = LabelMapAuto;
+  std::vector<int> HiddenLabels; ///< HideLabel's ids
   /// Sets the mapper's LabelMap from LabelMapMode, the colour map and the drawn array.
   void UpdateLabelMap();
 

@@ -3,8 +3,9 @@ coloured through a categorical colour map ("Interpret Values As Categories", ann
 indexed colours), is drawn by the Space Skipping Volume's label-map mode (Label Map = Auto):
 every pixel is the background or one label's colour, with either Label Sampling. The same data
 through a continuous map of the same colours (categories off: Auto draws an ordinary volume)
-shows colours of no label, so the check can fail. Label Map Off/On override Auto. A saved state
-reloads to the same image with the label-map mode on."""
+shows colours of no label, so the check can fail. Label Map Off/On override Auto. Hidden Labels
+hides one segment (its pixels go, the others stay, no voxel pass). A saved state reloads to the
+same image with the label-map mode on and the hidden label still hidden."""
 import numpy
 from paraview.simple import *
 import ssptest
@@ -131,7 +132,27 @@ p = ssptest.psnr(again, labelled)
 ok.check(label_map_used(disp) == 1 and p == float("inf"),
          "categories back on: the label image again (PSNR %.2f dB)" % p)
 
-# A saved state reloads to the same image, label-map mode on.
+# Hidden Labels: label 5 goes, the others stay; every pixel still explained.
+def count(img, i):
+    col = numpy.round(numpy.array(COLOURS[i]) * 255.0)
+    return int((numpy.abs(img - col) <= 2).all(axis=2).sum())
+
+
+ok.check(list(disp.HiddenLabels) == [], "Hidden Labels empty by default (%s)" % list(disp.HiddenLabels))
+disp.HiddenLabels = [5]
+hidden = shot(view, "labelmap_hidden5.png")
+print("hidden 5: label pixels %s" % {i: count(hidden, i) for i in ids})
+ok.check(count(hidden, 5) == 0, "Hidden Labels [5]: no pixel of label 5 (%d)" % count(hidden, 5))
+ok.check(all(count(hidden, i) > 50 for i in ids if i != 5), "Hidden Labels [5]: the other labels drawn")
+ok.check(unexplained(hidden, colours) == 0, "Hidden Labels [5]: every pixel explained")
+disp.HiddenLabels = []
+shown = shot(view, "labelmap_shown.png")
+p = ssptest.psnr(shown, labelled)
+ok.check(p == float("inf"), "Hidden Labels [] again: the label image again (PSNR %.2f dB)" % p)
+disp.HiddenLabels = [5]
+labelled = shot(view, "labelmap_hidden5_again.png")
+
+# A saved state reloads to the same image, label-map mode on, label 5 hidden.
 state = ssptest.temp_path("labelmap_state.pvsm")
 SaveState(state)
 ResetSession()
@@ -146,4 +167,5 @@ ok.check(disp.Representation == "Space Skipping Volume" and disp.LabelMap == "Au
 ok.check(label_map_used(disp) == 1, "state: label-map mode on after LoadState")
 ok.check(diff <= 1.0, "state: the same image (max difference %g/255)" % diff)
 ok.check(unexplained(after, colours) == 0, "state: every pixel explained")
+ok.check(list(disp.HiddenLabels) == [5], "state: Hidden Labels [5] (%s)" % list(disp.HiddenLabels))
 ok.done()
