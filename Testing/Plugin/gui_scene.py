@@ -30,6 +30,29 @@ try:
         "stats": {n: first_disp.GetPropertyValue(n) for n in
                   ("BuilderUsed", "BackendUsed", "LastRenderSeconds", "Occupancy", "FrameCount", "BuilderChoice")}}
     Delete(first)
+    # A segmentation, as a user colours one: the label array shown as Space Skipping Volume, its
+    # colour map made categorical (annotations, indexed colours): the label-map mode (Label Map
+    # Auto) with one segment hidden from the panel's Hidden Labels.
+    labels_path = os.path.join(out, "gui_labels.vti")
+    ssptest.write_label_blobs(labels_path)
+    labels = XMLImageDataReader(registrationName="segmentation", FileName=[labels_path])
+    labels_disp = Show(labels, first_view)
+    labels_disp.SetRepresentationType("Space Skipping Volume")
+    ColorBy(labels_disp, ("POINTS", "labels"))
+    ssptest.categorical_label_map("labels")
+    labels_disp.Shade = 0
+    labels_disp.ScalarOpacityUnitDistance = 1.0
+    labels_disp.HiddenLabels = [9]
+    first_view.ResetCamera()
+    first_view.OrientationAxesVisibility = 0  # only the background and the labels in the image
+    Render(first_view)
+    SaveScreenshot(os.path.join(out, "gui_labels.png"), first_view, ImageResolution=list(ssptest.IMAGE_SIZE),
+                   TransparentBackground=0)
+    labels_disp.UpdatePropertyInformation()
+    labels_result = {"label_map_used": labels_disp.GetPropertyValue("LabelMapUsed"),
+                     "hidden": list(labels_disp.HiddenLabels)}
+    Delete(labels)
+    first_view.OrientationAxesVisibility = 1
     paraview.simple._DisableFirstRenderCameraReset()  # keep the scene's camera
     reader = ssptest.open_data()
     RenameSource("shell_64x64x64_uint8.raw", reader)
@@ -44,7 +67,8 @@ try:
     result = {"representation": disp.SMProxy.GetProperty("Representation").GetElement(0),
               "stats": ssptest.stats(disp),
               "groups_shown": ssptest.groups_shown_for(disp),
-              "first": first_result}
+              "first": first_result,
+              "labels": labels_result}
 except Exception as e:  # report to the driver instead of leaving it waiting
     import traceback
     result = {"error": traceback.format_exc()}

@@ -301,3 +301,61 @@ class VersusStock:
         print("  %s: PSNR ours %.2f dB, ParaView's Volume %.2f dB" % (what, ours, stock))
         self.ok.check(ours < max_psnr and stock < max_psnr,
                       "%s changes the image (ours %.1f, stock %.1f dB)" % (what, ours, stock))
+
+
+# A label map (uint8 segmentation) of touching blobs whose ids are far apart, its colours and
+# names: test_labelmap.py and the GUI's scene (gui_scene.py).
+LABEL_N = 40
+LABEL_BLOBS = [(14, 14, 14, 8, 1), (24, 15, 15, 7, 5), (16, 25, 18, 7, 9), (26, 26, 26, 6, 2)]
+LABEL_COLOURS = {1: (0.9, 0.2, 0.2), 2: (1.0, 0.9, 0.1), 5: (0.2, 0.9, 0.2), 9: (0.2, 0.3, 1.0)}
+LABEL_NAMES = {1: "one", 2: "two", 5: "five", 9: "nine"}
+
+
+def write_label_blobs(path):
+    """LABEL_BLOBS painted in order (later over earlier: touching borders) into a .vti, array
+    "labels"."""
+    import numpy
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    n = LABEL_N
+    z, y, x = numpy.mgrid[0:n, 0:n, 0:n].astype(numpy.float64)
+    data = numpy.zeros((n, n, n), numpy.uint8)
+    for cx, cy, cz, r, label in LABEL_BLOBS:
+        inside = (x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2 <= r * r
+        data[inside] = label
+    img = vtkImageData()
+    img.SetDimensions(n, n, n)
+    arr = numpy_to_vtk(data.ravel(), deep=1)
+    arr.SetName("labels")
+    img.GetPointData().SetScalars(arr)
+    w = vtkXMLImageDataWriter()
+    w.SetFileName(path)
+    w.SetInputData(img)
+    w.Write()
+
+
+def categorical_label_map(array):
+    """`array`'s colour map made categorical as a user does in the colour map editor
+    (Interpret Values As Categories, an annotation and an indexed colour per id), opaque from 0.5."""
+    from paraview.simple import GetColorTransferFunction, GetOpacityTransferFunction
+    lut = GetColorTransferFunction(array)
+    lut.AutomaticRescaleRangeMode = "Never"
+    ids = sorted(LABEL_COLOURS)
+    lut.RGBPoints = sum(([float(i)] + list(LABEL_COLOURS[i]) for i in ids), [])
+    pwf = GetOpacityTransferFunction(array)
+    pwf.Points = [0.0, 0.0, 0.5, 0.0, 0.5, 1.0, 0.5, 0.0, 9.0, 1.0, 0.5, 0.0]
+    lut.InterpretValuesAsCategories = 1
+    lut.Annotations = sum(([str(i), LABEL_NAMES[i]] for i in ids), [])
+    lut.IndexedColors = sum((list(LABEL_COLOURS[i]) for i in ids), [])
+    return lut
+
+
+def unexplained_colours(img, colours, tol=2, background=(0.0, 0.0, 0.0)):
+    """Pixels whose colour is neither `background` (8-bit) nor one of `colours` (+-tol/255)."""
+    import numpy
+    known = [numpy.array(background, float)] + [numpy.round(numpy.array(c) * 255.0) for c in colours]
+    good = numpy.zeros(img.shape[:2], bool)
+    for c in known:
+        good |= (numpy.abs(img - c) <= tol).all(axis=2)
+    return int((~good).sum())

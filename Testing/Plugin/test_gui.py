@@ -14,7 +14,7 @@ ok = ssptest.Checker()
 here = os.path.dirname(os.path.abspath(__file__))
 out = os.path.dirname(ssptest.temp_path("x"))
 done = os.path.join(out, "gui_done.txt")
-for name in ("gui_done.txt", "gui_view.png", "gui_window.png", "gui_first.png"):
+for name in ("gui_done.txt", "gui_view.png", "gui_window.png", "gui_first.png", "gui_labels.png"):
     if os.path.exists(os.path.join(out, name)):
         os.remove(os.path.join(out, name))
 
@@ -92,6 +92,24 @@ if os.path.exists(first_png):
              % (100 * lit))
 else:
     ok.check(False, "the GUI saved no first-contact screenshot")
+# A segmentation with a categorical colour map: the label-map mode, every pixel the background or
+# a label's colour, the hidden label absent.
+labels = result.get("labels", {})
+ok.check(labels.get("label_map_used") == 1 and labels.get("hidden") == [9],
+         "a categorical colour map on a label array draws a label map in the GUI (%s)" % labels)
+labels_png = os.path.join(out, "gui_labels.png")
+if os.path.exists(labels_png):
+    import numpy
+    a = ssptest.read_png(labels_png)
+    shown = [ssptest.LABEL_COLOURS[i] for i in (1, 2, 5)]
+    bad = ssptest.unexplained_colours(a, shown, background=tuple(a[0, 0]))
+    nine = int((numpy.abs(a - numpy.round(numpy.array(ssptest.LABEL_COLOURS[9]) * 255.0)) <= 2).all(axis=2).sum())
+    lit = ssptest.lit_fraction(abs(a - a[0, 0]))
+    ok.check(lit > 0.02 and bad == 0 and nine == 0,
+             "the GUI's label map: %.1f%% lit, %d pixels of no shown label's colour, %d of the hidden one"
+             % (100 * lit, bad, nine))
+else:
+    ok.check(False, "the GUI saved no label screenshot")
 view_png = os.path.join(out, "gui_view.png")
 if os.path.exists(view_png):
     a = ssptest.read_png(view_png)

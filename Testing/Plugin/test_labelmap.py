@@ -13,40 +13,8 @@ import ssptest
 ssptest.load_plugin()
 ok = ssptest.Checker()
 
-N = 40
-BLOBS = [(14, 14, 14, 8, 1), (24, 15, 15, 7, 5), (16, 25, 18, 7, 9), (26, 26, 26, 6, 2)]
-# id -> colour, far apart (and far from the black background)
-COLOURS = {1: (0.9, 0.2, 0.2), 2: (1.0, 0.9, 0.1), 5: (0.2, 0.9, 0.2), 9: (0.2, 0.3, 1.0)}
-NAMES = {1: "one", 2: "two", 5: "five", 9: "nine"}
-
-
-def write_labels(path):
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    z, y, x = numpy.mgrid[0:N, 0:N, 0:N].astype(numpy.float64)
-    data = numpy.zeros((N, N, N), numpy.uint8)
-    for cx, cy, cz, r, label in BLOBS:  # later blobs over earlier ones: touching borders
-        inside = (x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2 <= r * r
-        data[inside] = label
-    img = vtkImageData()
-    img.SetDimensions(N, N, N)
-    arr = numpy_to_vtk(data.ravel(), deep=1)
-    arr.SetName("labels")
-    img.GetPointData().SetScalars(arr)
-    w = vtkXMLImageDataWriter()
-    w.SetFileName(path)
-    w.SetInputData(img)
-    w.Write()
-
-
-def unexplained(img, colours, tol=2):
-    """Pixels whose colour is neither the black background nor one of `colours` (+-tol/255)."""
-    known = [numpy.array([0.0, 0.0, 0.0])] + [numpy.round(numpy.array(c) * 255.0) for c in colours]
-    good = numpy.zeros(img.shape[:2], bool)
-    for c in known:
-        good |= (numpy.abs(img - c) <= tol).all(axis=2)
-    return int((~good).sum())
+N, BLOBS, COLOURS, NAMES = ssptest.LABEL_N, ssptest.LABEL_BLOBS, ssptest.LABEL_COLOURS, ssptest.LABEL_NAMES
+write_labels, unexplained = ssptest.write_label_blobs, ssptest.unexplained_colours
 
 
 def shot(view, name):
@@ -75,15 +43,8 @@ view.CameraPosition = [c + 45.0, c + 30.0, c + 60.0]
 view.CameraViewUp = [0.0, 1.0, 0.0]
 view.CameraViewAngle = 30.0
 
-lut = GetColorTransferFunction("labels")
-lut.AutomaticRescaleRangeMode = "Never"
+lut = ssptest.categorical_label_map("labels")
 ids = sorted(COLOURS)
-lut.RGBPoints = sum(([float(i)] + list(COLOURS[i]) for i in ids), [])
-pwf = GetOpacityTransferFunction("labels")
-pwf.Points = [0.0, 0.0, 0.5, 0.0, 0.5, 1.0, 0.5, 0.0, 9.0, 1.0, 0.5, 0.0]  # opaque from 0.5 on
-lut.InterpretValuesAsCategories = 1
-lut.Annotations = sum(([str(i), NAMES[i]] for i in ids), [])
-lut.IndexedColors = sum((list(COLOURS[i]) for i in ids), [])
 colours = [COLOURS[i] for i in ids]
 
 ok.check(disp.LabelMap == "Auto" and disp.LabelSampling == "Blended",
