@@ -177,9 +177,6 @@ def write_sparse_vti(path, n, balls=((0.3, 0.35, 0.4, 0.16), (0.7, 0.6, 0.55, 0.
     profiles in a background of exact zeros, as a user's sparse data set would be; built slice by
     slice (512^3 fits in memory). Returns the fraction of non-zero voxels."""
     import numpy
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
-    from vtkmodules.util.numpy_support import numpy_to_vtk
     data = numpy.zeros((n, n, n), numpy.uint8)
     y, x = numpy.mgrid[0:n, 0:n].astype(numpy.float32) / n
     for k in range(n):
@@ -191,16 +188,24 @@ def write_sparse_vti(path, n, balls=((0.3, 0.35, 0.4, 0.16), (0.7, 0.6, 0.55, 0.
         tube = numpy.sqrt((y - 0.5) ** 2 + (z - 0.65) ** 2) / tube_radius
         v = numpy.maximum(v, numpy.clip(1.0 - tube, 0.0, 1.0) * 0.8)
         data[k] = numpy.round(v * 255.0).astype(numpy.uint8)
+    write_vti(path, data, "density")
+    return float((data > 0).mean())
+
+
+def write_vti(path, data, name):
+    """A numpy array (z, y, x) as the point scalars `name` of an image data file."""
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
+    from vtkmodules.util.numpy_support import numpy_to_vtk
     img = vtkImageData()
-    img.SetDimensions(n, n, n)
+    img.SetDimensions(data.shape[2], data.shape[1], data.shape[0])
     arr = numpy_to_vtk(data.ravel(), deep=1)
-    arr.SetName("density")
+    arr.SetName(name)
     img.GetPointData().SetScalars(arr)
     w = vtkXMLImageDataWriter()
     w.SetFileName(path)
     w.SetInputData(img)
     w.Write()
-    return float((data > 0).mean())
 
 
 def groups_shown_for(disp, labels=("Volume Rendering", "Cropping Parameters"),
@@ -315,24 +320,13 @@ def write_label_blobs(path):
     """LABEL_BLOBS painted in order (later over earlier: touching borders) into a .vti, array
     "labels"."""
     import numpy
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOXML import vtkXMLImageDataWriter
-    from vtkmodules.util.numpy_support import numpy_to_vtk
     n = LABEL_N
     z, y, x = numpy.mgrid[0:n, 0:n, 0:n].astype(numpy.float64)
     data = numpy.zeros((n, n, n), numpy.uint8)
     for cx, cy, cz, r, label in LABEL_BLOBS:
         inside = (x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2 <= r * r
         data[inside] = label
-    img = vtkImageData()
-    img.SetDimensions(n, n, n)
-    arr = numpy_to_vtk(data.ravel(), deep=1)
-    arr.SetName("labels")
-    img.GetPointData().SetScalars(arr)
-    w = vtkXMLImageDataWriter()
-    w.SetFileName(path)
-    w.SetInputData(img)
-    w.Write()
+    write_vti(path, data, "labels")
 
 
 def categorical_label_map(array):
