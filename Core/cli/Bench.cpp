@@ -183,6 +183,7 @@ BenchRow measureItem(Engine& engine, const Volume& v, const std::string& itemTex
 int cmdBench(const Options& o) {
   if (o.has("--paper")) return cmdBenchPaper(o);
   if (o.has("--label-map")) return cmdBenchLabels(o);
+  if (o.has("--time-series")) return cmdBenchTimeSeries(o);
   if (o.positional.empty()) throw std::invalid_argument("bench needs at least one VOLUME (or --paper)");
   std::vector<std::string> builders = split(o.get("--builders", "naive,grid"), ',');
   const int frames = int(o.getInt("--frames", 8, 1, 1000000));

@@ -78,6 +78,7 @@ int cmdSparse(const Options& o);      ///< Sparse.cpp
 int cmdBench(const Options& o);       ///< Bench.cpp
 int cmdBenchPaper(const Options& o);  ///< Paper.cpp
 int cmdBenchLabels(const Options& o); ///< BenchLabels.cpp (bench --label-map)
+int cmdBenchTimeSeries(const Options& o); ///< BenchTimeSeries.cpp (bench --time-series)
 int cmdAccuracy(const Options& o);    ///< Accuracy.cpp
 
 }  // namespace spaceskip::cli

@@ -31,11 +31,11 @@ const std::set<std::string>& valueOptions() {
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
       "--shade", "--cuda-block", "--scale", "--datasets", "--time-limit", "--memory-budget",
       "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes", "--label-map", "--hide-labels",
-      "--toggles", "--visible-every"};
+      "--toggles", "--visible-every", "--time-series", "--steps-held", "--step-type"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
-  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper", "--no-in-core", "--nearest"};
+  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper", "--no-in-core", "--nearest", "--check"};
   return s;
 }
 

@@ -54,6 +54,14 @@ const char* kUsage = R"(usage:
       label at a still view, each setLabelTable + its frame (median, max) against a plain frame,
       with the counters (no voxel pass); exit 4 when a toggle read the voxels
 
+  spaceskip bench gen:nbody:N --time-series STEPS [--steps-held K] [--step-type uint8|float32]
+                  [--builder B] [--check] [options]
+      time-series playback: K (default min(STEPS, 10)) generated steps of the advected N-body
+      stand-in held in memory, STEPS played (cycling), each step's upload, ranges, classification,
+      build and frame at an orbiting camera waited for; beside the upload bound (bytes over the
+      measured pinned host-to-device rate), Naive and a fresh engine per step; --check compares
+      each held step played with its static render (exit 3 above 1/255)
+
   spaceskip sparse VOLUME --memory-budget N[K|M|G] [--pool-brick N] [--builders b1,b2] [--edit-tf PRESET]
                    [--no-in-core] [--frames N] [options]
       sparse residency: only the bricks a frame needs on the device, within the budget; per

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>
 #include <chrono>
 #include <cstdlib>
@@ -307,6 +308,26 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
   SS_CUDA_CHECK(brickRanges(v.d_voxels<unsigned char>(), vol.type, vol.components, vol.dims, bdims, brick, d_vmin.get(), d_vmax.get(),
                             stream));
   computePartRanges(stream);
+}
+
+bool BrickClassification::valueRange(double& lo, double& hi, cudaStream_t stream) {
+  const int64_t nb = numBricks();
+  if (nb <= 0 || nb > int64_t(INT32_MAX) || !d_vmin.get() || !d_vmax.get()) return false;
+  d_range_.reserve(2);
+  size_t a = 0, b = 0;
+  SS_CUDA_CHECK(cub::DeviceReduce::Min(nullptr, a, d_vmin.get(), d_range_.get(), int(nb), stream));
+  SS_CUDA_CHECK(cub::DeviceReduce::Max(nullptr, b, d_vmax.get(), d_range_.get() + 1, int(nb), stream));
+  const size_t bytes = std::max(a, b);
+  void* temp = rangeTemp_.ensure(bytes);
+  a = b = bytes;
+  SS_CUDA_CHECK(cub::DeviceReduce::Min(temp, a, d_vmin.get(), d_range_.get(), int(nb), stream));
+  SS_CUDA_CHECK(cub::DeviceReduce::Max(temp, b, d_vmax.get(), d_range_.get() + 1, int(nb), stream));
+  float h[2] = {0, 0};
+  SS_CUDA_CHECK(cudaMemcpyAsync(h, d_range_.get(), sizeof h, cudaMemcpyDeviceToHost, stream));
+  SS_CUDA_CHECK(cudaStreamSynchronize(stream));
+  lo = h[0];
+  hi = h[1];
+  return true;
 }
 
 void BrickClassification::computePartRanges(cudaStream_t stream) {

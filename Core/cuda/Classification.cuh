@@ -53,11 +53,17 @@ class BrickClassification {
   const OccupancyGrid& occupancy(cudaStream_t stream);
 
   int64_t numBricks() const { return int64_t(bdims.x) * bdims.y * bdims.z; }
+  /// The least brick minimum and the largest brick maximum (NaN skipped, +-Inf kept): the
+  /// volume's value range from the ranges setVolume computed, reduced on the device (no voxel
+  /// read); waits for `stream`. False before any ranges.
+  bool valueRange(double& lo, double& hi, cudaStream_t stream);
 
   // Plain state, read by the builders and the render launch.
   int brick = 8;
   vec3i cellDims{0, 0, 0}, bdims{0, 0, 0};
   DeviceBuffer<float> d_vmin, d_vmax;
+  DeviceBuffer<float> d_range_;  ///< valueRange's two results
+  TempStorage rangeTemp_;
   DeviceBuffer<uint8_t> d_occ[2];  ///< d_occ[cur]: the current occupancy
   /// The sub-brick masks of the current occupancy (Classification.h); null when there are none
   /// (brick size, several components, sparse residency, SPACESKIP_SUB_MASKS=0).

@@ -5,6 +5,7 @@
 #include "CudaExecutor.cuh"
 #include "DevicePool.cuh"
 #include "DeviceVolume.cuh"
+#include "HostStaging.cuh"
 #include "DistanceField.cuh"
 #include "KdTreeBuilder.cuh"
 #include "LbvhBuilder.cuh"
@@ -15,6 +16,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <cstring>
+#include <vector>
 
 namespace spaceskip {
 
@@ -195,6 +198,32 @@ class CudaBackend final : public Backend {
     cls_.tuning = t;
   }
   double lastFrameDeviceSeconds() const override { return exec_.lastFrameDeviceSeconds(); }
+  bool brickValueRange(double& lo, double& hi) override {
+    return !pool_.active() && cls_.valueRange(lo, hi, stream_);
+  }
+  UploadRates measureUpload(size_t bytes) override {
+    DeviceBuffer<unsigned char> dst(bytes);
+    std::vector<unsigned char> pageable(bytes, 1);
+    cuda::PinnedBuffer pinned;
+    pinned.reserve(bytes);
+    std::memset(pinned.get(), 1, bytes);
+    cuda::HostStaging staging;
+    auto best = [&](auto&& copy) {
+      double t = 1e30;
+      for (int i = 0; i < 3; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        copy();
+        SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
+        t = std::min(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      }
+      return t > 0 ? double(bytes) / t : 0.0;
+    };
+    UploadRates r;
+    r.pinned = best([&] { SS_CUDA_CHECK(cudaMemcpyAsync(dst.get(), pinned.get(), bytes, cudaMemcpyHostToDevice, stream_)); });
+    r.pageable = best([&] { SS_CUDA_CHECK(cudaMemcpyAsync(dst.get(), pageable.data(), bytes, cudaMemcpyHostToDevice, stream_)); });
+    r.staged = best([&] { staging.copy(dst.get(), pageable.data(), bytes, stream_); });
+    return r;
+  }
 
   const OccupancyGrid& occupancy() override { return cls_.occupancy(stream_); }
   double occupiedFraction() override {

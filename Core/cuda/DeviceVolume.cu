@@ -1,5 +1,9 @@
 // Volume upload and the hardware-filtered texture made from the device copy.
 #include "DeviceVolume.cuh"
+#include "HostStaging.cuh"
+#include "spaceskip/HostCopy.h"
+
+#include <algorithm>
 
 #include <limits>
 #include <type_traits>
@@ -23,9 +27,48 @@ void DeviceVolume::upload(const Volume& v, cudaStream_t stream) {
   volume_ = v;
   volume_.storage.reset();  // the Engine keeps the voxels alive; we keep the device copy
   const size_t bytes = v.byteSize();
-  d_voxels_.release();
+  // The allocation is kept when it fits (a time step of the same size: no free, no malloc).
+  if (d_voxels_.capacity() < bytes || d_voxels_.capacity() > 2 * bytes) d_voxels_.release();
   d_voxels_.reserve(bytes);
-  SS_CUDA_CHECK(cudaMemcpyAsync(d_voxels_.get(), v.data, bytes, cudaMemcpyHostToDevice, stream));
+  if (!staging_) staging_ = std::make_unique<HostStaging>();
+  staging_->copy(d_voxels_.get(), v.data, bytes, stream);
+}
+
+DeviceVolume::DeviceVolume() = default;
+DeviceVolume::~DeviceVolume() { destroyTexture(); }
+
+void HostStaging::copy(void* dst, const void* src, size_t bytes, cudaStream_t stream) {
+  if (bytes < 2 * kChunk) {  // small: the driver's own staging is as fast
+    SS_CUDA_CHECK(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, stream));
+    return;
+  }
+  for (int b = 0; b < kChunks; ++b) {
+    if (chunk_[b].get() == nullptr && chunk_[b].tryReserve(kChunk) != cudaSuccess) {
+      // No pinned memory to be had: the plain (pageable) copy.
+      SS_CUDA_CHECK(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, stream));
+      return;
+    }
+    if (!done_[b]) SS_CUDA_CHECK(cudaEventCreateWithFlags(&done_[b], cudaEventDisableTiming));
+  }
+  // The chunks in turn: a chunk is refilled once its last copy (of this call or the one before)
+  // has finished (its event; an event never recorded is complete).
+  size_t k = 0;
+  for (size_t off = 0; off < bytes; off += kChunk, ++k) {
+    const int b = int(k % kChunks);
+    const size_t n = std::min(kChunk, bytes - off);
+    SS_CUDA_CHECK(cudaEventSynchronize(done_[b]));
+    parallelCopy(chunk_[b].get(), static_cast<const char*>(src) + off, n);
+    SS_CUDA_CHECK(cudaMemcpyAsync(static_cast<char*>(dst) + off, chunk_[b].get(), n, cudaMemcpyHostToDevice, stream));
+    SS_CUDA_CHECK(cudaEventRecord(done_[b], stream));
+  }
+}
+
+HostStaging::~HostStaging() {
+  for (cudaEvent_t& e : done_)
+    if (e) {
+      cudaEventSynchronize(e);
+      cudaEventDestroy(e);
+    }
 }
 
 void DeviceVolume::describe(const Volume& v) {

@@ -5,6 +5,8 @@
 #include "spaceskip/Volume.h"
 #include "spaceskip/render/FrameShared.h"
 
+#include <memory>
+
 namespace spaceskip::cuda {
 
 /// Hardware-filtered sampling: a 3-D texture with linear filtering. Integer types are read as
@@ -18,10 +20,12 @@ struct TextureSampler {
   __device__ float sample(vec3f p) const { return tex3D<float>(tex, p.x + 0.5f, p.y + 0.5f, p.z + 0.5f) * scale; }
 };
 
+class HostStaging;  // HostStaging.cuh
+
 class DeviceVolume {
  public:
-  DeviceVolume() = default;
-  ~DeviceVolume() { destroyTexture(); }
+  DeviceVolume();
+  ~DeviceVolume();
   DeviceVolume(const DeviceVolume&) = delete;
   DeviceVolume& operator=(const DeviceVolume&) = delete;
 
@@ -48,6 +52,7 @@ class DeviceVolume {
 
   Volume volume_;
   DeviceBuffer<unsigned char> d_voxels_;
+  std::unique_ptr<HostStaging> staging_;  ///< made on the first upload
   cudaArray_t array_ = nullptr;
   size_t arrayBytes_ = 0;
   cudaTextureObject_t tex_ = 0;

@@ -65,6 +65,13 @@ class Backend {
   /// Seconds the last render() spent in device work (CUDA events), -1 when not measured. For a
   /// frame left on the device (not waited for by render()) this waits for the frame.
   virtual double lastFrameDeviceSeconds() const { return -1; }
+  /// Measures the host-to-device copy rates with buffers of `bytes` (best of 3 each); zeros
+  /// without a device.
+  virtual UploadRates measureUpload(size_t /*bytes*/) { return UploadRates{}; }
+  /// The volume's value range from the brick ranges setVolume computed (the least brick minimum,
+  /// the largest maximum; NaN skipped, +-Inf kept), without a pass over the voxels; false where
+  /// the backend has none at hand.
+  virtual bool brickValueRange(double& /*lo*/, double& /*hi*/) { return false; }
   /// The most memory the voxels may take (bytes; 0: the backend's default, for CUDA the free
   /// device memory less what the rest needs; the CPU backend holds the volume in host memory
   /// and ignores it unless set). A volume above it is kept sparse (BrickPool.h): only the

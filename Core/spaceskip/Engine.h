@@ -126,6 +126,9 @@ class Engine {
   /// for by render(): its deviceSeconds is read here, which waits for the frame's device work;
   /// with `waitForDevice` false nothing waits and deviceSeconds is -1 until someone waits.
   const FrameStats& frameStats(bool waitForDevice = true) const;
+  /// The host-to-device copy rates with buffers of `bytes` (Types.h UploadRates; zeros on the
+  /// CPU backend): the bound a time step's upload can reach, beside the engine's own upload.
+  UploadRates measureUpload(size_t bytes);
   const Counters& counters() const;
   /// Host copies for tests and statistics (downloaded from the device if needed).
   const OccupancyGrid& occupancy();
@@ -134,7 +137,8 @@ class Engine {
   double sampleDistance() const;
   /// Floating-point volumes whose magnitudes lie outside [2^-60, 2^60] are sampled through an
   /// exact power-of-two rescale (a float copy); values are multiplied by 2^valueExponent()
-  /// (0 when not rescaled).
+  /// (0 when not rescaled). For one-component float32 volumes it is decided from the backend's
+  /// brick ranges, i.e. known after update() (or the first render()).
   int valueExponent() const;
 
  private:

@@ -257,6 +257,18 @@ struct Counters {
   int voxelPasses = 0;
   /// Label maps: per-brick label sets computed (once per volume and brick size).
   int labelSets = 0;
+  /// Engine::setVolume calls that were a time step: a volume of the same shape (dims, type,
+  /// components, spacing, origin, direction) as the one before, whose Builder Auto choice is kept
+  /// (the kept structure is rebuilt for the step as after an opacity edit; Auto measures again
+  /// only when the occupancy moved by more than AutoBuilder::kReexplore).
+  int timeSteps = 0;
+};
+
+/// Host-to-device copy rates (bytes per second; 0 where there is no device), measured by
+/// Engine::measureUpload: a pinned buffer's copy (what the link can take), a pageable buffer's
+/// plain cudaMemcpy, and the backend's own upload of a pageable buffer (HostStaging).
+struct UploadRates {
+  double pinned = 0, pageable = 0, staged = 0;
 };
 
 struct Image {

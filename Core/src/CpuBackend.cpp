@@ -38,6 +38,13 @@ class CpuBackend final : public Backend {
     tree_ = Tree{};
   }
 
+  bool brickValueRange(double& lo, double& hi) override {
+    if (ranges_.vmin.empty()) return false;
+    lo = *std::min_element(ranges_.vmin.begin(), ranges_.vmin.end());
+    hi = *std::max_element(ranges_.vmax.begin(), ranges_.vmax.end());
+    return true;
+  }
+
   void setTuning(const Tuning& t) override { tuning_ = t; }
 
   bool classify(const TransferFunction& tf, const CropClip& cc) override {

@@ -95,6 +95,8 @@ struct Engine::Impl {
 
   Volume volume;
   int valueExponent = 0;  ///< voxel values (and so the TF range) times 2^this; see setVolume
+  Volume sourceShape;     ///< the last setVolume's volume as given (no voxels): time steps
+  bool magnitudePending = false;  ///< float32 magnitudes to check at the next ranges (setVolume)
   bool haveVolume = false;
   TransferFunction tf;
   bool haveTF = false;
@@ -255,6 +257,42 @@ struct Engine::Impl {
 
   /// 4 dependent components: the colour channels' finite ranges (of the sampled values).
   double rgbRange[3][2] = {{0, 1}, {0, 1}, {0, 1}};
+  /// When `m` (the largest finite |value|) is beyond 2^+-60: `volume` becomes a float copy of
+  /// the caller's voxels scaled by 2^-e (m * 2^-e in [0.5, 1); ldexp is exact and reaches
+  /// denormal scales a factor can't), valueExponent -e; the TF range is scaled alike, so the
+  /// image is the one of the unscaled data. NaN stays NaN and +-Inf stays +-Inf. True if scaled.
+  bool scaleExtremeFloats(double m) {
+    if (!(m > 0 && (m > 0x1p60 || m < 0x1p-60))) return false;
+    const Volume v = volume;  // the caller's voxels (called once per setVolume, before any scaling)
+    const int64_t n = v.voxelCount() * v.components;
+    int e = 0;
+    std::frexp(m, &e);
+    auto copy = std::make_shared<std::vector<unsigned char>>(size_t(n) * sizeof(float));
+    float* out = reinterpret_cast<float*>(copy->data());
+    if (v.type == VoxelType::Float32) scaleToFloat(static_cast<const float*>(v.data), out, n, -e);
+    else scaleToFloat(static_cast<const double*>(v.data), out, n, -e);
+    volume.type = VoxelType::Float32;
+    volume.storage = copy;
+    volume.data = copy->data();
+    valueExponent = -e;
+    return true;
+  }
+
+  /// The float32 magnitude check setVolume left to the ranges: from the backend's brick ranges
+  /// (or, where it has none or they are not finite, the host's range pass); a volume that needs
+  /// scaling is set on the backend again as its scaled copy.
+  void checkMagnitudes() {
+    if (!magnitudePending) return;
+    magnitudePending = false;
+    double lo = 0, hi = 0;
+    bool known = backend->brickValueRange(lo, hi) && std::isfinite(lo) && std::isfinite(hi);
+    if (!known) {
+      ++counters.voxelPasses;
+      known = volume.scalarRange(lo, hi);
+    }
+    if (known && scaleExtremeFloats(std::max(std::fabs(lo), std::fabs(hi)))) backend->setVolume(volume, build.brick);
+  }
+
   void componentRanges() {
     if (volume.components != 4) return;
     for (int c = 0; c < 3; ++c)
@@ -367,6 +405,7 @@ struct Engine::Impl {
     if (rangesDirty) {
       report(0.0, "value ranges");
       backend->setVolume(volume, build.brick);
+      checkMagnitudes();
       ++counters.rangeGrids;
       ++counters.voxelPasses;
       rangesDirty = false;
@@ -498,33 +537,49 @@ void Engine::setProgress(std::function<void(double, const char*)> progress) {
   impl_->backend->setProgress(impl_->backendProgress());
 }
 
+namespace {
+/// Whether `b` has `a`'s shape: the same grid in the same place with the same voxel layout (the
+/// voxels may differ): the next time step of a simulation.
+bool sameShape(const Volume& a, const Volume& b) {
+  if (a.dims.x != b.dims.x || a.dims.y != b.dims.y || a.dims.z != b.dims.z || a.type != b.type || a.components != b.components) return false;
+  for (int i = 0; i < 3; ++i)
+    if (a.spacing[i] != b.spacing[i] || a.origin[i] != b.origin[i]) return false;
+  for (int i = 0; i < 9; ++i)
+    if (a.direction[i] != b.direction[i]) return false;
+  return true;
+}
+}  // namespace
+
+UploadRates Engine::measureUpload(size_t bytes) { return impl_->backend->measureUpload(bytes); }
+
 void Engine::setVolume(const Volume& v) {
   validate(v);
+  // A time step (the same shape, new voxels) keeps Builder Auto's choice: the structures draw the
+  // step as they drew the one before, so the kept one is rebuilt for the new occupancy as after
+  // an opacity edit (Grid standing in for one frame when it is slow to build), and Auto measures
+  // again only when the occupancy moves by more than kReexplore (classifyIfNeeded). Any other
+  // volume measures from the start.
+  const bool step = impl_->haveVolume && sameShape(impl_->sourceShape, v);
+  impl_->sourceShape = v;
+  impl_->sourceShape.data = nullptr;
+  impl_->sourceShape.storage.reset();
   impl_->volume = v;
   impl_->valueExponent = 0;
-  impl_->autoBuilder.reset();
+  impl_->magnitudePending = false;
+  if (step) ++impl_->counters.timeSteps;
+  else impl_->autoBuilder.reset();
   // The integrator samples in float: magnitudes near the ends of double's (or float's) range
   // would overflow trilinear interpolation or the table mapping (+-1e308 gave a blank image),
   // and denormal-scale data would collapse to one table entry. Such volumes are sampled from a
-  // float copy scaled by an exact power of two; the TF range is scaled alike, so the image is
-  // the one of the unscaled data. NaN stays NaN and +-Inf stays +-Inf in the copy.
-  if (v.type == VoxelType::Float32 || v.type == VoxelType::Float64) {
-    const int64_t n = v.voxelCount() * v.components;
+  // float copy scaled by an exact power of two (scaleExtremeFloats). One float32 component is
+  // checked from the brick ranges the backend computes anyway (update(); no pass over the voxels
+  // here: on the time-step path that pass was most of a float step's host time); doubles (whose
+  // range in float may underflow) and several components here, by the host's range pass.
+  if (v.type == VoxelType::Float32 && v.components == 1) {
+    impl_->magnitudePending = true;
+  } else if (v.type == VoxelType::Float32 || v.type == VoxelType::Float64) {
     double lo = 0, hi = 0;  // the parallel finite range pass (NaN and +-Inf skipped)
-    const double m = v.scalarRange(lo, hi) ? std::max(std::fabs(lo), std::fabs(hi)) : 0.0;
-    if (m > 0 && (m > 0x1p60 || m < 0x1p-60)) {
-      int e = 0;
-      std::frexp(m, &e);
-      auto copy = std::make_shared<std::vector<unsigned char>>(size_t(n) * sizeof(float));
-      float* out = reinterpret_cast<float*>(copy->data());
-      // m * 2^-e lies in [0.5, 1); ldexp is exact and reaches denormal scales a factor can't.
-      if (v.type == VoxelType::Float32) scaleToFloat(static_cast<const float*>(v.data), out, n, -e);
-      else scaleToFloat(static_cast<const double*>(v.data), out, n, -e);
-      impl_->volume.type = VoxelType::Float32;
-      impl_->volume.storage = copy;
-      impl_->volume.data = copy->data();
-      impl_->valueExponent = -e;
-    }
+    if (v.scalarRange(lo, hi)) impl_->scaleExtremeFloats(std::max(std::fabs(lo), std::fabs(hi)));
   }
   impl_->componentRanges();
   impl_->haveVolume = true;

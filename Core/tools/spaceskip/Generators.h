@@ -26,6 +26,11 @@ Volume generateVolume(const std::string& shape, vec3l dims, unsigned seed = 1);
 /// larger than any one host's share never exists whole); other shapes are made whole and cut.
 Volume generateSlab(const std::string& shape, vec3l dims, int64_t z0, int64_t z1, unsigned seed = 1);
 std::vector<std::string> generatorShapes();
+/// Time step `step` of a generated simulation (issue 38's playback): "nbody" advected, its
+/// particles drifting step by step (step 0 is generateVolume("nbody")), as uint8 or float32
+/// (value / 255). Throws std::invalid_argument for other shapes or types.
+Volume generateTimeStep(const std::string& shape, vec3l dims, int step, VoxelType type = VoxelType::UInt8,
+                        unsigned seed = 1);
 
 /// A label map (segmentation, issue 37): `labels` ellipsoidal blobs, ids 1..labels, background 0,
 /// on a jittered grid of ~1.3 cells a label with the ids shuffled (neighbours' ids unrelated),

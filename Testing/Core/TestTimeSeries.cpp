@@ -1,0 +1,168 @@
+// Time series (issue 38): a new volume of the same shape is a time step. The played frames equal
+// each step's static render, Builder Auto keeps its choice across steps (no measuring again while
+// the occupancy holds), and a volume of another shape starts afresh. On the CPU and, where a
+// device answers, on CUDA (the upload through pinned staging, the device allocation kept).
+#include "TestUtil.h"
+
+#include "spaceskip/Builders.h"
+
+using namespace spaceskip;
+
+namespace {
+
+std::vector<Volume> nbodySteps(int n, int count, VoxelType type) {
+  std::vector<Volume> s;
+  for (int k = 0; k < count; ++k) s.push_back(generateTimeStep("nbody", vec3l{n, n, n}, k, type));
+  return s;
+}
+
+/// Plays `steps` (each twice, the second time at another view) in one engine of `backend` and
+/// compares every frame with a static render of that step by a fresh Naive engine on the CPU.
+void expectPlaybackEqualsStatic(BackendKind backend, const std::vector<Volume>& steps, const BuildParams& bp,
+                                float tolerance) {
+  double lo = 0, hi = 1;
+  ASSERT_TRUE(steps[0].scalarRange(lo, hi));
+  const TransferFunction tf = TransferFunction::preset("ramp", lo, hi);
+  Engine e(backend);
+  test::load(e, steps[0], tf, bp);
+  Image img, ref;
+  for (int k = 0; k < 2 * int(steps.size()); ++k) {
+    const Volume& v = steps[size_t(k) % steps.size()];
+    const Camera cam = test::orbit(v, 25.0 * k, 20);
+    e.setVolume(v);
+    e.render(cam, 80, 80, img);
+    Engine naive(BackendKind::CPU);
+    test::load(naive, v, tf, test::builder(BuilderKind::Naive));
+    naive.render(cam, 80, 80, ref);
+    EXPECT_LE(compareImages(ref, img).maxAbs, tolerance) << "step " << k % steps.size() << " played as frame " << k
+                                                           << " with " << builderName(bp.builder);
+    EXPECT_GT(test::coverage(img), 0.0) << "step " << k;
+  }
+  EXPECT_EQ(e.counters().timeSteps, 2 * int(steps.size()));  // every setVolume after load()'s
+}
+
+}  // namespace
+
+TEST(TimeSeries, StepsDifferAndStaySparse) {
+  const std::vector<Volume> s = nbodySteps(64, 3, VoxelType::UInt8);
+  for (int k = 1; k < 3; ++k) {
+    const auto* a = static_cast<const unsigned char*>(s[0].data);
+    const auto* b = static_cast<const unsigned char*>(s[size_t(k)].data);
+    int64_t differ = 0, occupied = 0;
+    for (int64_t i = 0; i < s[0].voxelCount(); ++i) {
+      differ += a[i] != b[i];
+      occupied += b[i] != 0;
+    }
+    EXPECT_GT(differ, 100) << "step " << k;
+    EXPECT_LT(occupied, s[0].voxelCount() / 10) << "step " << k;  // 6.3 % at 64^3
+  }
+  const Volume f = generateTimeStep("nbody", vec3l{32, 32, 32}, 2, VoxelType::Float32);
+  EXPECT_EQ(f.type, VoxelType::Float32);
+  EXPECT_THROW(generateTimeStep("menger", vec3l{32, 32, 32}, 1), std::invalid_argument);
+}
+
+TEST(TimeSeries, PlayedFramesEqualStaticRendersOnEveryBuilder) {
+  const std::vector<Volume> steps = nbodySteps(48, 3, VoxelType::UInt8);
+  for (BuilderKind k : {BuilderKind::Auto, BuilderKind::Grid, BuilderKind::LBVH, BuilderKind::KdTreeCPU,
+                        BuilderKind::Hybrid, BuilderKind::DistanceGrid})
+    expectPlaybackEqualsStatic(BackendKind::CPU, steps, test::builder(k), 1.f / 255.f);
+  expectPlaybackEqualsStatic(BackendKind::CPU, nbodySteps(40, 2, VoxelType::Float32), test::builder(BuilderKind::Auto),
+                             1.f / 255.f);
+}
+
+TEST(TimeSeries, AutoKeepsItsChoiceAcrossStepsAndStartsAfreshOnANewShape) {
+  const std::vector<Volume> steps = nbodySteps(64, 4, VoxelType::UInt8);
+  double lo = 0, hi = 1;
+  ASSERT_TRUE(steps[0].scalarRange(lo, hi));
+  const TransferFunction tf = TransferFunction::preset("ramp", lo, hi);
+  Engine e(BackendKind::CPU);
+  test::load(e, steps[0], tf, test::builder(BuilderKind::Auto));
+  Image img;
+  const Camera cam = test::orbit(steps[0], 30, 20);
+  e.render(cam, 96, 96, img);
+  for (int i = 0; i < 40 && e.exploring(); ++i) e.render(cam, 96, 96, img);
+  ASSERT_FALSE(e.exploring());
+  const int measurings = e.counters().autoProbeMeasurings;
+  const std::string choice = e.buildStats().choice;
+  for (int k = 1; k < 4; ++k) {
+    const int builds = e.counters().builds, ranges = e.counters().rangeGrids;
+    e.setVolume(steps[size_t(k)]);
+    e.render(cam, 96, 96, img);
+    EXPECT_FALSE(e.exploring()) << "step " << k;
+    EXPECT_EQ(e.counters().rangeGrids, ranges + 1) << "step " << k;  // the new voxels' ranges, once
+    EXPECT_GE(e.counters().builds, builds + 1) << "step " << k;      // the kept structure, rebuilt
+  }
+  EXPECT_EQ(e.counters().autoProbeMeasurings, measurings) << choice;
+  EXPECT_EQ(e.counters().timeSteps, 3);
+  // Another shape (dims) is another volume: Auto measures again.
+  const Volume other = generateTimeStep("nbody", vec3l{48, 48, 48}, 0);
+  e.setVolume(other);
+  e.render(test::orbit(other, 30, 20), 96, 96, img);
+  EXPECT_EQ(e.counters().timeSteps, 3);
+  EXPECT_GT(e.counters().autoProbeMeasurings, measurings);
+}
+
+/// Float32 steps of extreme magnitude (the check left to the brick ranges, no host range pass):
+/// scaled as before, drawn as the modest steps are.
+void expectExtremeStepsDrawLikeModestOnes(BackendKind backend) {
+  std::vector<Volume> modest = nbodySteps(40, 2, VoxelType::Float32);
+  double lo = 0, hi = 1;
+  ASSERT_TRUE(modest[0].scalarRange(lo, hi));
+  for (double scale : {1e30, 1e-30}) {
+    std::vector<Volume> steps;
+    for (const Volume& m : modest) {
+      Volume v;
+      v.allocate(m.dims, VoxelType::Float32);
+      const float* in = static_cast<const float*>(m.data);
+      float* out = reinterpret_cast<float*>(v.mutableData());
+      for (int64_t i = 0; i < m.voxelCount(); ++i) out[i] = float(in[i] * scale);
+      steps.push_back(v);
+    }
+    Engine e(backend), ref(backend);
+    test::load(e, steps[0], TransferFunction::preset("ramp", lo * scale, hi * scale), test::builder(BuilderKind::Grid));
+    test::load(ref, modest[0], TransferFunction::preset("ramp", lo, hi), test::builder(BuilderKind::Grid));
+    Image a, b;
+    for (int k = 0; k < 4; ++k) {
+      e.setVolume(steps[size_t(k) % 2]);
+      ref.setVolume(modest[size_t(k) % 2]);
+      const int passes = e.counters().voxelPasses, refPasses = ref.counters().voxelPasses;
+      e.render(test::orbit(modest[0], 30.0 * k, 20), 64, 64, a);
+      ref.render(test::orbit(modest[0], 30.0 * k, 20), 64, 64, b);
+      EXPECT_NE(e.valueExponent(), 0) << scale;
+      // No host range pass beyond what the modest steps take (the check read the brick ranges).
+      EXPECT_EQ(e.counters().voxelPasses - passes, ref.counters().voxelPasses - refPasses) << "scale " << scale;
+      EXPECT_LE(compareImages(b, a).maxAbs, 2.f / 255.f) << "scale " << scale << " step " << k;
+      EXPECT_GT(test::coverage(a), 0.0);
+    }
+  }
+}
+
+TEST(TimeSeries, ExtremeFloatStepsAreScaledFromTheBrickRanges) { expectExtremeStepsDrawLikeModestOnes(BackendKind::CPU); }
+
+TEST(TimeSeries, CudaExtremeFloatStepsAreScaledFromTheBrickRanges) {
+  SKIP_WITHOUT_CUDA();
+  expectExtremeStepsDrawLikeModestOnes(BackendKind::CUDA);
+}
+
+TEST(TimeSeries, CudaPlaybackEqualsStaticRenders) {
+  SKIP_WITHOUT_CUDA();
+  // Steps above HostStaging::kChunk (32 MiB) go through the pinned chunks: 384^3 uint8 is 54 MiB.
+  const std::vector<Volume> big = nbodySteps(384, 2, VoxelType::UInt8);
+  expectPlaybackEqualsStatic(BackendKind::CUDA, big, test::builder(BuilderKind::Auto), 1.f / 255.f);
+  const std::vector<Volume> steps = nbodySteps(48, 3, VoxelType::UInt8);
+  for (BuilderKind k : {BuilderKind::Grid, BuilderKind::LBVH, BuilderKind::KdTreeGPUFast, BuilderKind::DistanceGrid})
+    expectPlaybackEqualsStatic(BackendKind::CUDA, steps, test::builder(k), 1.f / 255.f);
+  expectPlaybackEqualsStatic(BackendKind::CUDA, nbodySteps(200, 2, VoxelType::Float32), test::builder(BuilderKind::Auto),
+                             1.f / 255.f);
+}
+
+TEST(TimeSeries, CudaUploadRatesAreMeasured) {
+  SKIP_WITHOUT_CUDA();
+  Engine e(BackendKind::CUDA);
+  const UploadRates r = e.measureUpload(size_t(64) << 20);
+  EXPECT_GT(r.pinned, 1e9);
+  EXPECT_GT(r.pageable, 1e8);
+  EXPECT_GT(r.staged, 1e8);
+  Engine cpu(BackendKind::CPU);
+  EXPECT_EQ(cpu.measureUpload(size_t(1) << 20).pinned, 0.0);
+}

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# On the GPU machine (issue 38): the carried Core tests (`tests`: .vtkbundle-core/core.tar.xz) run
+# the time-series tests, compute-sanitizer memcheck on the CUDA ones and the whole Core suite; the
+# carried CLI (`bench`: .vtkbundle-cli/cli.tar.xz) the playback benchmark at 512^3 and 1024^3,
+# uint8 and float32, 1024x1024 (bench/device/pack-core.sh packs both).
+#   bash bench/device/time-series.sh OUT tests|bench
+set -uo pipefail
+out=${1:?usage: time-series.sh OUT tests|bench}
+what=${2:?tests or bench}
+src=$(cd "$(dirname "$0")/../.." && pwd)
+mkdir -p "$out" /tmp/c
+if [ "$what" = tests ]; then tar -C /tmp/c -xJf "$src/.vtkbundle-core/core.tar.xz"
+else tar -C /tmp/c -xJf "$src/.vtkbundle-cli/cli.tar.xz"; fi
+export LD_LIBRARY_PATH=/tmp/c/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+# The Core tests read files of the source tree by the path they were built with.
+[ -e /work/main ] || { mkdir -p /work && ln -s "$src" /work/main; }
+{
+  date -u +%Y-%m-%dT%H:%M:%SZ
+  nvidia-smi --query-gpu=name,driver_version,pcie.link.gen.max,pcie.link.width.max --format=csv,noheader
+  echo "cores: $(nproc)"
+} > "$out/env.txt" 2>&1
+B=/tmp/c/bin
+if [ "$what" != bench ]; then
+  $B/spaceskip_core_tests --gtest_filter='TimeSeries.*' > "$out/time-series-tests.log" 2>&1
+  echo "time-series tests rc=$?" >> "$out/env.txt"
+  timeout 200 compute-sanitizer --tool memcheck --error-exitcode 9 $B/spaceskip_core_tests \
+    --gtest_filter='TimeSeries.Cuda*' > "$out/memcheck.log" 2>&1
+  echo "memcheck rc=$?" >> "$out/env.txt"
+  timeout 330 $B/spaceskip_core_tests > "$out/core-tests.log" 2>&1
+  echo "core tests rc=$?" >> "$out/env.txt"
+  tail -3 "$out/core-tests.log" >> "$out/env.txt"
+fi
+if [ "$what" != tests ]; then
+  for spec in "512 uint8 10" "512 float32 10" "1024 uint8 8" "1024 float32 4"; do
+    set -- $spec
+    echo "== spaceskip bench gen:nbody:$1 --time-series 100 --steps-held $3 --step-type $2 --backend cuda --size 1024x1024" >> "$out/bench.log"
+    timeout 140 $B/spaceskip bench gen:nbody:$1 --time-series 100 --steps-held $3 --step-type $2 --backend cuda \
+      --size 1024x1024 --check >> "$out/bench.log" 2>&1
+    echo "rc=$?" >> "$out/bench.log"
+  done
+fi

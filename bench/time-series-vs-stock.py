@@ -1,0 +1,126 @@
+"""Time-series playback in ParaView (issue 38): ours ('Space Skipping Volume') against ParaView's
+stock 'Volume' (vtkSmartVolumeMapper -> the GPU ray caster; Mesa llvmpipe on a machine without a
+GPU), the same steps in the same view, one pvpython process.
+
+The steps: N^3 uint8 .vti files of balls that drift apart and a ball that grows, step by step, in a
+background of exact zeros (sparse, as a simulation's early steps), listed in a .pvd. The animation
+scene steps AnimationTime over them; each Render() is timed (the reader's load of the step, the
+representation's update and the frame). Rounds alternate ours, stock, ours, stock; the median
+step time of each and their ratio (stock / ours: > 1 means ours is faster) are printed.
+
+Usage (an X server is needed: `source scripts/xvfb.sh 97`):
+  pvpython bench/time-series-vs-stock.py --plugin build/lib/paraview-5.11/plugins/SpaceSkip/SpaceSkip.so \
+      [--dims 256] [--steps 10] [--view 1024] [--rounds 2] [--backend CPU] [--workdir /tmp/ts]
+"""
+import argparse
+import os
+import statistics
+import time
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--plugin", required=True)
+parser.add_argument("--dims", type=int, default=256)
+parser.add_argument("--steps", type=int, default=10)
+parser.add_argument("--view", type=int, default=1024)
+parser.add_argument("--rounds", type=int, default=2)
+parser.add_argument("--backend", default="CPU")
+parser.add_argument("--workdir", default="/tmp/spaceskip-time-series")
+args = parser.parse_args()
+
+import numpy  # noqa: E402
+from paraview import simple  # noqa: E402
+from vtkmodules.vtkCommonDataModel import vtkImageData  # noqa: E402
+from vtkmodules.vtkIOXML import vtkXMLImageDataWriter  # noqa: E402
+from vtkmodules.util.numpy_support import numpy_to_vtk  # noqa: E402
+
+simple._DisableFirstRenderCameraReset()
+simple.LoadPlugin(args.plugin, remote=False, ns=vars(simple))
+N, K = args.dims, args.steps
+os.makedirs(args.workdir, exist_ok=True)
+
+
+def write_step(path, k):
+    d = 0.3 * k / K
+    balls = ((0.3 - d, 0.35, 0.4, 0.12), (0.7 + d / 2, 0.6, 0.55, 0.09), (0.5, 0.75 - d, 0.3, 0.07),
+             (0.5, 0.4, 0.7, 0.03 + 0.06 * k / K))
+    data = numpy.zeros((N, N, N), numpy.uint8)
+    y, x = numpy.mgrid[0:N, 0:N].astype(numpy.float32) / N
+    for z in range(N):
+        v = numpy.zeros((N, N), numpy.float32)
+        for cx, cy, cz, r in balls:
+            dist = numpy.sqrt((x - cx) ** 2 + (y - cy) ** 2 + (z / N - cz) ** 2) / r
+            v = numpy.maximum(v, numpy.clip(1.0 - dist, 0.0, 1.0))
+        data[z] = numpy.round(v * 255.0).astype(numpy.uint8)
+    img = vtkImageData()
+    img.SetDimensions(N, N, N)
+    arr = numpy_to_vtk(data.ravel(), deep=1)
+    arr.SetName("density")
+    img.GetPointData().SetScalars(arr)
+    w = vtkXMLImageDataWriter()
+    w.SetFileName(path)
+    w.SetInputData(img)
+    w.Write()
+    return float((data > 0).mean())
+
+
+pvd = os.path.join(args.workdir, "steps_%d.pvd" % N)
+with open(pvd, "w") as f:
+    f.write('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n<Collection>\n')
+    for k in range(K):
+        name = "step_%d_%d.vti" % (N, k)
+        path = os.path.join(args.workdir, name)
+        if not os.path.exists(path):
+            write_step(path, k)
+        f.write('<DataSet timestep="%d" file="%s"/>\n' % (k, name))
+    f.write('</Collection>\n</VTKFile>\n')
+
+reader = simple.PVDReader(FileName=pvd)
+view = simple.CreateView("RenderView")
+view.ViewSize = [args.view, args.view]
+view.OrientationAxesVisibility = 0
+view.EnableRenderOnInteraction = 0
+disp = simple.Show(reader, view)
+simple.ColorBy(disp, ("POINTS", "density"))
+lut = simple.GetColorTransferFunction("density")
+lut.AutomaticRescaleRangeMode = "Never"
+lut.RescaleTransferFunction(0.0, 255.0)
+pwf = simple.GetOpacityTransferFunction("density")
+pwf.Points = [0.0, 0.0, 0.5, 0.0, 20.0, 0.0, 0.5, 0.0, 255.0, 0.5, 0.5, 0.0]
+view.ResetCamera()
+scene = simple.GetAnimationScene()
+scene.UpdateAnimationUsingDataTimeSteps()
+times = list(reader.TimestepValues)
+
+
+def set_rep(name):
+    disp.SetRepresentationType(name)
+    if name == "Space Skipping Volume":
+        disp.Backend = args.backend
+    scene.AnimationTime = times[-1]
+    simple.Render(view)  # the representation's first frame, not timed
+
+
+def play():
+    ms = []
+    for t in times:
+        scene.AnimationTime = t
+        t0 = time.perf_counter()
+        simple.Render(view)
+        ms.append(1e3 * (time.perf_counter() - t0))
+    return ms
+
+
+results = {"Space Skipping Volume": [], "Volume": []}
+for r in range(args.rounds):
+    for name in results:
+        set_rep(name)
+        results[name] += play()
+ours = statistics.median(results["Space Skipping Volume"])
+stock = statistics.median(results["Volume"])
+print("time series %d^3 uint8, %d steps (.pvd of .vti), %dx%d view, %d rounds:" % (N, K, args.view, args.view, args.rounds))
+print("  a step (AnimationTime set -> Render() returned), median: ours %.1f ms (%.2f steps/s), stock Volume %.1f ms "
+      "(%.2f steps/s): %.2fx" % (ours, 1e3 / ours, stock, 1e3 / stock, stock / ours))
+disp.SetRepresentationType("Space Skipping Volume")
+disp.UpdatePropertyInformation()
+print("  ours: backend %s, builder %s; %s" % (disp.GetPropertyValue("BackendUsed"), disp.GetPropertyValue("BuilderUsed"),
+                                              disp.GetPropertyValue("BuilderChoice")))
