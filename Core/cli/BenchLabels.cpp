@@ -14,13 +14,6 @@ namespace spaceskip::cli {
 
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return 0.5 * (v[(v.size() - 1) / 2] + v[v.size() / 2]);
-}
-double maxOf(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
-
 struct Rate {
   double fps = 0, kernelFps = 0, occupancy = 0;
   std::string builder;

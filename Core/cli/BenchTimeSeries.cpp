@@ -19,13 +19,6 @@ namespace spaceskip::cli {
 
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return 0.5 * (v[(v.size() - 1) / 2] + v[v.size() / 2]);
-}
-double maxOf(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
-
 struct Playback {
   std::vector<double> step, update, frame;  // ms per played step: all, setVolume + update, render
   double seconds = 0;

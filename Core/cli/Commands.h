@@ -10,12 +10,17 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace spaceskip::cli {
 
 using Clock = std::chrono::steady_clock;
 inline double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+/// The median of `v` (the mean of the middle two for an even count; 0 when empty).
+double median(std::vector<double> v);
+/// The largest of `v` (0 when empty).
+double maxOf(const std::vector<double>& v);
 /// CPU seconds used by this process (all threads): a frame's work, robust against other load
 /// on a shared machine (wall-clock fps is not).
 double processCpuSeconds();

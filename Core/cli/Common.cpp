@@ -4,11 +4,19 @@
 #include "spaceskip/TransferFunctionIO.h"
 #include "spaceskip/VolumeIO.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
 
 namespace spaceskip::cli {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return 0.5 * (v[(v.size() - 1) / 2] + v[v.size() / 2]);
+}
+double maxOf(const std::vector<double>& v) { return v.empty() ? 0 : *std::max_element(v.begin(), v.end()); }
 
 double processCpuSeconds() {
   timespec ts{};
