@@ -1,7 +1,7 @@
 // Volume upload and the hardware-filtered texture made from the device copy.
 #include "DeviceVolume.cuh"
 #include "HostStaging.cuh"
-#include "spaceskip/HostCopy.h"
+#include "spaceskip/Backend.h"  // parallelCopy
 
 #include <algorithm>
 
