@@ -380,6 +380,11 @@ void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams&
   rp.useLights = false;
   rp.lights.clear();
   rp.twoSidedLighting = ren->GetTwoSidedLighting() != 0;
+  // Volumetric shadows and scattering (the engine draws them in shaded composite and isosurface
+  // frames only, as vtkGPUVolumeRayCastMapper).
+  rp.scatteringBlending = s.VolumetricScatteringBlending;
+  rp.globalIlluminationReach = s.GlobalIlluminationReach;
+  rp.scatteringAnisotropy = prop->GetScatteringAnisotropy();
   if (!rp.shade)
   {
     return;

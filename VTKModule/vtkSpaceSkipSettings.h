@@ -31,6 +31,8 @@ struct vtkSpaceSkipSettings
   bool EightBitComposite = true;
   bool GPUComposite = true;
   bool UseJittering = false;
+  float GlobalIlluminationReach = 0.0f;
+  float VolumetricScatteringBlending = 0.0f;
   vtkIdType DeviceMemoryBudget = 0;
   int VectorMode = 1;
   int VectorComponent = 0;
@@ -74,6 +76,8 @@ struct vtkSpaceSkipSettings
     s.EightBitComposite = m->GetEightBitComposite() != 0;
     s.GPUComposite = m->GetGPUComposite() != 0;
     s.UseJittering = m->GetUseJittering() != 0;
+    s.GlobalIlluminationReach = m->GetGlobalIlluminationReach();
+    s.VolumetricScatteringBlending = m->GetVolumetricScatteringBlending();
     s.DeviceMemoryBudget = m->GetDeviceMemoryBudget();
     s.VectorMode = m->GetVectorMode();
     s.VectorComponent = m->GetVectorComponent();
@@ -121,6 +125,8 @@ struct vtkSpaceSkipSettings
     to->SetEightBitComposite(s.EightBitComposite);
     to->SetGPUComposite(s.GPUComposite);
     to->SetUseJittering(s.UseJittering);
+    to->SetGlobalIlluminationReach(s.GlobalIlluminationReach);
+    to->SetVolumetricScatteringBlending(s.VolumetricScatteringBlending);
     to->SetDeviceMemoryBudget(s.DeviceMemoryBudget);
     to->SetTuning(s.Tuning);
     to->SetLabelMap(s.LabelMap);

@@ -824,6 +824,8 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EightBitComposite: " << (this->EightBitComposite ? "On" : "Off") << "\n";
   os << indent << "GPUComposite: " << (this->GPUComposite ? "On" : "Off") << "\n";
   os << indent << "UseJittering: " << (this->UseJittering ? "On" : "Off") << "\n";
+  os << indent << "GlobalIlluminationReach: " << this->GlobalIlluminationReach << "\n";
+  os << indent << "VolumetricScatteringBlending: " << this->VolumetricScatteringBlending << "\n";
   os << indent << "DeviceMemoryBudget: " << this->DeviceMemoryBudget << " MiB\n";
   os << indent << "VectorMode: " << this->VectorMode << "\n";
   os << indent << "VectorComponent: " << this->VectorComponent << "\n";

@@ -244,6 +244,23 @@ public:
 
   ///@{
   /**
+   * Volumetric shadows and scattering, as vtkGPUVolumeRayCastMapper (VTK 9.2) draws them:
+   * VolumetricScatteringBlending in [0, 2] blends the gradient (Phong) shading with the light
+   * each shaded sample scatters towards the eye, lit through one shadow ray per light (0: off,
+   * the default; 2: scattering only); GlobalIlluminationReach in [0, 1] is how far the shadow
+   * rays reach (0: about one sample, 1: across the whole volume). The anisotropy of the phase
+   * function is the volume property's ScatteringAnisotropy. Shaded composite and isosurface
+   * frames only, as VTK. The shadow rays skip empty space over the bricks classification found
+   * empty, so every builder still draws the image of Naive.
+   */
+  vtkSetClampMacro(GlobalIlluminationReach, float, 0.0f, 1.0f);
+  vtkGetMacro(GlobalIlluminationReach, float);
+  vtkSetClampMacro(VolumetricScatteringBlending, float, 0.0f, 2.0f);
+  vtkGetMacro(VolumetricScatteringBlending, float);
+  ///@}
+
+  ///@{
+  /**
    * Keep the image on the GPU (default on): with the CUDA backend and the window's OpenGL on the
    * same NVIDIA device, the frame is copied from CUDA memory into a GL texture (CUDA-GL interop)
    * instead of going down to host memory and up again. The copy is queued on the engine's CUDA
@@ -541,6 +558,8 @@ protected:
   vtkTypeBool EightBitComposite = 1;
   vtkTypeBool GPUComposite = 1;
   vtkTypeBool UseJittering = 0;
+  float GlobalIlluminationReach = 0.0f;
+  float VolumetricScatteringBlending = 0.0f;
   int CudaDevice = -1;
   vtkIdType DeviceMemoryBudget = 0;
   int VectorMode = 1; // vtkScalarsToColors::COMPONENT

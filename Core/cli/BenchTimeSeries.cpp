@@ -24,12 +24,14 @@ struct Playback {
   double seconds = 0;
   std::string builder;
   int builds = 0, measurings = 0;
+  int prefetched = 0;  // prefetches started
 };
 
 /// Plays `played` steps cycling over `steps` in `e` (already showing steps[0]): per step
 /// setVolume + update() (upload, value ranges, classification, build) then the frame at the
 /// orbit's next angle, waited for.
-Playback play(Engine& e, const std::vector<Volume>& steps, int played, const double* b6, int w, int h) {
+Playback play(Engine& e, const std::vector<Volume>& steps, int played, const double* b6, int w, int h,
+              bool prefetch = false) {
   Playback p;
   Image img;
   const double aspect = double(w) / h;
@@ -39,6 +41,9 @@ Playback play(Engine& e, const std::vector<Volume>& steps, int played, const dou
     const Camera cam = orbitCamera(b6, 360.0 * i / played, 15, 1, false, aspect);
     const auto a = Clock::now();
     e.setVolume(steps[size_t(i) % steps.size()]);
+    // The next step's upload on the copy stream while this one is classified, built and drawn
+    // (Engine::prefetchVolume uploads this one first, or swaps it in when it was prefetched).
+    if (prefetch) p.prefetched += e.prefetchVolume(steps[size_t(i + 1) % steps.size()]) ? 1 : 0;
     e.update();
     const auto b = Clock::now();
     e.render(cam, w, h, img);
@@ -130,11 +135,19 @@ int cmdBenchTimeSeries(const Options& o) {
   const bool onDevice = engine.setImageOnDevice(true);
   std::printf("first frame %.3f s; %s; image %s\n", first, engine.buildStats().choice.c_str(),
               onDevice ? "left on the device (as the window path)" : "on the host");
-  const Playback ours = play(engine, steps, played, b6, w, h);
+  // The time-step path with the next step prefetched while each is drawn, then without (each
+  // step uploaded by its setVolume), in this process, on this engine.
+  const int prefetchedBefore = engine.counters().prefetchedSteps;
+  const Playback ours = play(engine, steps, played, b6, w, h, true);
   const Counters& c = engine.counters();
-  printPlayback("playback (time-step path)", ours, played, boundMs);
-  std::printf("counters: time steps %d, value-range passes %d, classifications %d, builds %d, Auto measurings on probes %d\n",
-              c.timeSteps, c.rangeGrids, c.classifications, c.builds, c.autoProbeMeasurings);
+  printPlayback("playback (time-step path, next step prefetched)", ours, played, boundMs);
+  std::printf("counters: time steps %d, prefetched %d (started %d), value-range passes %d, classifications %d, builds %d, "
+              "Auto measurings on probes %d\n",
+              c.timeSteps, c.prefetchedSteps - prefetchedBefore, ours.prefetched, c.rangeGrids, c.classifications, c.builds,
+              c.autoProbeMeasurings);
+  const Playback unfetched = play(engine, steps, played, b6, w, h, false);
+  printPlayback("playback (time-step path, no prefetch)", unfetched, played, boundMs);
+  std::printf("prefetch: %.2fx the steps/s of uploading each step at its setVolume\n", unfetched.seconds / ours.seconds);
 
   // Naive: no structure, the same upload and frame otherwise.
   {
@@ -174,7 +187,9 @@ int cmdBenchTimeSeries(const Options& o) {
     Image ref;
     for (int k = 0; k < held; ++k) {
       const Camera cam = orbitCamera(b6, 37.0 * k, 15, 1, false, aspect);
-      engine.setVolume(steps[size_t(k)]);
+      engine.setVolume(steps[size_t(k)]);  // prefetched below on the CUDA backend (k > 0)
+      engine.update();
+      engine.prefetchVolume(steps[size_t(k + 1) % steps.size()]);
       engine.render(cam, w, h, img);
       Engine e(backendKind(o));
       makeEngine(e, bp);
@@ -184,7 +199,8 @@ int cmdBenchTimeSeries(const Options& o) {
         worst = std::max({worst, std::fabs(img.rgba[i].x - ref.rgba[i].x), std::fabs(img.rgba[i].y - ref.rgba[i].y),
                           std::fabs(img.rgba[i].z - ref.rgba[i].z), std::fabs(img.rgba[i].w - ref.rgba[i].w)});
     }
-    std::printf("check: %d steps played vs each step's static render: max difference %.3f/255\n", held, 255 * worst);
+    std::printf("check: %d steps played (each prefetched while the one before was drawn) vs each step's static "
+                "render: max difference %.3f/255\n", held, 255 * worst);
     if (255 * worst > 1.0) return 3;
   }
   return 0;

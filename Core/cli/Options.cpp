@@ -31,7 +31,7 @@ const std::set<std::string>& valueOptions() {
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
       "--shade", "--cuda-block", "--scale", "--datasets", "--time-limit", "--memory-budget",
       "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes", "--label-map", "--hide-labels",
-      "--toggles", "--visible-every", "--time-series", "--steps-held", "--step-type"};
+      "--toggles", "--visible-every", "--time-series", "--steps-held", "--step-type", "--scatter"};
   return s;
 }
 const std::set<std::string>& flagOptions() {
@@ -288,6 +288,15 @@ RenderParams renderParams(const Options& o) {
       r.specular = parseDoubleArg(c[2], "--shade (specular)", 0, 1);
       r.specularPower = parseDoubleArg(c[3], "--shade (specular power)", 0, 128);
     }
+  }
+  if (o.has("--scatter")) {  // BLENDING,REACH,ANISOTROPY: volumetric shadows and scattering (shades)
+    const std::string sc = o.get("--scatter", "");
+    std::vector<std::string> c = split(sc, ',');
+    if (c.size() != 3) throw bad("--scatter", sc, "is not BLENDING,REACH,ANISOTROPY");
+    r.scatteringBlending = parseDoubleArg(c[0], "--scatter (blending)", 0, 2);
+    r.globalIlluminationReach = parseDoubleArg(c[1], "--scatter (reach)", 0, 1);
+    r.scatteringAnisotropy = parseDoubleArg(c[2], "--scatter (anisotropy)", -1, 1);
+    r.shade = true;
   }
   return r;
 }

@@ -88,6 +88,9 @@ options:
   --ert T  --jitter  --filter exact|hardware
   --blend composite|mip|minip|average|additive|iso   --iso V1,V2,...  (iso values)
   --shade on|AMBIENT,DIFFUSE,SPECULAR,POWER  gradient shading with a headlight (on: 0,0.7,0.2,10)
+  --scatter BLENDING,REACH,ANISOTROPY  volumetric shadows and scattering as VTK's GPU mapper
+                       (VolumetricScatteringBlending 0..2, GlobalIlluminationReach 0..1,
+                       ScatteringAnisotropy -1..1); shades with the headlight
   --nearest          nearest-voxel sampling instead of trilinear
   --label-map nearest|blend  8/16-bit integer voxels as label ids: every id but 0 a label of its
                      own colour, opacity 0.5 (render); blend: smooth borders, never a label that

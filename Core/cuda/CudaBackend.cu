@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <thread>
 #include <vector>
 
 namespace spaceskip {
@@ -40,8 +41,9 @@ class CudaBackend final : public Backend {
     pool_.release();
     const int64_t budget = budget_ > 0 ? budget_ : defaultBudget(v, brick);
     if (int64_t(v.byteSize()) <= budget) {
-      vol_.upload(v, stream_);
-      cls_.setVolume(vol_, brick, stream_);
+      prefetchedLast_ = takePrefetched(v);
+      if (!prefetchedLast_) vol_->upload(v, stream_);
+      cls_.setVolume(*vol_, brick, stream_);
       SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
       inCore_ = ResidencyStats{};
       inCore_.budgetBytes = budget;
@@ -49,7 +51,9 @@ class CudaBackend final : public Backend {
     }
     // Sparse residency (BrickPool.h): the value ranges from the host's voxels, and a pool of
     // the budget's size that each frame fills with the bricks it needs.
-    vol_.describe(v);
+    finishPrefetch();
+    prefetchedLast_ = false;
+    vol_->describe(v);
     const RangeGrid ranges = computeRangeGrid(v, brick);
     cls_.setRanges(v, ranges, stream_);
     SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -177,14 +181,50 @@ class CudaBackend final : public Backend {
       f.traversal = TraversalKind::Grid;
       f.grid = GridView{nullptr, bdims_, brick_, nullptr, cls_.d_vmin.get(), cls_.d_vmax.get()};
     }
+    if (scatterSkips(f, traversal_)) f.scatter.occ = GridView{d_occ_[cur_].get(), bdims_, brick_};
     if (pool_.active() && f.sampling != kSampleTrilinear)
       throw BackendError("nearest and label-map sampling need the whole volume in device memory");
     if (pool_.active())
       pool_.update(poolNeedFor(f.blend, f.shade != 0 || f.gtf.mode != 0, tf_, f.avgLo, f.avgHi), cls_.d_occ[cls_.cur].get(),
                    cls_.generation, cls_.d_vmin.get(), cls_.d_vmax.get(), bdims_, brick_, stream_);
     const PoolView view = pool_.view();
-    exec_.render(f, filter, depth, vol_, pool_.active() ? &view : nullptr, out, stream_);
+    exec_.render(f, filter, depth, *vol_, pool_.active() ? &view : nullptr, out, stream_);
   }
+
+  ~CudaBackend() override { finishPrefetch(); }
+
+  // Time steps (Engine::prefetchVolume): the next step's voxels go to a second device volume on
+  // a copy stream, from a host thread (the pinned staging's host copies would otherwise hold
+  // the caller), while the current step is drawn; setVolume(next) swaps the two volumes.
+  bool prefetchVolume(const Volume& next) override {
+    finishPrefetch();
+    if (pool_.active() || !next.data || vol_->volume().byteSize() != next.byteSize()) return false;
+    const int64_t bytes = int64_t(next.byteSize());
+    if (!next_ || next_->volume().byteSize() != next.byteSize()) {
+      // A second step on the device: within the budget set, else within the free memory less
+      // what defaultBudget keeps back.
+      if (budget_ > 0 ? 2 * bytes > budget_ : defaultBudget(next, brick_) < bytes) return false;
+      next_ = std::make_unique<cuda::DeviceVolume>();
+    }
+    if (!copyStream_) copyStream_ = std::make_unique<cuda::Stream>();
+    if (!prefetchDone_) prefetchDone_ = std::make_unique<cuda::Event>();
+    prefetchOk_ = false;
+    prefetchData_ = next.data;
+    int device = 0;
+    SS_CUDA_CHECK(cudaGetDevice(&device));
+    prefetch_ = std::thread([this, next, device] {
+      try {
+        SS_CUDA_CHECK(cudaSetDevice(device));
+        next_->upload(next, *copyStream_);
+        SS_CUDA_CHECK(cudaEventRecord(*prefetchDone_, *copyStream_));
+        prefetchOk_ = true;
+      } catch (const std::exception&) {
+        (void)cudaGetLastError();  // setVolume uploads the step itself
+      }
+    });
+    return true;
+  }
+  bool lastVolumePrefetched() const override { return prefetchedLast_; }
 
   bool setImageOnDevice(bool on) override { return exec_.setImageOnDevice(on); }
   const void* deviceImage() const override { return exec_.deviceImage(); }
@@ -262,6 +302,21 @@ class CudaBackend final : public Backend {
     return std::max<int64_t>(0, avail - bricks * 40 - (int64_t(1) << 30));
   }
 
+  /// Waits for a prefetch's host thread (its copies may still be in flight on the copy stream).
+  void finishPrefetch() {
+    if (prefetch_.joinable()) prefetch_.join();
+  }
+  /// Whether `v` is the prefetched step: then the stream waits for its copies and it becomes the
+  /// volume drawn (the volume drawn before keeps its allocation for the next prefetch).
+  bool takePrefetched(const Volume& v) {
+    finishPrefetch();
+    if (!prefetchOk_ || !next_ || v.data != prefetchData_ || next_->volume().byteSize() != v.byteSize()) return false;
+    prefetchOk_ = false;
+    SS_CUDA_CHECK(cudaStreamWaitEvent(stream_, *prefetchDone_, 0));
+    std::swap(vol_, next_);
+    return true;
+  }
+
   void uploadTree(const Tree& t) {
     tree_.numNodes = int(t.nodes.size());
     tree_.height = t.height;
@@ -273,7 +328,15 @@ class CudaBackend final : public Backend {
   }
 
   cuda::Stream stream_;  // first: made first, destroyed last
-  cuda::DeviceVolume vol_;
+  std::unique_ptr<cuda::DeviceVolume> vol_ = std::make_unique<cuda::DeviceVolume>();
+  // Prefetched time steps (prefetchVolume): the second volume, its copy stream and host thread.
+  std::unique_ptr<cuda::DeviceVolume> next_;
+  std::unique_ptr<cuda::Stream> copyStream_;
+  std::unique_ptr<cuda::Event> prefetchDone_;
+  std::thread prefetch_;
+  bool prefetchOk_ = false;       ///< set by the thread before it ends (read after join)
+  const void* prefetchData_ = nullptr;
+  bool prefetchedLast_ = false;   ///< the last setVolume took the prefetched step
   cuda::DevicePool pool_;
   int64_t budget_ = 0;       ///< setMemoryBudget (0: defaultBudget)
   ResidencyStats inCore_;    ///< residency() of an in-core volume

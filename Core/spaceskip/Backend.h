@@ -23,6 +23,11 @@ class Backend {
   virtual const char* name() const = 0;
   /// Takes the volume (uploads it on the GPU) and computes the per-brick value ranges.
   virtual void setVolume(const Volume& v, int brick) = 0;
+  /// Starts moving `next` (the shape of the volume set, same brick) to where setVolume(next)
+  /// will find it, without waiting; false when this backend does not (the CPU reads in place).
+  virtual bool prefetchVolume(const Volume& /*next*/) { return false; }
+  /// Whether the last setVolume() found its voxels prefetched (Counters::prefetchedSteps).
+  virtual bool lastVolumePrefetched() const { return false; }
   /// Re-classifies bricks against the TF opacity and what `cc` leaves drawn (bricks no drawn
   /// sample can reach are empty); returns true when the occupancy changed.
   virtual bool classify(const TransferFunction& tf, const CropClip& cc) = 0;

@@ -51,6 +51,15 @@ class Engine {
 
   /// The engine borrows `v.data` (or shares `v.storage`): keep it alive while rendering.
   void setVolume(const Volume& v);
+  /// A time step's voxels before it is shown (playback): on the CUDA backend, when `next` has the
+  /// shape of the volume shown and two steps fit the device, its upload starts on a second stream
+  /// and a host thread while the current step is drawn, and setVolume(next) then finds it on the
+  /// device. Keep `next`'s voxels unchanged and alive until setVolume(next) (or another prefetch).
+  /// A step set before and not drawn yet is uploaded first (as update() would), so that
+  /// setVolume(t); prefetchVolume(t + 1); render(t) overlaps step t + 1's upload with step t's
+  /// classification, build and frame.
+  /// Returns whether the upload started (false: setVolume uploads it as before).
+  bool prefetchVolume(const Volume& next);
   /// A new table: compared with the one the engine has, an opacity change re-classifies (and
   /// rebuilds only when the occupied cells change), a colour-only change updates the table alone.
   /// A caller that knows a part is unchanged (the VTK mapper: that function was not edited) says

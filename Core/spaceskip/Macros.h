@@ -10,3 +10,11 @@
 #endif
 
 #define SS_FUNC SS_HOSTDEV SS_INLINE
+
+/// A shared function kept out of line on the GPU (one copy per template instance instead of one
+/// in every kernel that calls it): for rarely taken, large paths such as scattering's shadow rays.
+#if defined(__CUDACC__)
+#define SS_NOINLINE_FUNC __host__ __device__ __noinline__
+#else
+#define SS_NOINLINE_FUNC
+#endif

@@ -145,6 +145,12 @@ struct RenderParams {
   std::vector<Light> lights;
   bool twoSidedLighting = true;  ///< vtkRenderer's TwoSidedLighting: back faces lit as front ones
 
+  // Volumetric shadows and scattering (render/Scattering.h), as vtkGPUVolumeRayCastMapper (VTK
+  // 9.2) draws them: shaded composite and isosurface frames, one shadow ray per light.
+  double scatteringBlending = 0;       ///< VolumetricScatteringBlending in [0, 2]; 0: off
+  double globalIlluminationReach = 0;  ///< GlobalIlluminationReach in [0, 1]: the shadow rays' length
+  double scatteringAnisotropy = 0;     ///< vtkVolumeProperty's ScatteringAnisotropy in [-1, 1]
+
   // Slice blend mode: the plane through sliceOrigin with normal sliceNormal, in the volume's
   // world frame (as vtkPlane's origin and normal; a zero or non-finite normal: the plane through
   // the box centre normal to z, with one warning).
@@ -262,6 +268,8 @@ struct Counters {
   /// (the kept structure is rebuilt for the step as after an opacity edit; Auto measures again
   /// only when the occupancy moved by more than AutoBuilder::kReexplore).
   int timeSteps = 0;
+  /// Of those, steps whose voxels were already on the device (Engine::prefetchVolume).
+  int prefetchedSteps = 0;
 };
 
 /// Host-to-device copy rates (bytes per second; 0 where there is no device), measured by

@@ -140,6 +140,7 @@ class CpuBackend final : public Backend {
       f.grid = GridView{nullptr, ranges_.dims, ranges_.brick, nullptr, ranges_.vmin.data(), ranges_.vmax.data()};
     }
     f.tf = TransferFunctionView{table_.data(), int(table_.size()), tfLo_, tfScale_};
+    if (scatterSkips(f, traversal_)) f.scatter.occ = GridView{occ_.occ.data(), occ_.dims, occ_.brick};
     out.width = f.width;
     out.height = f.height;
     out.rgba.assign(size_t(f.width) * size_t(f.height), vec4f{0, 0, 0, 0});

@@ -394,6 +394,25 @@ struct Engine::Impl {
     return c;
   }
 
+  /// The volume set to the backend (its upload, or the prefetched step) and its value ranges,
+  /// when a setVolume is pending: update()'s first part, which prefetchVolume runs early so the
+  /// next step's upload overlaps this step's classification, build and frame.
+  void uploadIfNeeded() {
+    if (!rangesDirty) return;
+    report(0.0, "value ranges");
+    backend->setVolume(volume, build.brick);
+    if (backend->lastVolumePrefetched()) ++counters.prefetchedSteps;
+    checkMagnitudes();
+    ++counters.rangeGrids;
+    ++counters.voxelPasses;
+    rangesDirty = false;
+    newVolumeUploaded = true;  // for update(): the structures held belong to another volume
+    labelSetsDirty = true;  // computed when a label map is drawn (refreshLabelTF)
+    opacityDirty = true;
+    buildDirty = true;
+  }
+  bool newVolumeUploaded = false;
+
   /// Value ranges and classification, as far as they are stale. Returns whether the
   /// classification changed the occupancy (an edit).
   bool classifyIfNeeded() {
@@ -402,17 +421,7 @@ struct Engine::Impl {
       cropClip = cc;
       cropClipDirty = true;
     }
-    if (rangesDirty) {
-      report(0.0, "value ranges");
-      backend->setVolume(volume, build.brick);
-      checkMagnitudes();
-      ++counters.rangeGrids;
-      ++counters.voxelPasses;
-      rangesDirty = false;
-      labelSetsDirty = true;  // computed when a label map is drawn (refreshLabelTF)
-      opacityDirty = true;
-      buildDirty = true;
-    }
+    uploadIfNeeded();
     refreshLabelTF();
     // A TF (or crop/clip) edit: no contender is built on the frame that shows it.
     if (opacityDirty || colorDirty || cropClipDirty) autoBuilder.edited();
@@ -487,8 +496,9 @@ struct Engine::Impl {
     if (!haveTF && !labelOn) throw std::runtime_error("no transfer function set");
     const bool isAuto = build.builder == BuilderKind::Auto;
     const bool refineNow = autoBuilder.standingIn();  // the last frame stood in: build the kept one now
-    const bool newRanges = rangesDirty;
     const bool edited = classifyIfNeeded();  // this update's classification changed the occupancy
+    const bool newRanges = newVolumeUploaded;  // since the last update (prefetchVolume may upload early)
+    newVolumeUploaded = false;
     if (isAuto && !autoBuilder.started()) startAuto();
     updateTable();
     if (refineNow && !buildDirty) buildDirty = true;
@@ -551,6 +561,25 @@ bool sameShape(const Volume& a, const Volume& b) {
 }  // namespace
 
 UploadRates Engine::measureUpload(size_t bytes) { return impl_->backend->measureUpload(bytes); }
+
+bool Engine::prefetchVolume(const Volume& next) {
+  Impl& d = *impl_;
+  if (!d.haveVolume || !next.data || !sameShape(d.sourceShape, next)) return false;
+  // Steps drawn from a scaled copy (extreme float magnitudes; doubles and several float
+  // components, whose check reads the host's voxels) are uploaded by setVolume as before.
+  if (d.valueExponent != 0 || next.type == VoxelType::Float64 || (next.type == VoxelType::Float32 && next.components != 1))
+    return false;
+  // The step set before goes to the backend first (its prefetched voxels swapped in): the next
+  // one's upload then overlaps this one's classification, build and frame.
+  try {
+    d.uploadIfNeeded();
+  } catch (const BackendError& e) {
+    if (d.backend->kind() != BackendKind::CUDA) throw;
+    d.fallBackToCpu(e.what());
+    return false;
+  }
+  return d.backend->prefetchVolume(next);
+}
 
 void Engine::setVolume(const Volume& v) {
   validate(v);
@@ -904,6 +933,67 @@ void fillGradientTF(Impl& d, FrameView& f) {
     g.gradScale[a] = h > 0 ? float(avg / (2.0 * h) / (0.25 * range)) : 0.f;
   }
 }
+/// Volumetric shadows and scattering (render/Scattering.h): VTK's texture space for this
+/// volume, the lights there, the reach as VTK maps GlobalIlluminationReach, the blend's gradient
+/// scale. After fillBlend (shading, lights, the scalar normalisation) and fillGradientTF.
+template <class Impl>
+void fillScatter(Impl& d, FrameView& f, const MarchFrame& frame, bool piece) {
+  const RenderParams& r = d.render;
+  ScatterView& S = f.scatter;
+  S.on = 0;
+  const double b = r.scatteringBlending;
+  if (!(b > 0) || !f.shade || !(f.blend == BlendMode::Composite || f.blend == BlendMode::Isosurface)) return;
+  if (piece) {
+    d.warn("volumetric scattering is not drawn in pieces (MPI): a shadow ray would need the other ranks' voxels; "
+           "drawn with gradient shading only");
+    return;
+  }
+  if (f.useLights && f.numLights == 0) return;  // no light: VTK generates no scattering either
+  S.on = 1;
+  S.blending = float(std::min(b, 2.0));
+  // |g| near 1 makes the phase function a spike of height ~1/(1-|g|)^2; clamped where float holds it.
+  S.g = float(std::max(-0.99, std::min(0.99, std::isfinite(r.scatteringAnisotropy) ? r.scatteringAnisotropy : 0.0)));
+  S.cutoff = 1.f / 4096.f;
+  const vec3f cells = f.boxHi;
+  S.texN = vec3f{cells.x + 1.f, cells.y + 1.f, cells.z + 1.f};
+  S.dirScale = vec3f{cells.x > 0.f ? 1.f / cells.x : 1.f, cells.y > 0.f ? 1.f / cells.y : 1.f,
+                     cells.z > 0.f ? 1.f / cells.z : 1.f};
+  // VTK: reach = (minExtent - sqrt 3) (1 - r)^0.33 + sqrt 3, minExtent = the sample distance in
+  // texture units along the longest axis.
+  const mat4 i2w = frame.shape.indexToWorld();
+  double longest = 0;
+  const float cd[3] = {cells.x, cells.y, cells.z};
+  for (int a = 0; a < 3; ++a)
+    longest = std::max(longest, std::hypot(i2w.m[a * 4], i2w.m[a * 4 + 1], i2w.m[a * 4 + 2]) * double(cd[a]));
+  const double minExtent = longest > 0 ? double(f.dt) / longest : 0.0;
+  const double reach = std::max(0.0, std::min(1.0, std::isfinite(r.globalIlluminationReach) ? r.globalIlluminationReach : 0.0));
+  const double sqrt3 = 1.73205;
+  S.reach = float((minExtent - sqrt3) * std::pow(1.0 - reach, 0.33) + sqrt3);
+  // VTK's gradient for the blend: the scalar normalised over the array's range, per world length
+  // (the data set's spacing), from central differences.
+  for (int a = 0; a < 3; ++a) {
+    const double h = std::fabs(d.volume.spacing[a]);
+    S.gradScale[a] = h > 0 ? saturatedFloat(double(f.normScale) / h) : 0.f;
+  }
+  const float* W = f.worldToIndex;
+  auto toIndexDir = [&](vec3f v) {
+    return vec3f{W[0] * v.x + W[1] * v.y + W[2] * v.z, W[4] * v.x + W[5] * v.y + W[6] * v.z,
+                 W[8] * v.x + W[9] * v.y + W[10] * v.z};
+  };
+  auto toIndexPoint = [&](vec3f v) { return toIndexDir(v) + vec3f{W[3], W[7], W[11]}; };
+  auto unadjusted = [&](vec3f i) { return vec3f{i.x * S.dirScale.x, i.y * S.dirScale.y, i.z * S.dirScale.z}; };
+  S.eyeIdx = toIndexPoint(f.eyeW);
+  if (f.useLights) {
+    for (int i = 0; i < f.numLights; ++i) {
+      const LightView& L = f.lights[i];
+      S.lightU[i] = L.positional ? unadjusted(toIndexPoint(L.pos)) : unadjusted(toIndexDir(L.dir * -1.f));
+    }
+  } else {
+    const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
+    S.headPositional = head ? 1 : 0;
+    S.lightU[0] = head ? unadjusted(S.eyeIdx) : unadjusted(toIndexDir(normalize(f.lightDir)));
+  }
+}
 }  // namespace
 
 void Engine::render(const Camera& cam, int width, int height, Image& out, const float* depth,
@@ -979,6 +1069,7 @@ void Engine::render(const Camera& cam, int width, int height, Image& out, const 
   fillBlend(d, f, frame);
   fillComponents(d, f);
   fillGradientTF(d, f);
+  fillScatter(d, f, frame, piece != nullptr);
   // Nearest and label-map sampling (render/LabelSampler.h).
   if (d.labelOn)
     f.sampling = d.render.labelSampling == LabelSampling::Nearest ? kLabelNearest : kLabelBlend;

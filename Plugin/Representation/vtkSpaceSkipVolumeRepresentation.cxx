@@ -662,6 +662,16 @@ vtkSpaceSkipForwardGet(FrameCount, int)
 
 vtkSpaceSkipForwardBool(EarlyRayTermination)
 vtkSpaceSkipForwardBool(UseJittering)
+void vtkSpaceSkipVolumeRepresentation::SetGlobalIlluminationReach(float reach)
+{
+  this->Superclass::SetGlobalIlluminationReach(reach);
+  this->SpaceSkipMapper->SetGlobalIlluminationReach(reach);
+}
+void vtkSpaceSkipVolumeRepresentation::SetVolumetricScatteringBlending(float blending)
+{
+  this->Superclass::SetVolumetricScatteringBlending(blending);
+  this->SpaceSkipMapper->SetVolumetricScatteringBlending(blending);
+}
 void vtkSpaceSkipVolumeRepresentation::SetDeviceMemoryBudget(int mib)
 {
   this->SpaceSkipMapper->SetDeviceMemoryBudget(mib);

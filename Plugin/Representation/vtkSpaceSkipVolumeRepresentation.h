@@ -56,6 +56,13 @@ public:
   void SetEarlyRayTermination(int on);
   int GetEarlyRayTermination();
   void SetUseJittering(int on);
+  ///@{
+  /// The stock Volume's Global Illumination Reach and Volumetric Scattering Blending (shared
+  /// properties; the base class hands them to VTK's mappers only): to our mapper as well. The
+  /// anisotropy reaches it through the volume property (ScatteringAnisotropy).
+  void SetGlobalIlluminationReach(float reach);
+  void SetVolumetricScatteringBlending(float blending);
+  ///@}
   int GetUseJittering();
   void SetFilterMode(int mode);
   int GetFilterMode();

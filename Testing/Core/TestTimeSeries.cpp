@@ -18,8 +18,10 @@ std::vector<Volume> nbodySteps(int n, int count, VoxelType type) {
 
 /// Plays `steps` (each twice, the second time at another view) in one engine of `backend` and
 /// compares every frame with a static render of that step by a fresh Naive engine on the CPU.
+/// With `prefetch`, each next step is prefetched (Engine::prefetchVolume) while a step is drawn;
+/// on CUDA then every played step after the first was found on the device.
 void expectPlaybackEqualsStatic(BackendKind backend, const std::vector<Volume>& steps, const BuildParams& bp,
-                                float tolerance) {
+                                float tolerance, bool prefetch = false) {
   double lo = 0, hi = 1;
   ASSERT_TRUE(steps[0].scalarRange(lo, hi));
   const TransferFunction tf = TransferFunction::preset("ramp", lo, hi);
@@ -30,6 +32,8 @@ void expectPlaybackEqualsStatic(BackendKind backend, const std::vector<Volume>& 
     const Volume& v = steps[size_t(k) % steps.size()];
     const Camera cam = test::orbit(v, 25.0 * k, 20);
     e.setVolume(v);
+    e.update();
+    if (prefetch) EXPECT_EQ(e.prefetchVolume(steps[size_t(k + 1) % steps.size()]), backend == BackendKind::CUDA);
     e.render(cam, 80, 80, img);
     Engine naive(BackendKind::CPU);
     test::load(naive, v, tf, test::builder(BuilderKind::Naive));
@@ -39,6 +43,8 @@ void expectPlaybackEqualsStatic(BackendKind backend, const std::vector<Volume>& 
     EXPECT_GT(test::coverage(img), 0.0) << "step " << k;
   }
   EXPECT_EQ(e.counters().timeSteps, 2 * int(steps.size()));  // every setVolume after load()'s
+  // Prefetched: every step after the first played one (the CPU reads the steps in place).
+  if (prefetch) EXPECT_EQ(e.counters().prefetchedSteps, backend == BackendKind::CUDA ? 2 * int(steps.size()) - 1 : 0);
 }
 
 }  // namespace
@@ -156,6 +162,34 @@ TEST(TimeSeries, CudaPlaybackEqualsStaticRenders) {
                              1.f / 255.f);
 }
 
+TEST(TimeSeries, PrefetchIsANoOpOnTheCpu) {
+  expectPlaybackEqualsStatic(BackendKind::CPU, nbodySteps(40, 3, VoxelType::UInt8), test::builder(BuilderKind::Grid),
+                             1.f / 255.f, true);
+}
+TEST(TimeSeries, CudaPrefetchedPlaybackEqualsStaticRenders) {
+  SKIP_WITHOUT_CUDA();
+  // Through the pinned chunks (54 MiB) and below them; uint8 and float32; a structure and Auto.
+  expectPlaybackEqualsStatic(BackendKind::CUDA, nbodySteps(384, 2, VoxelType::UInt8), test::builder(BuilderKind::Auto),
+                             1.f / 255.f, true);
+  expectPlaybackEqualsStatic(BackendKind::CUDA, nbodySteps(48, 3, VoxelType::UInt8), test::builder(BuilderKind::Grid),
+                             1.f / 255.f, true);
+  expectPlaybackEqualsStatic(BackendKind::CUDA, nbodySteps(200, 3, VoxelType::Float32),
+                             test::builder(BuilderKind::DistanceGrid), 1.f / 255.f, true);
+  // A prefetch of another shape, or of a step never shown: nothing breaks, setVolume uploads.
+  const std::vector<Volume> a = nbodySteps(48, 2, VoxelType::UInt8), other = nbodySteps(40, 1, VoxelType::UInt8);
+  double lo = 0, hi = 1;
+  ASSERT_TRUE(a[0].scalarRange(lo, hi));
+  Engine e(BackendKind::CUDA);
+  test::load(e, a[0], TransferFunction::preset("ramp", lo, hi), test::builder(BuilderKind::Grid));
+  Image img, ref;
+  e.render(test::orbit(a[0], 10, 20), 64, 64, img);
+  EXPECT_FALSE(e.prefetchVolume(other[0]));  // another shape
+  EXPECT_TRUE(e.prefetchVolume(a[1]));
+  e.setVolume(a[0]);  // not the prefetched step: uploaded as before
+  e.render(test::orbit(a[0], 10, 20), 64, 64, ref);
+  EXPECT_EQ(compareImages(img, ref).maxAbs, 0.f);
+  EXPECT_EQ(e.counters().prefetchedSteps, 0);
+}
 TEST(TimeSeries, CudaUploadRatesAreMeasured) {
   SKIP_WITHOUT_CUDA();
   Engine e(BackendKind::CUDA);

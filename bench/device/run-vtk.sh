@@ -28,7 +28,9 @@
 #          calls, waits; summaries in nsys.log, the CUDA/GL traces as CSV in logs.tgz)
 #          bench-depth (N-body 1024^3 with an opaque point actor: the depth readback a
 #          volume-only scene skips) bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
-#          shading, window and CLI, N-body and Menger 1024^3: modes.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
+#          shading, window and CLI, N-body and Menger 1024^3: modes.log) bench-scatter (issue 34:
+#          volumetric scattering on vs off in one process, and vtkGPUVolumeRayCastMapper with it:
+#          scatter.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
 #          its CUDA tests: core.log) auto (the CLI's Builder Auto against fixed builders, dense and
 #          sparse 1024^3: cli-bench.log) cli-ab (CLI kernel fps, settings alternated per process:
 #          CLI_AB_RUNS, CLI_AB_DATASETS, CLI_AB_ITEMS: cli-ab.txt)
@@ -238,7 +240,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: first a vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl),
 # else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor || has bench-oldnew; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-scatter || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor || has bench-oldnew; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -338,6 +340,25 @@ fi
 
 # MIP: Naive takes every sample; every skipping builder marches the per-brick value ranges
 # (render/Integrator.h, usesValueRanges). Shading: composite with and without --shade.
+# Volumetric shadows and scattering (issue 34): shading alone (:noscatter) against scattering
+# SCATTER (blending,reach,anisotropy; default 1,0.5,0) item by item in one process, N-body
+# SCATTER_N^3 (2048) and the dense stand-in SCATTER_DENSE (rm) at SCATTER_DENSE_N^3 (1024); then
+# vtkGPUVolumeRayCastMapper with the same settings (SCATTER_VTK_FRAMES frames, default 2) beside
+# our Auto, at SCATTER_VTK_N^3 (1024). scatter.log.
+if has bench-scatter; then
+  sc=${SCATTER:-1,0.5,0}
+  for c in "nbody ${SCATTER_N:-2048}" "${SCATTER_DENSE:-rm} ${SCATTER_DENSE_N:-1024}"; do
+    set -- $c
+    ITEMS=${SCATTER_ITEMS:-Auto:noscatter,Auto,Grid:noscatter,Grid,Auto:noscatter,Auto} window_bench "$1" "$2" "${v2[@]}" --scatter "$sc"
+  done
+  if [ "${VTK_GPU:-1}" = 1 ]; then
+    for shape in nbody "${SCATTER_DENSE:-rm}"; do
+      frames=${SCATTER_VTK_FRAMES:-2} ITEMS=Auto:noscatter,Auto window_bench "$shape" "${SCATTER_VTK_N:-1024}" "${vg[@]}" --scatter "$sc"
+    done
+  fi
+  grep -E "^blend|^item|^Auto|^Grid|^Naive|^vtkGPU|volume |GL_RENDERER" "$work/bench.log" > "$out/scatter.log"
+fi
+
 if has bench-modes; then
   for shape in nbody menger; do
     for mode in "--blend composite" "--blend composite --shade" "--blend mip"; do

@@ -3,7 +3,8 @@
 # the time-series tests, compute-sanitizer memcheck on the CUDA ones and the whole Core suite; the
 # carried CLI (`bench`: .vtkbundle-cli/cli.tar.xz) the playback benchmark at 512^3 and 1024^3,
 # uint8 and float32, 1024x1024 (bench/device/pack-core.sh packs both).
-#   bash bench/device/time-series.sh OUT tests|bench
+# `scatter`: the CLI's volumetric-scattering benchmark instead (issue 34).
+#   bash bench/device/time-series.sh OUT tests|bench|scatter
 set -uo pipefail
 out=${1:?usage: time-series.sh OUT tests|bench}
 what=${2:?tests or bench}
@@ -20,6 +21,20 @@ export LD_LIBRARY_PATH=/tmp/c/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
   echo "cores: $(nproc)"
 } > "$out/env.txt" 2>&1
 B=/tmp/c/bin
+# Volumetric scattering (issue 34) in the CLI: shading alone, then scattering (SCATTER, default
+# 1,0.5,0), N-body 2048^3 and the dense stand-in rm 1024^3, kernel fps per builder.
+if [ "$what" = scatter ]; then
+  for spec in "nbody 2048" "rm 1024"; do
+    set -- $spec
+    for mode in "--shade on" "--scatter ${SCATTER:-1,0.5,0}"; do
+      echo "== spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} --size 1024x1024 --frames 8 $mode" >> "$out/scatter.log"
+      timeout 200 $B/spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} \
+        --size 1024x1024 --frames 8 $mode >> "$out/scatter.log" 2>&1
+      echo "rc=$?" >> "$out/scatter.log"
+    done
+  done
+  exit 0
+fi
 if [ "$what" != bench ]; then
   $B/spaceskip_core_tests --gtest_filter='TimeSeries.*' > "$out/time-series-tests.log" 2>&1
   echo "time-series tests rc=$?" >> "$out/env.txt"

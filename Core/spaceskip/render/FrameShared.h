@@ -82,6 +82,30 @@ struct GradientTFView {
   float gradScale[3] = {0.f, 0.f, 0.f};
 };
 
+/// Volumetric shadows and scattering as vtkGPUVolumeRayCastMapper (VTK 9.2) draws them with
+/// VolumetricScatteringBlending > 0, GlobalIlluminationReach and the volume property's
+/// ScatteringAnisotropy (render/Scattering.h). Shadow rays live in VTK's texture space: texture
+/// coordinate (i + 1/2) / n per axis (n points), the box [0, 1]^3; lights and the view direction
+/// in its unadjusted form i / (n - 1). Composite and isosurface blending, shaded frames only.
+struct ScatterView {
+  int on = 0;
+  float blending = 0.f;         ///< VolumetricScatteringBlending, (0, 2]
+  float g = 0.f;                ///< Henyey-Greenstein anisotropy; |g| < 0.01: isotropic (phase 1)
+  float reach = 0.f;            ///< the longest shadow ray in texture units (VTK's in_giReach)
+  vec3f texN{1, 1, 1};          ///< points per axis n: texture units -> index units
+  vec3f dirScale{1, 1, 1};      ///< 1 / (n - 1) per axis: index -> unadjusted texture units
+  float gradScale[3] = {0.f, 0.f, 0.f};  ///< central difference -> VTK's gradient (normalised scalar per world length)
+  float cutoff = 0.f;           ///< a shadow ray stops once its light's largest contribution falls below this
+  /// Where each light is in unadjusted texture units (the headlight model: [0]): the direction
+  /// towards it for a directional light, its position for a positional one.
+  vec3f lightU[kMaxLights];
+  int headPositional = 1;       ///< the headlight model: 1: a point light at the eye; 0: directional
+  vec3f eyeIdx{0, 0, 0};        ///< the eye in index space (the view direction of the phase function)
+  /// The brick occupancy the shadow rays skip with (every builder's classification, no cuts:
+  /// VTK's shadow rays ignore cropping and clipping); occ == nullptr: every sample is taken.
+  GridView occ{};
+};
+
 /// Everything a pixel needs, plain data (device pointers on the GPU).
 struct FrameView {
   float invViewProj[16];   ///< NDC -> world, column-major
@@ -138,6 +162,7 @@ struct FrameView {
   /// voxel's value; 2, 3 a label map, its nearest label or the argmax of the corners' label
   /// weights, drawn through labelLookup. One-component volumes; the executors pick the sampler.
   int sampling;
+  ScatterView scatter;  ///< volumetric shadows and scattering (off: on == 0)
 };
 
 }  // namespace spaceskip

@@ -77,6 +77,7 @@ struct ArraySampler {
 #include "LabelSampler.h"  // needs voxelValue and ArraySampler
 #include "Components.h"  // needs voxelValue and ArraySampler
 #include "GradientTF.h"
+#include "Scattering.h"
 
 namespace spaceskip {
 
@@ -122,6 +123,7 @@ struct IntervalMarcher {
   unsigned count;    ///< MIP/MinIP: samples seen; average: samples counted
   int isoIndex;      ///< isosurface: the iso interval of the last sample, -1 before the first
   vec3f orgW{0, 0, 0}, dirW{0, 0, 0};  ///< the ray in world space (light list, positional lights)
+  float shadowL = 0.f;  ///< scattering: the shadow rays' step, the primary step in texture units
 
   /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
   SS_FUNC bool active(float lo, float hi) const {
@@ -144,23 +146,49 @@ struct IntervalMarcher {
   /// specular not tinted, the result clamped to [0, 1].
   /// A label map (LabelSampler.h) is lit by the gradient of the sampled label's interpolated
   /// indicator: its border is the surface, whatever the ids of the labels on either side.
-  SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p) const {
+  /// With `alpha` >= 0 (the sample's opacity) and FrameView::scatter on, the gradient shading is
+  /// blended with the scattered light (render/Scattering.h) as vtkGPUVolumeRayCastMapper does.
+  SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p, float alpha = -1.f) const {
     float gx, gy, gz;
+    bool done = false;
     if constexpr (IsNearestSampler<Sampler>::value) {
       if (s->labels()) {
         const float l = s->sample(p);
         gx = s->indicator(p + vec3f{1, 0, 0}, l) - s->indicator(p - vec3f{1, 0, 0}, l);
         gy = s->indicator(p + vec3f{0, 1, 0}, l) - s->indicator(p - vec3f{0, 1, 0}, l);
         gz = s->indicator(p + vec3f{0, 0, 1}, l) - s->indicator(p - vec3f{0, 0, 1}, l);
-        return shadeGradient(rgb, p, gx, gy, gz);
+        done = true;
       }
     }
-    gx = gradientSample(*f, *s, p + vec3f{1, 0, 0}) - gradientSample(*f, *s, p - vec3f{1, 0, 0});
-    gy = gradientSample(*f, *s, p + vec3f{0, 1, 0}) - gradientSample(*f, *s, p - vec3f{0, 1, 0});
-    gz = gradientSample(*f, *s, p + vec3f{0, 0, 1}) - gradientSample(*f, *s, p - vec3f{0, 0, 1});
-    return shadeGradient(rgb, p, gx, gy, gz);
+    if (!done) {
+      gx = gradientSample(*f, *s, p + vec3f{1, 0, 0}) - gradientSample(*f, *s, p - vec3f{1, 0, 0});
+      gy = gradientSample(*f, *s, p + vec3f{0, 1, 0}) - gradientSample(*f, *s, p - vec3f{0, 1, 0});
+      gz = gradientSample(*f, *s, p + vec3f{0, 0, 1}) - gradientSample(*f, *s, p - vec3f{0, 0, 1});
+    }
+    if (Plain || !(alpha >= 0.f) || !f->scatter.on) return clamp01(shadeGradient(rgb, p, gx, gy, gz));
+    // The blend's gradient magnitude: VTK's (normalised scalar per world length), 1 wherever a
+    // 2-D transfer function or gradient opacity normalises its gradient.
+    const ScatterView& S = f->scatter;
+    float G;
+    if (f->gtf.mode != 0) {
+      G = gx != 0.f || gy != 0.f || gz != 0.f ? 1.f : 0.f;
+    } else {
+      const float ax = gx * S.gradScale[0], ay = gy * S.gradScale[1], az = gz * S.gradScale[2];
+      G = sqrtf(ax * ax + ay * ay + az * az);
+    }
+    const float coef = scatterBlend(S.blending, G, alpha);
+    const vec3f phong = shadeGradient(rgb, p, gx, gy, gz);
+    if (!(coef > 0.f)) return clamp01(phong);
+    const vec3f e = S.eyeIdx - p;
+    const vec3f viewU = normalize(vec3f{e.x * S.dirScale.x, e.y * S.dirScale.y, e.z * S.dirScale.z});
+    const vec3f sec = scatteredLight(*f, *s, p, f->useLights ? worldAt(p) : vec3f{0, 0, 0}, viewU, rgb, shadowL, coef);
+    return clamp01(phong * (1.f - coef) + sec * coef);
   }
-  /// shadeColor for the index-space central differences (gx, gy, gz).
+  SS_FUNC static vec3f clamp01(vec3f c) {
+    return vec3f{ss_clamp(c.x, 0.f, 1.f), ss_clamp(c.y, 0.f, 1.f), ss_clamp(c.z, 0.f, 1.f)};
+  }
+  /// The gradient (Phong) shading for the index-space central differences (gx, gy, gz), not
+  /// clamped (shadeColor clamps, after the blend with scattering as VTK does).
   SS_FUNC vec3f shadeGradient(vec3f rgb, vec3f p, float gx, float gy, float gz) const {
     const float* M = f->worldToIndex;
     vec3f n{M[0] * gx + M[4] * gy + M[8] * gz, M[1] * gx + M[5] * gy + M[9] * gz, M[2] * gx + M[6] * gy + M[10] * gz};
@@ -172,8 +200,7 @@ struct IntervalMarcher {
     const float vr = ss_max(-dot(r, viewW), 0.f);
     const float spec = vr > 0.f ? f->specular * powf(vr, f->specularPower) : 0.f;
     const float k = f->ambient + f->diffuse * fabsf(nl);
-    return vec3f{ss_clamp(k * rgb.x + spec, 0.f, 1.f), ss_clamp(k * rgb.y + spec, 0.f, 1.f),
-                 ss_clamp(k * rgb.z + spec, 0.f, 1.f)};
+    return vec3f{k * rgb.x + spec, k * rgb.y + spec, k * rgb.z + spec};
   }
 
   /// World position (origin-relative) of index-space sample p on this ray: the ray's parameter
@@ -187,8 +214,8 @@ struct IntervalMarcher {
   /// single default headlight (VTK 9.2, ComputeLightingDeclaration; e.g. ParaView's light kit):
   /// unit normal n (towards larger values), per light its direction of travel, two-sided
   /// diffuse when asked, specular from -reflect; positional lights with attenuation and spot
-  /// cone; ambient = the lights' ambient colours (not the sample's colour); clamped to [0, 1]
-  /// as VTK's computeColor does.
+  /// cone; ambient = the lights' ambient colours (not the sample's colour); shadeColor clamps
+  /// to [0, 1] as VTK's computeColor does.
   SS_FUNC vec3f shadeLights(vec3f rgb, vec3f n, vec3f p) const {
     const vec3f pw = worldAt(p);
     const vec3f v = normalize(pw - f->eyeW);  // eye -> sample (VTK: -viewDirection)
@@ -218,9 +245,9 @@ struct IntervalMarcher {
       }
     }
     const vec3f a = f->lightAmbient;
-    return vec3f{ss_clamp(f->ambient * a.x + f->diffuse * dif.x * rgb.x + f->specular * spe.x, 0.f, 1.f),
-                 ss_clamp(f->ambient * a.y + f->diffuse * dif.y * rgb.y + f->specular * spe.y, 0.f, 1.f),
-                 ss_clamp(f->ambient * a.z + f->diffuse * dif.z * rgb.z + f->specular * spe.z, 0.f, 1.f)};
+    return vec3f{f->ambient * a.x + f->diffuse * dif.x * rgb.x + f->specular * spe.x,
+                 f->ambient * a.y + f->diffuse * dif.y * rgb.y + f->specular * spe.y,
+                 f->ambient * a.z + f->diffuse * dif.z * rgb.z + f->specular * spe.z};
   }
 
   /// Slice blend mode (vtkVolumeShaderComposer, VTK 9.2): the ray's value is its one sample where
@@ -258,7 +285,7 @@ struct IntervalMarcher {
   /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
   SS_FUNC bool composite(vec4f c, vec3f p) {
     if (!Plain && f->shade) {
-      vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p);
+      vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p, c.w);
       c.x = rgb.x;
       c.y = rgb.y;
       c.z = rgb.z;
@@ -548,6 +575,10 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py, 
   }
   m.orgW = nearW;
   m.dirW = dirW;
+  if (!Plain && f.scatter.on) {  // VTK's g_lengthStep: the primary step in texture units
+    const vec3f st = rl.dir * f.dt;
+    m.shadowL = length(vec3f{st.x / f.scatter.texN.x, st.y / f.scatter.texN.y, st.z / f.scatter.texN.z});
+  }
   if (!Plain && f.blend == BlendMode::Slice) {  // no marching: the sample on the plane, if drawn
     float a = tEnter, b = tExit;
     if (f.cut.numClipPlanes == 0 || clipToPlanes(f.cut, r, a, b)) {

@@ -8,7 +8,7 @@
 // edit's frame with). Run by bench/device/run-vtk.sh.
 //
 //   spaceskip_window_bench --shape nbody|menger|... --dims N [--frames F] [--size S]
-//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:full|:float|:glblend|:segN|:batchN]]
+//       [--builders Naive,Grid,LBVH,...[:shallow|:deep|:mlsN|:brickN|:hw|:exact|:full|:float|:glblend|:segN|:batchN|:noscatter]]
 //       [--vtk-gpu]
 //       [--edits E (4)] [--edit-cut C (the edits move the ramp's zero between 10% and C of the
 //        range: 0.3 by default, which changes N-body's occupied cells; 0.2 does not, as its
@@ -18,6 +18,8 @@
 //       [--egl] [--png PREFIX (the last timed frame of each item)] [--float-composite] [--ert]
 //       [--host-composite (GPUComposite off)] [--blend composite|mip|minip|average|additive]
 //       [--shade (gradient shading, VTK's default headlight and material)]
+//       [--scatter B,R,G (volumetric scattering: VolumetricScatteringBlending B, GlobalIlluminationReach
+//        R and ScatteringAnisotropy G on both mappers; implies --shade)]
 //       [--depth-actor (an opaque point actor outside the volume: the mapper reads the window's
 //        depth as with geometry in the scene; without it a volume-only scene skips the readback)]
 // The mapper's knobs (spaceskip::Tuning) come from the environment (Core/cli/Environment.h,
@@ -192,6 +194,7 @@ struct Item
   bool glBlend = false; ///< Tuning::cudaBlend off
   int segments = 0;     ///< Tuning::raySegments (0: the environment's)
   int batch = 0;        ///< Tuning::sampleBatch (0: the environment's)
+  bool noScatter = false; ///< without --scatter's scattering (shading only): the ratio in one run
 };
 
 bool ParseItem(const std::string& spec, Item& it)
@@ -253,6 +256,10 @@ bool ParseItem(const std::string& spec, Item& it)
     else if (parts[i].rfind("seg", 0) == 0 && parts[i].size() > 3)
     {
       it.segments = std::atoi(parts[i].c_str() + 3);
+    }
+    else if (parts[i] == "noscatter")
+    {
+      it.noScatter = true;
     }
     else if (parts[i].rfind("batch", 0) == 0 && parts[i].size() > 5)
     {
@@ -326,6 +333,7 @@ int main(int argc, char* argv[])
   double editCut = 0.3;
   bool vtkGpu = false, egl = false, floatComposite = false, ert = false, hostComposite = false;
   bool shade = false, depthActor = false;
+  float scatter[3] = { 0.f, 0.f, 0.f }; // --scatter: blending, reach, anisotropy
   int blend = vtkVolumeMapper::COMPOSITE_BLEND;
   int filter = vtkSpaceSkippingVolumeMapper::ExactFilter;
   // The on/off options.
@@ -385,6 +393,15 @@ int main(int argc, char* argv[])
       {
         return 2;
       }
+    }
+    else if (a == "--scatter")
+    {
+      if (std::sscanf(next().c_str(), "%f,%f,%f", &scatter[0], &scatter[1], &scatter[2]) != 3)
+      {
+        std::cerr << "--scatter takes B,R,G (blending, reach, anisotropy)\n";
+        return 2;
+      }
+      shade = true;
     }
     else if (a == "--csv")
       csvPath = next();
@@ -456,7 +473,9 @@ int main(int argc, char* argv[])
   prop->SetInterpolationTypeToLinear();
   prop->SetShade(shade ? 1 : 0);
   prop->SetScalarOpacityUnitDistance(1.0);
-  std::printf("blend mode %d, shading %s\n", blend, shade ? "on" : "off");
+  prop->SetScatteringAnisotropy(scatter[2]);
+  std::printf("blend mode %d, shading %s, scattering blending %g reach %g anisotropy %g\n", blend,
+    shade ? "on" : "off", scatter[0], scatter[1], scatter[2]);
 
   vtkNew<vtkRenderer> ren;
   ren->SetBackground(0, 0, 0);
@@ -557,6 +576,8 @@ int main(int argc, char* argv[])
   mapper->SetEightBitComposite(!floatComposite);
   mapper->SetGPUComposite(!hostComposite);
   mapper->SetBlendMode(blend);
+  mapper->SetVolumetricScatteringBlending(scatter[0]);
+  mapper->SetGlobalIlluminationReach(scatter[1]);
   std::printf("composite: %s image upload\n", floatComposite ? "32-bit float" : "8-bit");
   volume->SetMapper(mapper);
   const spaceskip::Tuning baseTuning = spaceskip::cli::tuningFromEnvironment();
@@ -582,6 +603,7 @@ int main(int argc, char* argv[])
       tuning.sampleBatch = it.batch;
     }
     mapper->SetTuning(tuning);
+    mapper->SetVolumetricScatteringBlending(it.noScatter ? 0.f : scatter[0]);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
@@ -724,6 +746,8 @@ int main(int argc, char* argv[])
     gpu->AutoAdjustSampleDistancesOff();
     gpu->SetSampleDistance(0.5);
     gpu->SetBlendMode(blend);
+    gpu->SetVolumetricScatteringBlending(scatter[0]);
+    gpu->SetGlobalIlluminationReach(scatter[1]);
     volume->SetMapper(gpu);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
