@@ -11,7 +11,7 @@ from ssptest import DIMS
 ssptest.load_plugin()
 ok = ssptest.Checker()
 reader = ssptest.open_data()
-view = ssptest.make_view(size=(200, 200))
+view = ssptest.make_view(size=(180, 180))
 # A float copy (llvmpipe filters the stock Volume's 8-bit texture in whole 1/255 steps, which
 # quantises its gradients: see test_stock_slice_lights.py).
 as_float = Calculator(Input=reader, AttributeType="Point Data", ResultArrayName=ssptest.ARRAY,
@@ -43,26 +43,26 @@ disp.VolumetricScatteringBlending = 0.6
 disp.GlobalIlluminationReach = 0.5
 half = both("blend0.6-reach0.5")
 changes("Volumetric Scattering Blending 0.6", off, half)
+# Pure scattering, shadow rays across the whole volume, forward scattering (the anisotropy alone
+# is checked against vtkGPUVolumeRayCastMapper in TestSpaceSkippingVolumeScatteringVsGPU).
 disp.VolumetricScatteringBlending = 2.0
 disp.GlobalIlluminationReach = 1.0
-full = both("blend2-reach1")
-changes("Volumetric Scattering Blending 2, reach 1", half, full, max_psnr=35.0)
 disp.VolumeAnisotropy = 0.6
-forward = both("blend2-reach1-g0.6")
-changes("Volume Anisotropy 0.6", full, forward, max_psnr=40.0)
+full = both("blend2-reach1-g0.6")
+changes("Volumetric Scattering Blending 2, reach 1, Volume Anisotropy 0.6", half, full)
 disp.VolumeAnisotropy = 0.0
 log = warnings.stop()
 ok.check("scatter" not in log.lower(), "no scattering warning while it is drawn (%s)"
          % (log.strip()[:160] or "none"))
 
-# The skipping builders keep Naive's image with scattering on (their shadow rays skip empty
+# A skipping builder keeps Naive's image with scattering on (their shadow rays skip empty
 # bricks; every builder against Naive: Scattering.EveryBuilderEqualsNaive in Core's tests). A
 # shorter reach here: the CPU backend casts five shadow rays (the light kit's) per sample.
 disp.SetRepresentationType("Space Skipping Volume")
 disp.VolumetricScatteringBlending = 1.5
 disp.GlobalIlluminationReach = 0.3
 ref = ssptest.read_png(ssptest.render_to(view, "scattering_builder_Naive.png"))
-for b in ["Grid", "KdTreeCPU"]:
+for b in ["Grid"]:
     disp.Builder = b
     img = ssptest.read_png(ssptest.render_to(view, "scattering_builder_%s.png" % b))
     p = ssptest.psnr(ref, img)
