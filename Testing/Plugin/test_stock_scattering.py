@@ -6,27 +6,12 @@ agree (PSNR >= 40 dB) with it off and at several settings, and every builder kee
 with it on (shadow rays skip empty space losslessly)."""
 from paraview.simple import *
 import ssptest
-from ssptest import DIMS
 
 ssptest.load_plugin()
 ok = ssptest.Checker()
-reader = ssptest.open_data()
 view = ssptest.make_view(size=(180, 180))
-# A float copy (llvmpipe filters the stock Volume's 8-bit texture in whole 1/255 steps, which
-# quantises its gradients: see test_stock_slice_lights.py).
-as_float = Calculator(Input=reader, AttributeType="Point Data", ResultArrayName=ssptest.ARRAY,
-                      Function="%s*1.0" % ssptest.ARRAY, ResultArrayType="Float")
-disp = ssptest.show_space_skipping(as_float, view, builder="Naive", backend="CPU")
-ssptest.set_camera(view)
-ssptest.set_transfer_functions(opacity_points=[0.0, 0.0, 0.5, 0.0, 40.0, 0.0, 0.5, 0.0,
-                                               255.0, 0.3, 0.5, 0.0])
-disp.ScalarOpacityUnitDistance = 1.0
-# The shadow rays step as the primary rays: the same sample distance as ParaView's Volume
-# (locked to the input spacing: half the mean spacing, scaled down below 100 voxels per axis).
-n = ((DIMS[0] - 1) * (DIMS[1] - 1) * (DIMS[2] - 1)) ** 0.333
-stock_distance = 0.5 * (0.01 + 0.99 * n / 100.0) if n < 100 else 0.5
-disp.SampleDistance = stock_distance
-disp.BlendMode = "Composite"
+# The shadow rays step as the primary rays: both at ParaView's Volume's sample distance.
+disp = ssptest.show_float_shell_vs_stock(view, 0.3)
 disp.Shade = 1
 disp.Ambient = 0.2
 disp.Diffuse = 0.7

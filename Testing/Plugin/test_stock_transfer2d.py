@@ -6,30 +6,15 @@ off and on, for ParaView's default 10x10 function image and a finer one; every b
 Naive's image with it on."""
 from paraview.simple import *
 import ssptest
-from ssptest import DIMS
 
 ssptest.load_plugin()
 ok = ssptest.Checker()
-reader = ssptest.open_data()
 view = ssptest.make_view(size=(240, 240))
-# A float copy (llvmpipe filters the stock Volume's 8-bit texture in whole 1/255 steps, which
-# quantises its gradient magnitudes: see test_stock_slice_lights.py).
-as_float = Calculator(Input=reader, AttributeType="Point Data", ResultArrayName=ssptest.ARRAY,
-                      Function="%s*1.0" % ssptest.ARRAY, ResultArrayType="Float")
-disp = ssptest.show_space_skipping(as_float, view, builder="Naive", backend="CPU")
-ssptest.set_camera(view)
-ssptest.set_transfer_functions(opacity_points=[0.0, 0.0, 0.5, 0.0, 40.0, 0.0, 0.5, 0.0,
-                                               255.0, 0.5, 0.5, 0.0])
-disp.ScalarOpacityUnitDistance = 1.0
 # A 2-D function's opacity is per sample (VTK corrects it not for the sample distance), so the
-# image depends on the sample distance itself: ParaView's Volume locks it to the input spacing
-# (vtkVolumeMapper::SpacingAdjustedSampleDistance: half the mean spacing, scaled down below 100
-# voxels per axis), ours defaults to half the smallest spacing. The same distance for both:
-n = ((DIMS[0] - 1) * (DIMS[1] - 1) * (DIMS[2] - 1)) ** 0.333
-stock_distance = 0.5 * (0.01 + 0.99 * n / 100.0) if n < 100 else 0.5
-disp.SampleDistance = stock_distance
+# image depends on the sample distance itself: both at ParaView's Volume's (stock_sample_distance).
+disp = ssptest.show_float_shell_vs_stock(view, 0.5)
+stock_distance = ssptest.stock_sample_distance()
 disp.Shade = 0
-disp.BlendMode = "Composite"
 
 tf2d = GetTransferFunction2D(ssptest.ARRAY)
 disp.TransferFunction2D = tf2d

@@ -15,17 +15,10 @@ constexpr double kMinPSNR = 40.0;
 int TestSpaceSkippingVolumeScatteringVsGPU(int argc, char* argv[])
 {
   sstest::VsGPUScene vs;
-  const double lo = vs.Lo, hi = vs.Hi;
-  vtkGPUVolumeRayCastMapper* gpu = vs.Gpu;
-  vtkSpaceSkippingVolumeMapper* ours = vs.Ours;
-  sstest::Scene& scene = vs.Stage;
-  vtkVolumeProperty* prop = scene.Property;
-  vtkVolume* volume = scene.Volume;
-  vtkRenderer* ren = scene.Renderer;
-  vtkRenderWindow* win = scene.Window;
-  const std::string dir = sstest::TempDir(argc, argv);
-
-  sstest::SetupProperty(prop, lo, hi, 0.6);
+  vtkVolumeProperty* prop = vs.Stage.Property;
+  vtkRenderer* ren = vs.Stage.Renderer;
+  vtkRenderWindow* win = vs.Stage.Window;
+  sstest::SetupProperty(prop, vs.Lo, vs.Hi, 0.6);
   prop->SetInterpolationTypeToLinear();
   prop->SetScalarOpacityUnitDistance(1.0);
   prop->ShadeOn();
@@ -57,19 +50,19 @@ int TestSpaceSkippingVolumeScatteringVsGPU(int argc, char* argv[])
       kit->AddLightsToRenderer(ren);
       kitOn = true;
     }
-    gpu->SetVolumetricScatteringBlending(c.blending);
-    gpu->SetGlobalIlluminationReach(c.reach);
-    ours->SetVolumetricScatteringBlending(c.blending);
-    ours->SetGlobalIlluminationReach(c.reach);
+    vs.Gpu->SetVolumetricScatteringBlending(c.blending);
+    vs.Gpu->SetGlobalIlluminationReach(c.reach);
+    vs.Ours->SetVolumetricScatteringBlending(c.blending);
+    vs.Ours->SetGlobalIlluminationReach(c.reach);
     prop->SetScatteringAnisotropy(c.anisotropy);
     ren->ResetCameraClippingRange();
-    volume->SetMapper(gpu);
+    vs.Stage.Volume->SetMapper(vs.Gpu);
     win->Render();
     auto a = sstest::Capture(win);
-    volume->SetMapper(ours);
+    vs.Stage.Volume->SetMapper(vs.Ours);
     win->Render();
     auto b = sstest::Capture(win);
-    vs.Judge(dir, "TestSpaceSkippingVolumeScatteringVsGPU", c.name, a, b, kMinPSNR);
+    vs.Judge(sstest::TempDir(argc, argv), "TestSpaceSkippingVolumeScatteringVsGPU", c.name, a, b, kMinPSNR);
     if (c.blending == 0.f)
     {
       shadedGpu = a;
