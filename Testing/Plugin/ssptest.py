@@ -113,6 +113,17 @@ def show_float_shell_vs_stock(view, opacity_top):
     return disp
 
 
+def builders_keep_naive(view, disp, ok, ref, builders, what, prefix):
+    """Each of `builders` draws `ref` (Naive's image) within 50 dB; the display is left on Naive."""
+    for b in builders:
+        disp.Builder = b
+        img = read_png(render_to(view, "%s_builder_%s.png" % (prefix, b)))
+        p = psnr(ref, img)
+        print("builder %s vs Naive: PSNR %.2f dB" % (b, p))
+        ok.check(p >= 50.0, "builder %s keeps Naive's %s image (PSNR %.2f >= 50 dB)" % (b, what, p))
+    disp.Builder = "Naive"
+
+
 def stock_sample_distance():
     """The sample distance ParaView's Volume uses for the bundled data (see show_float_shell_vs_stock)."""
     n = ((DIMS[0] - 1) * (DIMS[1] - 1) * (DIMS[2] - 1)) ** 0.333

@@ -90,11 +90,6 @@ disp.UseGradientForTransfer2D = 1
 # Every builder keeps Naive's image with the 2-D function on (skipping stays lossless).
 disp.SetRepresentationType("Space Skipping Volume")
 ref = fine[0]
-for b in ["Grid", "DistanceGrid", "LBVHCPU", "KdTreeCPU", "Hybrid"]:
-    disp.Builder = b
-    img = ssptest.read_png(ssptest.render_to(view, "transfer2d_builder_%s.png" % b))
-    p = ssptest.psnr(ref, img)
-    print("builder %s vs Naive: PSNR %.2f dB" % (b, p))
-    ok.check(p >= 50.0, "builder %s keeps Naive's 2-D image (PSNR %.2f >= 50 dB)" % (b, p))
-disp.Builder = "Naive"
+ssptest.builders_keep_naive(view, disp, ok, ref, ["Grid", "DistanceGrid", "LBVHCPU", "KdTreeCPU", "Hybrid"],
+                            "2-D", "transfer2d")
 ok.done()
