@@ -24,6 +24,7 @@
 #include "vtkVolume.h"
 #include "vtkVolumeMapper.h"
 #include "vtkVariant.h"
+#include "vtkVersionMacros.h"
 #include "vtkVolumeProperty.h"
 
 #include "spaceskip/Engine.h"
@@ -385,6 +386,13 @@ void vtkSpaceSkipPropertyTranslator::SetBlendAndShading(spaceskip::RenderParams&
   rp.scatteringBlending = s.VolumetricScatteringBlending;
   rp.globalIlluminationReach = s.GlobalIlluminationReach;
   rp.scatteringAnisotropy = prop->GetScatteringAnisotropy();
+  // Four dependent components are lit by the gradient of component 0 in VTK 9.2 and 9.3's
+  // vtkGPUVolumeRayCastMapper, of component 3 from VTK 9.4 on: the same as the VTK at hand.
+#if VTK_VERSION_NUMBER >= VTK_VERSION_CHECK(9, 4, 0)
+  rp.rgbaLightingComponent = 3;
+#else
+  rp.rgbaLightingComponent = 0;
+#endif
   if (!rp.shade)
   {
     return;

@@ -17,12 +17,18 @@ namespace {
 /// frame finished on the device (the image left in device memory, as the mapper's interop path
 /// does; on the CPU backend the frame is the host's), with one untimed frame after each. The
 /// edits alternate between zeroing the opacity below `cut` of the table (bricks empty) and the
-/// TF as it was (bricks occupied again).
+/// TF as it was (bricks occupied again); with a 2-D transfer function (--tf2d) the same share of
+/// its columns as well.
 void measureEdits(Engine& engine, const TransferFunction& tf, const Camera& cam, int w, int h, int edits, double cut,
                   BenchRow& row) {
   TransferFunction cutTF = tf;
   const size_t below = size_t(std::clamp(cut, 0.0, 1.0) * double(cutTF.table.size()));
   for (size_t i = 0; i < below && i < cutTF.table.size(); ++i) cutTF.table[i].w = 0.f;
+  if (cutTF.uses2D()) {  // a 2-D table: the same share of its columns, at every gradient magnitude
+    const size_t cols = size_t(std::clamp(cut, 0.0, 1.0) * double(cutTF.width2D));
+    for (int r = 0; r < cutTF.height2D; ++r)
+      for (size_t c = 0; c < cols; ++c) cutTF.table2D[size_t(r) * size_t(cutTF.width2D) + c].w = 0.f;
+  }
   const bool onDevice = engine.setImageOnDevice(true);
   Image img;
   engine.render(cam, w, h, img);

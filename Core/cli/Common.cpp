@@ -42,8 +42,27 @@ TransferFunction makeTF(const Options& o, const Volume& v) {
   std::string t = o.get("--tf", "ramp");
   // A preset name unless a file of that name exists (loadTransferFunction refuses devices).
   std::error_code ec;
-  if (std::filesystem::exists(t, ec)) return loadTransferFunction(t, lo, hi);
-  return TransferFunction::preset(t, lo, hi);
+  TransferFunction tf =
+      std::filesystem::exists(t, ec) ? loadTransferFunction(t, lo, hi) : TransferFunction::preset(t, lo, hi);
+  if (o.has("--tf2d")) {
+    // A boundary-emphasising 2-D transfer function (value x gradient magnitude): each column the
+    // 1-D table's colour, its opacity times a ramp over the normalised gradient magnitude, 0 at
+    // g = 0 up to 1 from g = 1/2; 256 columns, ROWS rows.
+    const int rows = int(o.getInt("--tf2d", 64, 2, 4096));
+    const int cols = 256;
+    tf.width2D = cols;
+    tf.height2D = rows;
+    tf.table2D.assign(size_t(cols) * size_t(rows), vec4f{0, 0, 0, 0});
+    const size_t n = tf.table.size();
+    for (int c = 0; c < cols; ++c) {
+      const vec4f e = tf.table[std::min(n - 1, size_t((double(c) + 0.5) / cols * double(n)))];
+      for (int r = 0; r < rows; ++r) {
+        const float g = (float(r) + 0.5f) / float(rows);
+        tf.table2D[size_t(r) * cols + size_t(c)] = vec4f{e.x, e.y, e.z, e.w * std::min(1.f, 2.f * g)};
+      }
+    }
+  }
+  return tf;
 }
 
 Camera makeCamera(const Options& o, const Volume& v, int w, int h, double azDefault, double elDefault) {

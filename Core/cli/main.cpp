@@ -81,6 +81,9 @@ options:
   --cuda-block WxH   CUDA launch shape: threads per block (32..256; default 16x8; also
                      SPACESKIP_CUDA_BLOCK; the other SPACESKIP_* knobs: docs/tuning.md)
   --tf PRESET|FILE   presets: ramp grayscale coolwarm band spike opaque zero
+  --tf2d ROWS        a 2-D transfer function (value x gradient magnitude, as VTK's TF_2D): the
+                     --tf table's colours, its opacity times a ramp over the gradient magnitude
+                     (0 at none, 1 from half the largest); 256 columns x ROWS rows
   --size WxH         (render default 512x512, bench default 1024x1024)
   --max-image-bytes N[K|M|G|T]  largest image (16 bytes a pixel; default 1G: 8192x8192)
   --camera AZ,EL[,ZOOM]  orbit angles in degrees  --perspective

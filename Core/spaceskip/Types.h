@@ -150,6 +150,10 @@ struct RenderParams {
   double scatteringBlending = 0;       ///< VolumetricScatteringBlending in [0, 2]; 0: off
   double globalIlluminationReach = 0;  ///< GlobalIlluminationReach in [0, 1]: the shadow rays' length
   double scatteringAnisotropy = 0;     ///< vtkVolumeProperty's ScatteringAnisotropy in [-1, 1]
+  /// Shading of four dependent components (RGBA): the component whose gradient lights a sample.
+  /// vtkGPUVolumeRayCastMapper uses component 0 up to VTK 9.3 (ParaView 5.11's VTK 9.2) and
+  /// component 3, the opacity, from VTK 9.4 on; two dependent components use component 0 in both.
+  int rgbaLightingComponent = 0;
 
   // Slice blend mode: the plane through sliceOrigin with normal sliceNormal, in the volume's
   // world frame (as vtkPlane's origin and normal; a zero or non-finite normal: the plane through

@@ -883,10 +883,11 @@ void fillComponents(Impl& d, FrameView& f) {
     f.rgbScale[c] = hi > lo ? float(1.0 / (hi - lo)) : 0.f;
   }
   // VTK 9.2's vtkVolumeShaderComposer lights both modes with component 0's gradient
-  // (computeLighting(color, 0)); later VTK uses component 3 for 4 components. Measured against
-  // ParaView 5.11's vtkGPUVolumeRayCastMapper on TestSpaceSkippingVolumeRGBA shaded: 59.9 dB
-  // with component 0, 25.7 dB with component 3.
-  f.gradientComponent = 0;
+  // (computeLighting(color, 0)); VTK 9.4 and later light 4 components by component 3's
+  // (RenderParams::rgbaLightingComponent, set by the VTK mapper for the VTK it is built with).
+  // Measured against ParaView 5.11's vtkGPUVolumeRayCastMapper on TestSpaceSkippingVolumeRGBA
+  // shaded: 59.9 dB with component 0, 25.7 dB with component 3.
+  f.gradientComponent = v.components == 4 ? std::clamp(d.render.rgbaLightingComponent, 0, 3) : 0;
   if (v.components > 1 && d.render.filter == FilterMode::Hardware)
     d.warn("hardware filtering with dependent components: sampling exactly");
 }

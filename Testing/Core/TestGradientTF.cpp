@@ -139,7 +139,7 @@ TEST(GradientTF, ZeroGradientOpacityEmptiesEverything) {
   EXPECT_GT(test::coverage(img), 0.1);
 }
 
-TEST(GradientTF, CudaBuildersEqualCpuNaive) {
+TEST(GradientTF, CudaBuildersEqualNaive) {
   SKIP_WITHOUT_CUDA();
   for (const char* shape : {"vessels", "nbody"}) {
     Volume v = generateVolume(shape, vec3l{64, 61, 67});
@@ -147,8 +147,8 @@ TEST(GradientTF, CudaBuildersEqualCpuNaive) {
     const auto [tf, tf2, go] = gradientCases(v);
     RenderParams rp, shaded;
     shaded.shade = true;
-    test::expectCudaBuildersEqualCpuNaive(v, tf2, rp, std::string(shape) + " 2-D");
-    test::expectCudaBuildersEqualCpuNaive(v, tf2, shaded, std::string(shape) + " 2-D shaded");
-    test::expectCudaBuildersEqualCpuNaive(v, go, rp, std::string(shape) + " gradient opacity");
+    test::expectCudaBuildersEqualNaive(v, tf2, rp, std::string(shape) + " 2-D");
+    test::expectCudaBuildersEqualNaive(v, tf2, shaded, std::string(shape) + " 2-D shaded");
+    test::expectCudaBuildersEqualNaive(v, go, rp, std::string(shape) + " gradient opacity");
   }
 }

@@ -194,7 +194,7 @@ TEST(Scattering, ExtremesStayFinite) {
   }
 }
 
-TEST(Scattering, CudaBuildersEqualCpuNaive) {
+TEST(Scattering, CudaBuildersEqualNaive) {
   SKIP_WITHOUT_CUDA();
   for (const char* shape : {"nbody", "vessels"}) {
     Volume v = generateVolume(shape, vec3l{64, 61, 67});
@@ -202,7 +202,7 @@ TEST(Scattering, CudaBuildersEqualCpuNaive) {
     const TransferFunction tf = rampOf(v);
     RenderParams head = scattering(1.5, 1.0, 0.5), kit = scattering(2.0, 0.6, -0.3);
     addLights(kit);
-    test::expectCudaBuildersEqualCpuNaive(v, tf, head, std::string(shape) + " headlight");
-    test::expectCudaBuildersEqualCpuNaive(v, tf, kit, std::string(shape) + " lights");
+    test::expectCudaBuildersEqualNaive(v, tf, head, std::string(shape) + " headlight");
+    test::expectCudaBuildersEqualNaive(v, tf, kit, std::string(shape) + " lights");
   }
 }

@@ -253,7 +253,7 @@ TEST(Slice, CudaEqualsCpu) {
   for (const Mode& m : sliceAndLightModes(v)) {
     const TransferFunction tf = m.rp.blend == BlendMode::Slice ? sliceTF(lo, hi)
                                                                : TransferFunction::preset("ramp", lo, hi, 256);
-    test::expectCudaBuildersEqualCpuNaive(v, tf, m.rp, m.name);
+    test::expectCudaBuildersEqualNaive(v, tf, m.rp, m.name);
   }
 }
 

@@ -56,7 +56,7 @@ struct ArraySampler {
     f = x - float(i0);
     i1 = n > 1 ? i0 + 1 : 0;
   }
-  SS_FUNC float sample(vec3f p) const {
+  SS_FORCE_FUNC float sample(vec3f p) const {
     int64_t x0, x1, y0, y1, z0, z1;
     float fx, fy, fz;
     axis(p.x, nx, x0, x1, fx);

@@ -97,7 +97,6 @@ SS_FUNC float shadowTransmittance(const FrameView& f, const Sampler& s, vec3f p,
         run(a, b);
         if (done) return T;
       }
-      if (next < sampleIndexCeil(tGrid / L)) next = sampleIndexCeil(tGrid / L);
     }
   }
   // The rest: every sample (no grid, or the half voxel between the voxels and the texture box,
