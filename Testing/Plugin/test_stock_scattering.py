@@ -9,7 +9,7 @@ import ssptest
 
 ssptest.load_plugin()
 ok = ssptest.Checker()
-view = ssptest.make_view(size=(180, 180))
+view = ssptest.make_view(size=(140, 140))
 # The shadow rays step as the primary rays: both at ParaView's Volume's sample distance.
 disp = ssptest.show_float_shell_vs_stock(view, 0.3)
 disp.Shade = 1

@@ -34,11 +34,11 @@ int TestSpaceSkippingVolumeScatteringVsGPU(int argc, char* argv[])
     bool lightKit;
   };
   // The default headlight (a point light at the camera for VTK's shadow rays), then ParaView's
-  // light kit (five directional lights, five shadow rays per sample).
+  // light kit (five directional lights, five shadow rays per sample: one scattering case there,
+  // as the CPU backend's shadow rays are scalar code; with two the test took 141 s in CI).
   const Case cases[] = { { "shade", 0.f, 0.f, 0.f, false }, { "blend0.5-reach0.6", 0.5f, 0.6f, 0.f, false },
     { "blend1.5-reach1-g0.6", 1.5f, 1.f, 0.6f, false }, { "blend2-reach0.3", 2.f, 0.3f, 0.f, false },
-    { "kit-shade", 0.f, 0.f, 0.f, true }, { "kit-blend1-reach0.7-g0.4", 1.f, 0.7f, 0.4f, true },
-    { "kit-blend2-reach1-g-0.5", 2.f, 1.f, -0.5f, true } };
+    { "kit-shade", 0.f, 0.f, 0.f, true }, { "kit-blend1.5-reach0.5-g-0.5", 1.5f, 0.5f, -0.5f, true } };
   vtkSmartPointer<vtkImageData> shadedGpu, shadedOurs;
   vtkNew<vtkLightKit> kit;
   bool kitOn = false;
