@@ -8,7 +8,7 @@
 # same TF, camera, size and sample distance (and SS_OPTS); the first view of each, VisRTX's and
 # ours, compared (PSNR) with a reference: SpaceSkip's Naive at a quarter of the sample distance. Writes OUT/visrtx.csv, OUT/summary.md,
 # OUT/*.png, OUT/*.log.
-# env: TF (ramp), SIZE (1024x1024), FRAMES (8), EDITS (20), SD (sample distance; default
+# env: LIBRARY (visrtx; helide: ANARI's CPU device, a smoke test without a GPU), TF (ramp), SIZE (1024x1024), FRAMES (8), EDITS (20), SD (sample distance; default
 # half a voxel, both sides), ACCUM (0: extra frames at the first view before saving),
 # SS_OPTS (extra spaceskip options, default "--ert 0.99"; e.g. add "--filter hardware")
 set -uo pipefail
@@ -50,32 +50,22 @@ for vol in "$@"; do
   name=$(basename "$raw" .raw)
   log=$out/$name.log
   : > "$log"
+  # logged LIMIT TITLE COMMAND...: the command and its output and exit status in the log.
+  logged() { local limit=$1 title=$2; shift 2; echo "== $title$*" >> "$log"; timeout "$limit" "$@" >> "$log" 2>&1; echo "rc=$?" >> "$log"; }
   for s in default fast; do
-    cmd="$ab $raw --settings $s --tf $tf --size $size --frames $frames --edits $edits $sdv"
-    cmd+=" --accumulate $accum -o $out/$name-visrtx-$s.png --csv $out/visrtx.csv"
-    echo "== $cmd" >> "$log"
-    timeout 600 $cmd >> "$log" 2>&1
-    echo "rc=$?" >> "$log"
+    logged 600 "" $ab $raw --library ${LIBRARY:-visrtx} --settings $s --tf $tf --size $size --frames $frames --edits $edits $sdv \
+      --accumulate $accum -o $out/$name-visrtx-$s.png --csv $out/visrtx.csv
   done
   if [ -n "$ss" ]; then
     common="--backend cuda --tf $tf --size $size $sdv ${SS_OPTS---ert 0.99}"
-    cmd="$ss bench $raw --builders naive,auto --frames $frames --edits $edits $common"
-    echo "== $cmd" >> "$log"
-    timeout 900 $cmd >> "$log" 2>&1
-    echo "rc=$?" >> "$log"
-    cmd="$ss render $raw --camera 0,15 $common -o $out/$name-spaceskip.png"
-    echo "== $cmd" >> "$log"
-    timeout 600 $cmd >> "$log" 2>&1
-    echo "rc=$?" >> "$log"
+    logged 900 "" $ss bench $raw --builders naive,auto --frames $frames --edits $edits $common
+    logged 600 "" $ss render $raw --camera 0,15 $common -o $out/$name-spaceskip.png
     # Quality at the first view: each image against a reference drawn by SpaceSkip's Naive with
     # exact trilinear sampling at a quarter of the sample distance and no early termination.
     refsd=$(awk -v d="${SD:-0.5}" 'BEGIN {print d / 4}')
     for img in visrtx-default visrtx-fast spaceskip; do
-      cmd="$ss render $raw --camera 0,15 --backend cuda --builder naive --tf $tf --size $size --sample-distance $refsd"
-      cmd+=" -o $out/$name-reference.png --compare $out/$name-$img.png"
-      echo "== reference vs $img: $cmd" >> "$log"
-      timeout 600 $cmd >> "$log" 2>&1
-      echo "rc=$?" >> "$log"
+      logged 600 "reference vs $img: " $ss render $raw --camera 0,15 --backend cuda --builder naive --tf $tf \
+        --size $size --sample-distance $refsd -o $out/$name-reference.png --compare $out/$name-$img.png
     done
   fi
   { echo; echo "## $name"; echo '```'; grep -v '^\[anari PERF' "$log"; echo '```'; } >> "$summary"
