@@ -199,6 +199,24 @@ TEST(Components, BuildersEqualNaiveFourComponents) {
   expectBuildersEqualNaive(fourComponents<uint16_t>(VoxelType::UInt16), BackendKind::CPU);
 }
 
+// RenderParams::rgbaLightingComponent (VTK >= 9.4 lights RGBA by component 3's gradient, 9.2 by
+// component 0's): the two light the blobs differently, and skipping stays lossless with either.
+TEST(Components, RgbaLightingComponentPicksTheGradient) {
+  const Volume v = fourComponents<uint8_t>(VoxelType::UInt8);
+  RenderParams c0 = shaded(), c3 = shaded();
+  c3.rgbaLightingComponent = 3;
+  const Image naive0 = test::renderWith(v, dependentTF(), test::builder(BuilderKind::Naive), 30, 20, false, 80,
+                                        BackendKind::CPU, c0);
+  const Image naive3 = test::renderWith(v, dependentTF(), test::builder(BuilderKind::Naive), 30, 20, false, 80,
+                                        BackendKind::CPU, c3);
+  ASSERT_GT(test::coverage(naive3), 0.01);
+  EXPECT_GT(maxDiff(naive0, naive3), 20.f / 255.f) << "component 3's gradient lights the blobs otherwise";
+  for (const BuildParams& p : test::skippingBuilders()) {
+    const Image img = test::renderWith(v, dependentTF(), p, 30, 20, false, 80, BackendKind::CPU, c3);
+    EXPECT_LE(maxDiff(img, naive3), kTol) << builderName(p.builder);
+  }
+}
+
 // Blend modes other than composite have no dependent-component rule in VTK: one warning, then
 // the composite image.
 TEST(Components, OtherBlendModesWarnAndComposite) {
@@ -227,7 +245,9 @@ TEST(ComponentsCuda, BuildersEqualNaiveAndCpu) {
   SKIP_WITHOUT_CUDA();
   for (const Volume& v : {twoComponents<uint8_t>(VoxelType::UInt8), fourComponents<float>(VoxelType::Float32)}) {
     expectBuildersEqualNaive(v, BackendKind::CUDA);
-    for (const RenderParams& rp : {RenderParams{}, shaded()}) {
+    RenderParams shaded3 = shaded();
+    shaded3.rgbaLightingComponent = 3;
+    for (const RenderParams& rp : {RenderParams{}, shaded(), shaded3}) {
       const Image cpu = test::renderWith(v, dependentTF(), test::builder(BuilderKind::Grid), 30, 20, true, 80,
                                          BackendKind::CPU, rp);
       for (BuilderKind k : {BuilderKind::LBVH, BuilderKind::KdTreeGPUFast, BuilderKind::KdTreeGPU}) {
