@@ -22,10 +22,11 @@ namespace {
 void measureEdits(Engine& engine, const TransferFunction& tf, const Camera& cam, int w, int h, int edits, double cut,
                   BenchRow& row) {
   TransferFunction cutTF = tf;
-  const size_t below = size_t(std::clamp(cut, 0.0, 1.0) * double(cutTF.table.size()));
+  const double share = std::clamp(cut, 0.0, 1.0);
+  const size_t below = size_t(share * double(cutTF.table.size()));
   for (size_t i = 0; i < below && i < cutTF.table.size(); ++i) cutTF.table[i].w = 0.f;
   if (cutTF.uses2D()) {  // a 2-D table: the same share of its columns, at every gradient magnitude
-    const size_t cols = size_t(std::clamp(cut, 0.0, 1.0) * double(cutTF.width2D));
+    const size_t cols = size_t(share * double(cutTF.width2D));
     for (int r = 0; r < cutTF.height2D; ++r)
       for (size_t c = 0; c < cols; ++c) cutTF.table2D[size_t(r) * size_t(cutTF.width2D) + c].w = 0.f;
   }

@@ -12,6 +12,8 @@
 
 #include "spaceskip/TransferFunction.h"
 #include "spaceskip/TransferFunctionIO.h"
+#include "spaceskip/ImageIO.h"
+#include "spaceskip/VolumeIO.h"
 
 #include <algorithm>
 #include <chrono>
@@ -36,8 +38,8 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 const char *kUsage = R"(usage: anari_bench VOLUME.raw [options]
        anari_bench --list [--library NAME]
 
-VOLUME is named the Open SciVis way: NAME_XxYxZ_TYPE.raw, TYPE one of uint8,
-int8, uint16, int16, float32, float64 (float64 is converted to float32).
+VOLUME: NAME_XxYxZ_TYPE.raw (TYPE uint8, int8, uint16, int16, float32, float64) or
+a .nrrd, read by SpaceSkip's own loader (float64 is converted to float32).
 
   --library NAME        ANARI library: visrtx (default), helide (CPU), sink
   --device NAME         device subtype (default "default")
@@ -148,107 +150,39 @@ std::vector<double> nums(const std::string &s, char sep, size_t n, const std::st
   return r;
 }
 
-// ---- volume ---------------------------------------------------------------
+// ---- volume: read by SpaceSkip's own loader (Core/tools/VolumeIO.cpp, compiled in) ------------
 
-struct Volume
+// A SpaceSkip volume as ANARI takes it: fixed-point voxels are read normalised (value / norm);
+// float64 is converted to float32 (VisRTX samples no doubles).
+struct AnariVolume
 {
-  uint64_t dims[3] = {0, 0, 0};
-  std::string type;
-  ANARIDataType anariType = ANARI_UNKNOWN;
-  double norm = 1; // the device reads fixed-point voxels as value / norm
-  std::vector<uint8_t> bytes;
+  spaceskip::Volume v;
+  ANARIDataType type = ANARI_UNKNOWN;
+  double norm = 1;
+  std::vector<float> asFloat; // float64 volumes only
+  const void *data() const { return asFloat.empty() ? v.data : asFloat.data(); }
 };
 
-Volume loadRaw(const std::string &path)
+AnariVolume loadForAnari(const std::string &path)
 {
-  const std::string base = path.substr(path.find_last_of('/') + 1);
-  const size_t dot = base.rfind(".raw");
-  const size_t u2 = base.rfind('_', dot);
-  const size_t u1 = u2 == std::string::npos ? u2 : base.rfind('_', u2 - 1);
-  if (dot == std::string::npos || u1 == std::string::npos)
-    fail(path + ": name must be NAME_XxYxZ_TYPE.raw");
-  Volume v;
-  v.type = base.substr(u2 + 1, dot - u2 - 1);
-  const auto d = nums(base.substr(u1 + 1, u2 - u1 - 1), 'x', 3, path + " dims");
-  for (int i = 0; i < 3; ++i) {
-    if (d[i] < 1 || d[i] != std::floor(d[i]))
-      fail(path + ": bad dims");
-    v.dims[i] = uint64_t(d[i]);
-  }
-  size_t vs = 0;
-  if (v.type == "uint8")
-    vs = 1, v.anariType = ANARI_UFIXED8, v.norm = 255;
-  else if (v.type == "int8")
-    vs = 1, v.anariType = ANARI_FIXED8, v.norm = 127;
-  else if (v.type == "uint16")
-    vs = 2, v.anariType = ANARI_UFIXED16, v.norm = 65535;
-  else if (v.type == "int16")
-    vs = 2, v.anariType = ANARI_FIXED16, v.norm = 32767;
-  else if (v.type == "float32" || v.type == "float64")
-    vs = v.type == "float32" ? 4 : 8, v.anariType = ANARI_FLOAT32, v.norm = 1;
-  else
-    fail(path + ": unknown voxel type '" + v.type + "'");
-  const uint64_t n = v.dims[0] * v.dims[1] * v.dims[2];
-  std::FILE *f = std::fopen(path.c_str(), "rb");
-  if (!f)
-    fail(path + ": cannot open");
-  std::fseek(f, 0, SEEK_END);
-  const long long fileBytes = std::ftell(f);
-  std::fseek(f, 0, SEEK_SET);
-  if (fileBytes < 0 || uint64_t(fileBytes) != n * vs)
-    fail(path + ": " + std::to_string(fileBytes) + " bytes, the name says "
-        + std::to_string(n * vs));
-  v.bytes.resize(n * vs);
-  size_t got = 0;
-  while (got < v.bytes.size()) {
-    const size_t r = std::fread(v.bytes.data() + got, 1, std::min<size_t>(v.bytes.size() - got, size_t(1) << 30), f);
-    if (r == 0)
-      fail(path + ": read error");
-    got += r;
-  }
-  std::fclose(f);
-  if (v.type == "float64") { // in place: float32 i fits before float64 i
-    for (uint64_t i = 0; i < n; ++i) {
-      double x;
-      std::memcpy(&x, v.bytes.data() + 8 * i, 8);
-      const float f = float(x);
-      std::memcpy(v.bytes.data() + 4 * i, &f, 4);
+  AnariVolume a;
+  a.v = spaceskip::loadVolume(path);
+  if (a.v.components != 1)
+    fail(path + ": one component only");
+  switch (a.v.type) {
+    case spaceskip::VoxelType::UInt8: a.type = ANARI_UFIXED8, a.norm = 255; break;
+    case spaceskip::VoxelType::Int8: a.type = ANARI_FIXED8, a.norm = 127; break;
+    case spaceskip::VoxelType::UInt16: a.type = ANARI_UFIXED16, a.norm = 65535; break;
+    case spaceskip::VoxelType::Int16: a.type = ANARI_FIXED16, a.norm = 32767; break;
+    case spaceskip::VoxelType::Float32: a.type = ANARI_FLOAT32; break;
+    case spaceskip::VoxelType::Float64: {
+      a.type = ANARI_FLOAT32;
+      const double *d = static_cast<const double *>(a.v.data);
+      a.asFloat.assign(d, d + a.v.voxelCount());
+      break;
     }
-    v.bytes.resize(n * 4);
-    v.bytes.shrink_to_fit();
   }
-  return v;
-}
-
-// Finite min/max of the voxel values (SpaceSkip's Volume::scalarRange).
-template <class T>
-bool rangeOf(const Volume &v, double &lo, double &hi)
-{
-  const T *p = reinterpret_cast<const T *>(v.bytes.data());
-  const size_t n = v.bytes.size() / sizeof(T);
-  double a = std::numeric_limits<double>::infinity(), b = -a;
-  for (size_t i = 0; i < n; ++i) {
-    const double x = double(p[i]);
-    if (std::isfinite(x))
-      a = std::min(a, x), b = std::max(b, x);
-  }
-  if (!(a <= b))
-    return false;
-  lo = a, hi = b;
-  return true;
-}
-
-bool scalarRange(const Volume &v, double &lo, double &hi)
-{
-  if (v.type == "uint8")
-    return rangeOf<uint8_t>(v, lo, hi);
-  if (v.type == "int8")
-    return rangeOf<int8_t>(v, lo, hi);
-  if (v.type == "uint16")
-    return rangeOf<uint16_t>(v, lo, hi);
-  if (v.type == "int16")
-    return rangeOf<int16_t>(v, lo, hi);
-  return rangeOf<float>(v, lo, hi);
+  return a;
 }
 
 // ---- transfer function: SpaceSkip's own presets and file reader (Core/src/TransferFunction.cpp
@@ -261,85 +195,6 @@ spaceskip::TransferFunction makeTF(const std::string &spec, double lo, double hi
   if (std::filesystem::exists(spec, ec))
     return spaceskip::loadTransferFunction(spec, lo, hi);
   return spaceskip::TransferFunction::preset(spec, lo, hi);
-}
-
-// ---- images ---------------------------------------------------------------
-
-uint32_t crc32(const uint8_t *p, size_t n, uint32_t c = 0)
-{
-  static uint32_t t[256];
-  static bool init = false;
-  if (!init) {
-    for (uint32_t i = 0; i < 256; ++i) {
-      uint32_t k = i;
-      for (int j = 0; j < 8; ++j)
-        k = k & 1 ? 0xEDB88320u ^ (k >> 1) : k >> 1;
-      t[i] = k;
-    }
-    init = true;
-  }
-  c = ~c;
-  for (size_t i = 0; i < n; ++i)
-    c = t[(c ^ p[i]) & 0xFF] ^ (c >> 8);
-  return ~c;
-}
-
-// 8-bit RGBA PNG with stored (uncompressed) deflate blocks: no zlib needed.
-void writePng(const std::string &path, const std::vector<uint8_t> &rgbaTopFirst, int w, int h)
-{
-  std::vector<uint8_t> raw;
-  raw.reserve(size_t(h) * (size_t(w) * 4 + 1));
-  for (int y = 0; y < h; ++y) {
-    raw.push_back(0);
-    raw.insert(raw.end(), rgbaTopFirst.begin() + size_t(y) * w * 4, rgbaTopFirst.begin() + size_t(y + 1) * w * 4);
-  }
-  std::vector<uint8_t> z = {0x78, 0x01};
-  uint32_t a = 1, b = 0;
-  for (uint8_t c : raw)
-    a = (a + c) % 65521, b = (b + a) % 65521;
-  for (size_t off = 0; off < raw.size() || off == 0;) {
-    const size_t n = std::min<size_t>(65535, raw.size() - off);
-    const bool last = off + n == raw.size();
-    z.push_back(last ? 1 : 0);
-    z.push_back(uint8_t(n)), z.push_back(uint8_t(n >> 8));
-    z.push_back(uint8_t(~n)), z.push_back(uint8_t(~n >> 8));
-    z.insert(z.end(), raw.begin() + off, raw.begin() + off + n);
-    off += n;
-    if (last)
-      break;
-  }
-  const uint32_t ad = (b << 16) | a;
-  for (int s = 24; s >= 0; s -= 8)
-    z.push_back(uint8_t(ad >> s));
-  std::vector<uint8_t> out = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
-  auto chunk = [&](const char *type, const std::vector<uint8_t> &data) {
-    const uint32_t n = uint32_t(data.size());
-    for (int s = 24; s >= 0; s -= 8)
-      out.push_back(uint8_t(n >> s));
-    std::vector<uint8_t> td(type, type + 4);
-    td.insert(td.end(), data.begin(), data.end());
-    out.insert(out.end(), td.begin(), td.end());
-    const uint32_t c = crc32(td.data(), td.size());
-    for (int s = 24; s >= 0; s -= 8)
-      out.push_back(uint8_t(c >> s));
-  };
-  std::vector<uint8_t> ihdr;
-  for (uint32_t v : {uint32_t(w), uint32_t(h)})
-    for (int s = 24; s >= 0; s -= 8)
-      ihdr.push_back(uint8_t(v >> s));
-  ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0}); // 8-bit RGBA
-  chunk("IHDR", ihdr);
-  chunk("IDAT", z);
-  chunk("IEND", {});
-  std::ofstream f(path, std::ios::binary);
-  f.write(reinterpret_cast<const char *>(out.data()), std::streamsize(out.size()));
-  if (!f)
-    fail(path + ": cannot write");
-}
-
-uint8_t to8(float v)
-{
-  return uint8_t(std::lround(std::clamp(v, 0.f, 1.f) * 255.f));
 }
 
 // ---- ANARI helpers --------------------------------------------------------
@@ -512,10 +367,10 @@ int main(int argc, char **argv)
   // Volume and transfer function (host side, not timed).
   const std::string volPath = a.pos[0];
   auto t0 = Clock::now();
-  Volume vol = loadRaw(volPath);
+  const AnariVolume vol = loadForAnari(volPath);
   const double loadS = since(t0);
   double lo = 0, hi = 1;
-  if (!scalarRange(vol, lo, hi))
+  if (!vol.v.scalarRange(lo, hi))
     lo = 0, hi = 1;
   if (a.has("--range")) {
     const auto r = nums(a.get("--range"), ',', 2, "--range");
@@ -541,9 +396,9 @@ int main(int argc, char **argv)
   const float valueRange[2] = {float(tf.rangeMin / vol.norm), float(tf.rangeMax / vol.norm)};
 
   // Camera: spaceskip's orbitCamera (Core/src/Camera.cpp), orthographic.
-  const double ext[3] = {double(vol.dims[0] > 1 ? vol.dims[0] - 1 : 1) * spacing[0],
-      double(vol.dims[1] > 1 ? vol.dims[1] - 1 : 1) * spacing[1],
-      double(vol.dims[2] > 1 ? vol.dims[2] - 1 : 1) * spacing[2]};
+  const uint64_t dims[3] = {uint64_t(vol.v.dims.x), uint64_t(vol.v.dims.y), uint64_t(vol.v.dims.z)};
+  const double ext[3] = {double(dims[0] > 1 ? dims[0] - 1 : 1) * spacing[0],
+      double(dims[1] > 1 ? dims[1] - 1 : 1) * spacing[1], double(dims[2] > 1 ? dims[2] - 1 : 1) * spacing[2]};
   const double ctr[3] = {ext[0] / 2, ext[1] / 2, ext[2] / 2};
   double radius = 0.5 * std::sqrt(ext[0] * ext[0] + ext[1] * ext[1] + ext[2] * ext[2]);
   if (!(radius > 0))
@@ -553,8 +408,7 @@ int main(int argc, char **argv)
 
   // Scene: field, volume, world, camera, renderer, frame (timed to the first frame).
   t0 = Clock::now();
-  ANARIArray3D data = anariNewArray3D(x.d, vol.bytes.data(), nullptr, nullptr, vol.anariType,
-      vol.dims[0], vol.dims[1], vol.dims[2]);
+  ANARIArray3D data = anariNewArray3D(x.d, vol.data(), nullptr, nullptr, vol.type, dims[0], dims[1], dims[2]);
   ANARISpatialField field = anariNewSpatialField(x.d, "structuredRegular");
   x.setObj(field, "data", ANARI_ARRAY3D, data);
   const float origin[3] = {0, 0, 0};
@@ -672,18 +526,12 @@ int main(int argc, char **argv)
         fail(a.get("--raw") + ": cannot write");
       std::printf("wrote %s (float32 RGBA %dx%d, premultiplied, bottom row first)\n", a.get("--raw").c_str(), W, H);
     }
-    if (a.has("-o")) {
-      std::vector<uint8_t> png(size_t(W) * H * 4);
-      for (int y = 0; y < H; ++y)
-        for (int xx = 0; xx < W; ++xx) {
-          const float *p = &f[(size_t(y) * W + xx) * 4];
-          uint8_t *o = &png[(size_t(H - 1 - y) * W + xx) * 4];
-          const float al = p[3];
-          for (int c = 0; c < 3; ++c)
-            o[c] = to8(al > 0 ? p[c] / al : 0);
-          o[3] = to8(al);
-        }
-      writePng(a.get("-o"), png, W, H);
+    if (a.has("-o")) { // premultiplied, bottom row first: SpaceSkip's Image, written by its savePng
+      spaceskip::Image img;
+      img.width = W, img.height = H;
+      img.rgba.resize(size_t(W) * H);
+      std::memcpy(img.rgba.data(), f.data(), img.rgba.size() * sizeof(spaceskip::vec4f));
+      spaceskip::savePng(img, a.get("-o"));
       std::printf("wrote %s\n", a.get("-o").c_str());
     }
   };
@@ -741,8 +589,8 @@ int main(int argc, char **argv)
   const std::string volName = volPath.substr(volPath.find_last_of('/') + 1);
   const std::string label = a.get("--label", libName + "/" + rendererName + "/" + settings);
   std::printf("volume %s: %llux%llux%llu %s, load %.3f s, value range [%g, %g], TF %s (%zu entries, unit %g)\n",
-      volName.c_str(), (unsigned long long)vol.dims[0], (unsigned long long)vol.dims[1],
-      (unsigned long long)vol.dims[2], vol.type.c_str(), loadS, tf.rangeMin, tf.rangeMax, tfSpec.c_str(), n, tf.unitDistance);
+      volName.c_str(), (unsigned long long)dims[0], (unsigned long long)dims[1],
+      (unsigned long long)dims[2], spaceskip::voxelTypeName(vol.v.type), loadS, tf.rangeMin, tf.rangeMax, tfSpec.c_str(), n, tf.unitDistance);
   std::printf("%s: renderer \"%s\" (settings %s%s), %dx%d, sample distance %g (volumeSamplingRate %g), "
               "elevation %g, azimuth step %g\n",
       libName.c_str(), rendererName.c_str(), settings.c_str(), extra.c_str(), W, H, sampleDistance, samplingRate,
@@ -763,7 +611,7 @@ int main(int argc, char **argv)
       c << "label,library,renderer,settings,volume,dims,type,width,height,tf,sample_distance,sampling_rate,frames,"
            "load_s,init_s,first_frame_s,fps,fps_device,fps_mapped,edit_ms_median,edit_ms_first,next_ms_median,errors\n";
     c << label << "," << libName << "," << rendererName << "," << settings << "," << volName << ","
-      << vol.dims[0] << "x" << vol.dims[1] << "x" << vol.dims[2] << "," << vol.type << "," << W << "," << H << ","
+      << dims[0] << "x" << dims[1] << "x" << dims[2] << "," << spaceskip::voxelTypeName(vol.v.type) << "," << W << "," << H << ","
       << tfSpec << "," << sampleDistance << "," << samplingRate << "," << frames << "," << loadS << "," << initS
       << "," << firstS << "," << fps << "," << gpuFps << "," << fpsMapped << "," << median(editMs) << ","
       << (editMs.empty() ? 0 : editMs[0]) << "," << median(nextMs) << "," << g_errors << "\n";
