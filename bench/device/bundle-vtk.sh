@@ -14,13 +14,14 @@
 # stubs that define the symbols their users link against and abort if ever called; Mesa never
 # calls them (checked by running Xvfb and a Mesa client on the stubs, see run-vtk.sh).
 #
-#   bench/device/bundle-vtk.sh [BUILD_DIR]     (default ./build; configure it with CUDA on)
+#   bench/device/bundle-vtk.sh [BUILD_DIR]     (default ./build; configure it with CUDA on; BUNDLE_OUT:
+#   the folder instead of .vtkbundle, e.g. .vtkbundle-pipvtk for build-pipvtk-cuda, VTK 9.5 from pip)
 # Then on the GPU machine: bench/device/run-vtk.sh OUTDIR (the device tool: carry .vtkbundle).
 # x.tar.xz is kept when it exists (it takes ~2 minutes to compress): delete it to repack.
 set -euo pipefail
 src=$(cd "$(dirname "$0")/../.." && pwd)
 build=$(cd "${1:-$src/build}" && pwd)
-out=$src/.vtkbundle
+out=${BUNDLE_OUT:-$src/.vtkbundle}  # BUNDLE_OUT: e.g. .vtkbundle-pipvtk for a second build
 mkdir -p "$out"
 stage=$(mktemp -d)
 trap 'rm -rf "$stage"' EXIT

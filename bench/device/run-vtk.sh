@@ -30,7 +30,8 @@
 #          volume-only scene skips) bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
 #          shading, window and CLI, N-body and Menger 1024^3: modes.log) bench-scatter (issue 34:
 #          volumetric scattering on vs off in one process, and vtkGPUVolumeRayCastMapper with it:
-#          scatter.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
+#          scatter.log) bench-time-series (issue 38: playback of N-body time steps, ours against
+#          vtkGPUVolumeRayCastMapper in one window, and the CLI's upload bound: time-series.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
 #          its CUDA tests: core.log) auto (the CLI's Builder Auto against fixed builders, dense and
 #          sparse 1024^3: cli-bench.log) cli-ab (CLI kernel fps, settings alternated per process:
 #          CLI_AB_RUNS, CLI_AB_DATASETS, CLI_AB_ITEMS: cli-ab.txt)
@@ -200,7 +201,7 @@ if has memcheck && ! late; then
   for exe in ${MEMCHECK_TESTS:-$all_tests}; do
     late && { log "memcheck $exe skipped (deadline)"; echo "==== $exe skipped (deadline)" >> "$out/memcheck.log"; continue; }
     log "memcheck $exe"
-    SPACESKIP_BACKEND=cuda SPACESKIP_REPORT=1 SPACESKIP_TEST_WINDOW=${MEMCHECK_WINDOW:-x} timeout 240 compute-sanitizer --tool memcheck \
+    SPACESKIP_BACKEND=cuda SPACESKIP_REPORT=1 SPACESKIP_UNDER_SANITIZER=1 SPACESKIP_TEST_WINDOW=${MEMCHECK_WINDOW:-x} timeout 240 compute-sanitizer --tool memcheck \
       --error-exitcode 99 "$tests" "$exe" -D "$work/data" -T "$work/tmp-cuda" \
       > "$work/memcheck-$exe.log" 2>&1
     rc=$?
@@ -240,7 +241,7 @@ vg=()
 [ "${VTK_GPU:-1}" = 1 ] && vg=(--vtk-gpu)
 # The benchmark's window: first a vtkGenericOpenGLRenderWindow on NVIDIA's headless EGL (--egl),
 # else the tests' X window.
-if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-scatter || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor || has bench-oldnew; then
+if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has bench-modes || has bench-scatter || has bench-time-series || has bench-depth || has bench-hw || has bench-frame || has interop-memcheck || has nsys-frame || has bench-ab || has bench-floor || has bench-oldnew; then
   egl_json=$(ls /usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json /usr/share/glvnd/egl_vendor.d/10_nvidia.json 2>/dev/null | head -1)
   [ -n "$egl_json" ] && export __EGL_VENDOR_LIBRARY_FILENAMES=$egl_json
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
@@ -357,6 +358,29 @@ if has bench-scatter; then
     done
   fi
   grep -E "^blend|^item|^Auto|^Grid|^Naive|^vtkGPU|volume |GL_RENDERER" "$work/bench.log" > "$out/scatter.log"
+fi
+
+# Time series (issue 38): TS_STEPS (100) steps of the N-body stand-in advected, TS_HELD (4) held,
+# played by our mapper (TS_ITEMS, default Auto) and then vtkGPUVolumeRayCastMapper in the same
+# window, each step a new scalar array (the window benchmark's --time-series; VTK's mapper plays
+# TS_VTK_STEPS of them, default 20: its steps take up to seconds), for every case of
+# TS_CASES ("512:uint8 512:float32 1024:uint8 1024:float32"); then, with the CLI in the bundle
+# (BUNDLE_NO_CLI=0), its playback and upload bound for the same case. time-series.log.
+if has bench-time-series; then
+  for c in ${TS_CASES:-512:uint8 512:float32 1024:uint8 1024:float32}; do
+    late && break
+    tn=${c%%:*} tt=${c#*:}
+    echo "==== time series nbody $tn^3 $tt" >> "$work/bench.log"
+    ITEMS=${TS_ITEMS:-Auto} window_bench nbody "$tn" "${vg[@]}" --time-series "${TS_STEPS:-100}" \
+      --steps-held "${TS_HELD:-4}" --step-type "$tt" --vtk-gpu-steps "${TS_VTK_STEPS:-20}"
+    if [ -x "$cli" ]; then
+      { echo "==== CLI time series nbody $tn^3 $tt"; timeout 300 "$cli" bench "gen:nbody:$tn" --backend cuda \
+          --size 1024x1024 --time-series "${TS_STEPS:-100}" --steps-held "${TS_HELD:-4}" --step-type "$tt"; } \
+        >> "$work/time-series-cli.log" 2>&1
+    fi
+  done
+  { grep -E "^====|^item|^Auto|^Grid|^DistanceGrid|^Naive|^vtkGPU|^time series|volume |GL_RENDERER" "$work/bench.log"
+    echo; cat "$work/time-series-cli.log" 2>/dev/null; } > "$out/time-series.log"
 fi
 
 if has bench-modes; then

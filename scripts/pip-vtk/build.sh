@@ -16,7 +16,9 @@
 # repository), the script compiles vtkWrapHierarchy, vtkWrapPython and vtkWrapPythonInit from
 # its Wrapping/Tools against the wheel's libvtkWrappingTools.so, wraps the mapper (package
 # spaceskip), installs numpy into the venv and runs the Python test too; without it, it says so
-# and builds C++ only. Not built: CUDA (a CPU build; the GPU runs are bench/device/, Testing/gpu/).
+# and builds C++ only. CUDA is off unless SPACESKIP_PIP_VTK_CUDA_ARCH is set (e.g. 90: the CUDA
+# backend for sm_90, its host code with the same ABI; bench/device/bundle-pipvtk.sh carries it to a
+# GPU machine). Without it CUDA is not built: a CPU build.
 # The SDK part (downloads, wrapping tools, assemble_sdk.py) is sdk.sh, shared with wheel.sh (the
 # `spaceskip` wheel + PyVista test).
 #
@@ -27,6 +29,8 @@
 #   SPACESKIP_PIP_VTK_BUILD    build folder (default build-pipvtk in the repository, git-ignored)
 #   SPACESKIP_PIP_VTK_JOBS     build jobs (default: nproc)
 #   SPACESKIP_PIP_VTK_SOURCE   VTK git repository with tag v$VER: Python wrapping (see above)
+#   SPACESKIP_PIP_VTK_CUDA_ARCH  CUDA architecture: build the CUDA backend for it (default: none, CUDA off)
+#   SPACESKIP_PIP_VTK_NO_TESTS   set: build only, run no test (e.g. a CUDA build for the GPU machine)
 #   SPACESKIP_XVFB_DISPLAY     Xvfb display number when DISPLAY is unset (default 92)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -43,12 +47,18 @@ mkdir -p "$cache"
 
 source "$root/scripts/pip-vtk/sdk.sh"
 
-step "configure $build (ParaView off, CUDA off, Python wrapping $wrap, -D_GLIBCXX_USE_CXX11_ABI=0)"
+cuda=(-DSPACESKIP_ENABLE_CUDA=OFF)
+if [ -n "${SPACESKIP_PIP_VTK_CUDA_ARCH:-}" ]; then
+  # nvcc's host compiler needs the same C++ ABI as the C++ files: Core's API passes std::string.
+  cuda=(-DSPACESKIP_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES="$SPACESKIP_PIP_VTK_CUDA_ARCH"
+    -DCMAKE_CUDA_FLAGS="-D_GLIBCXX_USE_CXX11_ABI=0")
+fi
+step "configure $build (ParaView off, ${cuda[0]#-D}, Python wrapping $wrap, -D_GLIBCXX_USE_CXX11_ABI=0)"
 # CMAKE_DISABLE_FIND_PACKAGE_ParaView: the system ParaView's VTK must not be loaded beside this one.
 mkdir -p "$build"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_DISABLE_FIND_PACKAGE_ParaView=TRUE -DSPACESKIP_ENABLE_PARAVIEW=OFF \
-  -DSPACESKIP_ENABLE_VTK=ON -DSPACESKIP_ENABLE_CUDA=OFF -DSPACESKIP_WRAP_PYTHON=$wrap \
+  -DSPACESKIP_ENABLE_VTK=ON "${cuda[@]}" -DSPACESKIP_WRAP_PYTHON=$wrap \
   -DPython3_EXECUTABLE="$venv/bin/python" \
   -DVTK_DIR="$vtk_dir" -DCMAKE_CXX_FLAGS="-D_GLIBCXX_USE_CXX11_ABI=0" >"$build/pip-vtk-configure.log" 2>&1 ||
   { tail -30 "$build/pip-vtk-configure.log"; exit 1; }
@@ -59,6 +69,10 @@ targets=(vtkSpaceSkipCxxTests spaceskip_window_bench SpaceSkip-data)
 [ "$wrap" = OFF ] || targets+=(vtkSpaceSkipPython)
 nice -n 10 cmake --build "$build" -j "$jobs" --target "${targets[@]}"
 
+if [ -n "${SPACESKIP_PIP_VTK_NO_TESTS:-}" ]; then
+  step "built; no tests run (SPACESKIP_PIP_VTK_NO_TESTS)"
+  exit 0
+fi
 step "VTK C++ tests (ctest ${ctest_args[*]}) under X"
 source "$root/scripts/xvfb.sh" 92
 echo "DISPLAY=$DISPLAY"

@@ -22,6 +22,13 @@
 //        R and ScatteringAnisotropy G on both mappers; implies --shade)]
 //       [--depth-actor (an opaque point actor outside the volume: the mapper reads the window's
 //        depth as with geometry in the scene; without it a volume-only scene skips the readback)]
+//       [--time-series STEPS [--steps-held K (4)] [--step-type uint8|float32] (playback, issue 38:
+//        K time steps of the shape (Generators.h generateTimeStep; N-body advected) held in host
+//        memory, STEPS played cycling over them, each step a new scalar array of the image as a
+//        reader hands ParaView the next step, the frame at the orbit's next angle waited for; per
+//        item, then for vtkGPUVolumeRayCastMapper with --vtk-gpu (--vtk-gpu-steps M of them, default
+//        STEPS: its steps can take seconds): steps/s and ms a step, in place of the orbit and edit
+//        timings)]
 // The mapper's knobs (spaceskip::Tuning) come from the environment (Core/cli/Environment.h,
 // docs/tuning.md), and item suffixes set some of them for one item, for measuring the frame
 // around the kernel in one process: :full Tuning::compositeFull (copy and blend the whole window,
@@ -51,6 +58,7 @@
 #include "vtkSmartPointer.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
 #include "vtkUnsignedCharArray.h"
+#include "vtkFloatArray.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
 #include "vtkWindowToImageFilter.h"
@@ -307,6 +315,62 @@ double StreamedRender(vtkRenderWindow* win, vtkRenderer* ren, const double b[6],
   return Since(t0);
 }
 
+// The voxels of `v` as a VTK array, without a copy (v keeps the storage).
+vtkSmartPointer<vtkDataArray> WrapVoxels(const spaceskip::Volume& v)
+{
+  const auto count = static_cast<vtkIdType>(v.voxelCount());
+  if (v.type == spaceskip::VoxelType::Float32)
+  {
+    auto a = vtkSmartPointer<vtkFloatArray>::New();
+    a->SetArray(static_cast<float*>(const_cast<void*>(v.data)), count, 1);
+    a->SetName("scalars");
+    return a;
+  }
+  auto a = vtkSmartPointer<vtkUnsignedCharArray>::New();
+  a->SetArray(static_cast<unsigned char*>(const_cast<void*>(v.data)), count, 1);
+  a->SetName("scalars");
+  return a;
+}
+
+double Median(std::vector<double> x)
+{
+  if (x.empty())
+  {
+    return 0;
+  }
+  std::sort(x.begin(), x.end());
+  const size_t m = x.size() / 2;
+  return x.size() % 2 ? x[m] : 0.5 * (x[m - 1] + x[m]);
+}
+
+// Plays `played` time steps on the volume's current mapper, cycling over `arrays`: per step the
+// image's scalars are replaced (a new array of the same shape, as a reader hands over the next
+// step) and the frame at the orbit's next angle is rendered and waited for. Milliseconds a step;
+// `update` and `range` (if given) get what `ours` reports for each step's engine update (upload,
+// brick ranges, classification, build) and scalar-range pass.
+std::vector<double> PlaySteps(vtkRenderWindow* win, vtkRenderer* ren, vtkImageData* image,
+  const std::vector<vtkSmartPointer<vtkDataArray>>& arrays, const double b[6], int played,
+  vtkSpaceSkippingVolumeMapper* ours = nullptr, std::vector<double>* update = nullptr,
+  std::vector<double>* range = nullptr)
+{
+  std::vector<double> ms;
+  for (int i = 1; i <= played; ++i)
+  {
+    Orbit(ren, b, 360.0 * i / played, 15);
+    const auto t0 = Clock::now();
+    image->GetPointData()->SetScalars(arrays[static_cast<size_t>(i) % arrays.size()]);
+    win->Render();
+    glFinish();
+    ms.push_back(1e3 * Since(t0));
+    if (ours && update && range)
+    {
+      update->push_back(1e3 * ours->GetLastUpdateSeconds());
+      range->push_back(1e3 * ours->GetLastScalarRangeSeconds());
+    }
+  }
+  return ms;
+}
+
 // `out` set to the value that `names` gives `m`; false (printing "unknown <what> <m><hint>")
 // where m is none of the names.
 bool Named(const std::string& m, std::initializer_list<std::pair<const char*, int>> names, int& out,
@@ -330,6 +394,8 @@ int main(int argc, char* argv[])
   std::string shape = "nbody", csvPath, pngPrefix, builders =
     "Naive,Grid,LBVH,LBVHCPU,KdTreeCPU:mls32,KdTreeGPUFast:mls32,Hybrid,DistanceGrid,DistanceGrid:brick4";
   int n = 256, frames = 16, size = 1024, edits = 4;
+  int timeSeries = 0, stepsHeld = 4, vtkGpuSteps = 0; // --time-series, --steps-held, --vtk-gpu-steps
+  spaceskip::VoxelType stepType = spaceskip::VoxelType::UInt8;
   double editCut = 0.3;
   bool vtkGpu = false, egl = false, floatComposite = false, ert = false, hostComposite = false;
   bool shade = false, depthActor = false;
@@ -403,6 +469,23 @@ int main(int argc, char* argv[])
       }
       shade = true;
     }
+    else if (a == "--time-series")
+      timeSeries = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--vtk-gpu-steps")
+      vtkGpuSteps = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--steps-held")
+      stepsHeld = std::max(1, std::atoi(next().c_str()));
+    else if (a == "--step-type")
+    {
+      const std::string t = next();
+      if (t == "float32")
+        stepType = spaceskip::VoxelType::Float32;
+      else if (t != "uint8")
+      {
+        std::cerr << "--step-type takes uint8 or float32\n";
+        return 2;
+      }
+    }
     else if (a == "--csv")
       csvPath = next();
     else if (a == "--png")
@@ -445,21 +528,37 @@ int main(int argc, char* argv[])
     items.push_back(it);
   }
 
-  // The volume, generated here (nothing big travels), wrapped without a copy.
+  // The volume, generated here (nothing big travels), wrapped without a copy; with
+  // --time-series the held steps, the first one shown.
   auto t0 = Clock::now();
-  spaceskip::Volume v = spaceskip::generateVolume(shape, spaceskip::vec3l{ n, n, n });
+  std::vector<spaceskip::Volume> steps;
+  std::vector<vtkSmartPointer<vtkDataArray>> stepArrays;
+  if (timeSeries > 0)
+  {
+    for (int k = 0; k < stepsHeld; ++k)
+    {
+      steps.push_back(spaceskip::generateTimeStep(shape, spaceskip::vec3l{ n, n, n }, k, stepType));
+    }
+  }
+  else
+  {
+    steps.push_back(spaceskip::generateVolume(shape, spaceskip::vec3l{ n, n, n }));
+  }
+  for (const spaceskip::Volume& s : steps)
+  {
+    stepArrays.push_back(WrapVoxels(s));
+  }
+  const spaceskip::Volume& v = steps[0];
   const double genSeconds = Since(t0);
-  vtkNew<vtkUnsignedCharArray> voxels;
-  voxels->SetName("scalars");
-  voxels->SetArray(static_cast<unsigned char*>(const_cast<void*>(v.data)),
-    static_cast<vtkIdType>(v.voxelCount()), 1);
   vtkNew<vtkImageData> image;
   image->SetDimensions(n, n, n);
   image->SetSpacing(1, 1, 1);
-  image->GetPointData()->SetScalars(voxels);
+  image->GetPointData()->SetScalars(stepArrays[0]);
   double b[6];
   image->GetBounds(b);
-  std::printf("volume %s %d^3 uint8 generated in %.2f s\n", shape.c_str(), n, genSeconds);
+  std::printf("volume %s %d^3 %s generated in %.2f s%s\n", shape.c_str(), n,
+    v.type == spaceskip::VoxelType::Float32 ? "float32" : "uint8", genSeconds,
+    timeSeries > 0 ? (" (" + std::to_string(stepsHeld) + " time steps)").c_str() : "");
 
   vtkNew<vtkColorTransferFunction> ctf;
   vtkNew<vtkPiecewiseFunction> pwf;
@@ -540,7 +639,8 @@ int main(int argc, char* argv[])
         << emptyStream * 1e3 << "," << 1 / emptyStream << ",,\n";
   }
 
-  std::printf("%-22s %-13s %-5s %8s %7s %8s %8s %8s %8s %8s %8s %8s %8s %9s %8s %8s %8s %9s %7s "
+  if (timeSeries == 0)
+    std::printf("%-22s %-13s %-5s %8s %7s %8s %8s %8s %8s %8s %8s %8s %8s %9s %8s %8s %8s %9s %7s "
               "%8s %8s %6s %9s %8s %8s %8s %7s %7s %7s %s\n",
     "item", "used", "bk", "frame_ms", "fps", "mapper", "update", "depth", "engine", "kernel",
     "compos", "other", "kern_fps", "first_s", "build_ms", "class_ms", "nodes", "occupancy",
@@ -581,10 +681,8 @@ int main(int argc, char* argv[])
   std::printf("composite: %s image upload\n", floatComposite ? "32-bit float" : "8-bit");
   volume->SetMapper(mapper);
   const spaceskip::Tuning baseTuning = spaceskip::cli::tuningFromEnvironment();
-  bool firstOfAll = true;
-  int imageMismatches = 0; // items whose GPU-path image differs from the host path's by > 1/255
-  for (const Item& it : items)
-  {
+  // One item's settings on the mapper.
+  auto apply = [&](const Item& it) {
     mapper->SetBuilder(it.builder);
     mapper->SetLeafCriterion(it.leaf);
     mapper->SetMaxLeafSize(it.mls);
@@ -604,6 +702,78 @@ int main(int argc, char* argv[])
     }
     mapper->SetTuning(tuning);
     mapper->SetVolumetricScatteringBlending(it.noScatter ? 0.f : scatter[0]);
+  };
+  // Builder Auto measures its candidates first (one to four frames each): the steady state
+  // starts after.
+  auto settle = [&]() {
+    for (int i = 0; i < 40 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
+    {
+      TimedRender(win);
+    }
+  };
+  if (timeSeries > 0)
+  {
+    // Playback: per item, then VTK's mapper in the same window; the same steps and camera path.
+    const double stepMiB = double(v.byteSize()) / 1048576.0;
+    std::printf("time series: %d steps played over %d held, %.1f MiB a step\n", timeSeries,
+      stepsHeld, stepMiB);
+    std::printf("%-22s %-13s %-5s %9s %9s %9s %9s %10s %9s %9s\n", "item", "used", "bk", "first_s",
+      "step_ms", "max_ms", "steps/s", "update_ms", "range_ms", "builds");
+    double oursMs = 0;
+    for (const Item& it : items)
+    {
+      apply(it);
+      image->GetPointData()->SetScalars(stepArrays[0]);
+      Orbit(ren, b, 0, 15);
+      const double first = TimedRender(win);
+      settle();
+      const int builds = mapper->GetBuildCount();
+      std::vector<double> update, range;
+      const auto t = Clock::now();
+      const std::vector<double> ms =
+        PlaySteps(win, ren, image, stepArrays, b, timeSeries, mapper, &update, &range);
+      const double sec = Since(t);
+      std::printf("%-22s %-13s %-5s %9.3f %9.3f %9.3f %9.2f %10.3f %9.3f %9d\n", it.label.c_str(),
+        mapper->GetBuilderUsed(), mapper->GetBackendUsed(), first, Median(ms),
+        *std::max_element(ms.begin(), ms.end()), timeSeries / sec, Median(update), Median(range),
+        mapper->GetBuildCount() - builds);
+      std::fflush(stdout);
+      if (oursMs == 0)
+      {
+        oursMs = Median(ms);
+      }
+    }
+    if (vtkGpu)
+    {
+      vtkNew<vtkGPUVolumeRayCastMapper> gpu;
+      gpu->SetInputData(image);
+      gpu->AutoAdjustSampleDistancesOff();
+      gpu->SetSampleDistance(0.5);
+      gpu->SetBlendMode(blend);
+      volume->SetMapper(gpu);
+      image->GetPointData()->SetScalars(stepArrays[0]);
+      Orbit(ren, b, 0, 15);
+      const double first = TimedRender(win);
+      TimedRender(win);
+      const auto t = Clock::now();
+      const int played = vtkGpuSteps > 0 ? vtkGpuSteps : timeSeries;
+      const std::vector<double> ms = PlaySteps(win, ren, image, stepArrays, b, played);
+      const double sec = Since(t);
+      std::printf("%-22s %-13s %-5s %9.3f %9.3f %9.3f %9.2f %10s %9s %9s (%d steps)\n",
+        "vtkGPUVolumeRayCast", "-", "gl", first, Median(ms), *std::max_element(ms.begin(), ms.end()),
+        played / sec, "-", "-", "-", played);
+      std::printf("time series: the first item's step is %.2fx faster than vtkGPUVolumeRayCastMapper's "
+                  "(median ms a step, same window, steps and camera path)\n",
+        oursMs > 0 ? Median(ms) / oursMs : 0.0);
+      volume->SetMapper(mapper);
+    }
+    return 0;
+  }
+  bool firstOfAll = true;
+  int imageMismatches = 0; // items whose GPU-path image differs from the host path's by > 1/255
+  for (const Item& it : items)
+  {
+    apply(it);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
     if (firstOfAll)
@@ -617,12 +787,7 @@ int main(int argc, char* argv[])
         mapper->GetLastCompositeSeconds());
       firstOfAll = false;
     }
-    // Builder Auto measures its candidates first (one to four frames each): the steady state
-    // starts after.
-    for (int i = 0; i < 40 && std::string(mapper->GetBuilderChoice()).rfind("Auto: measuring", 0) == 0; ++i)
-    {
-      TimedRender(win);
-    }
+    settle();
     const double buildS = mapper->GetLastBuildSeconds(), classifyS = mapper->GetLastClassifySeconds();
     TimedRender(win); // warm-up of the steady state
     double wall = 0, m = 0, up = 0, dep = 0, eng = 0, ker = 0, comp = 0, call = 0;

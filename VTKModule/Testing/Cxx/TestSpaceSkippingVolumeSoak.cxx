@@ -9,6 +9,7 @@
 
 #include "SpaceSkipTestHelpers.h"
 
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <string>
@@ -159,8 +160,14 @@ int TestSpaceSkippingVolumeSoak(int, char*[])
   SS_CHECK(said >= 1); // at least the clamped sample distance was reported
   SS_CHECK(said <= 8);
   // Each backend switch makes a new engine (and CUDA stream/events on a GPU): a bound, not zero.
-  // Measured on the H100: +0.95 MB; under compute-sanitizer memcheck +5 MB (its own bookkeeping).
-  SS_CHECK(rss3 - rss2 <= 8.0 * 1048576.0);
+  // Measured on the H100: +0.95 MB; under compute-sanitizer memcheck +5 MB with Mesa's GL and
+  // +22 MB with NVIDIA's GLX (H200, its bookkeeping of every interop registration):
+  // bench/device/run-vtk.sh's memcheck phase says so with SPACESKIP_UNDER_SANITIZER=1.
+  const bool sanitizer = std::getenv("SPACESKIP_UNDER_SANITIZER") != nullptr;
+  const double switchBound = (sanitizer ? 48.0 : 8.0) * 1048576.0;
+  std::cout << "switch bound " << switchBound / 1048576.0 << " MiB"
+            << (sanitizer ? " (under compute-sanitizer)" : "") << "\n";
+  SS_CHECK(rss3 - rss2 <= switchBound);
   vtkOutputWindow::SetInstance(nullptr);
   return ok ? EXIT_SUCCESS : EXIT_FAILURE;
 }
