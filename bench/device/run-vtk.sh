@@ -117,7 +117,7 @@ export LD_LIBRARY_PATH=$B/vtk/lib:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_l
 export __GLX_VENDOR_LIBRARY_NAME=nvidia
 bench=$B/vtk/bin/spaceskip_window_bench
 tests=$B/vtk/bin/vtkSpaceSkipCxxTests
-cli=$B/vtk/bin/spaceskip
+cli=${CLI:-$B/vtk/bin/spaceskip}  # CLI: e.g. one carried apart (bench/device/pack-core.sh: its cli.tar.xz)
 probe() { timeout 60 "$bench" --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 > "$work/probe.log" 2>&1; }
 if probe && grep -q "GL_RENDERER.*NVIDIA" "$work/probe.log"; then
   gl="NVIDIA GL (__GLX_VENDOR_LIBRARY_NAME=nvidia)"

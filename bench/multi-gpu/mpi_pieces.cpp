@@ -2,7 +2,13 @@
 // volume's sample lattice, its own cells only: VolumePiece.h), the ranks composite the float
 // images by direct send (each rank blends one band of rows from every rank in visibility
 // order, PieceOrder.h) and rank 0 gathers the bands. Frames are waited for; the frame time is
-// the slowest rank's render + download, the exchange, the blend and the gather.
+// the slowest rank's render, the exchange, the blend and the gather.
+// Two ways to composite (--composite): `host` downloads every image and exchanges it with MPI
+// through host memory (MPI_Alltoallv, then MPI_Gatherv to rank 0); `gpu` (the default where the
+// ranks have CUDA devices on one host) keeps the images on the GPUs: each rank copies its frame
+// into an exchange buffer that the other ranks map through CUDA IPC, and blends its band from all
+// of them straight into rank 0's final image on rank 0's GPU (gpu_composite.cu); MPI carries only
+// two barriers a frame. It falls back to `host`, and says why, where IPC or peer access fails.
 //
 // This is the benchmark's stand-in for ParaView's engine (pvbatch with float compositing does
 // the same steps: each rank draws its piece into a float image, the images are blended in
@@ -11,6 +17,7 @@
 //
 //   mpiexec -n N spaceskip_mpi_pieces [--shape nbody] [--dims 2048] [--size 1024] [--frames 30]
 //       [--builder Auto] [--backend auto|cpu|cuda] [--tf ramp] [--check] [--png out.png]
+//       [--composite gpu|host]
 // --check: rank 0 also renders the whole volume alone and prints the largest difference of
 // the composited image from it (8-bit units). --slabs: each rank makes only its slab (volumes
 // larger than one host's share or one GPU: no rank holds the whole; with --check rank 0 makes
@@ -26,6 +33,8 @@
 
 #include <mpi.h>
 #ifdef SPACESKIP_MPI_PIECES_CUDA
+#include "gpu_composite.h"
+
 #include <cuda_runtime.h>
 #endif
 
@@ -45,6 +54,7 @@ namespace {
 
 struct Args {
   std::string shape = "nbody", builder = "Auto", backend = "auto", tf = "ramp", png;
+  std::string composite;  // gpu or host; empty: gpu where every rank has a CUDA device on one host
   int64_t dims = 256;
   int size = 512, frames = 20;
   bool check = false, slabs = false;
@@ -69,12 +79,17 @@ Args parse(int argc, char** argv) {
     else if (k == "--backend") a.backend = next();
     else if (k == "--tf") a.tf = next();
     else if (k == "--png") a.png = next();
+    else if (k == "--composite") a.composite = next();
     else if (k == "--check") a.check = true;
     else if (k == "--slabs") a.slabs = true;
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       MPI_Abort(MPI_COMM_WORLD, 2);
     }
+  }
+  if (!a.composite.empty() && a.composite != "gpu" && a.composite != "host") {
+    std::fprintf(stderr, "--composite takes gpu or host\n");
+    MPI_Abort(MPI_COMM_WORLD, 2);
   }
   if (a.dims < 8 || a.size < 8 || a.frames < 1) {
     std::fprintf(stderr, "--dims and --size must be >= 8, --frames >= 1\n");
@@ -103,6 +118,78 @@ void over(vec4f* acc, const vec4f* back, size_t n) {
 }
 
 int to8(float v) { return int(std::lround(std::min(1.f, std::max(0.f, v)) * 255.f)); }
+
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+/// The GPU compositing's buffers: this rank's exchange buffer (its frame's copy), every rank's
+/// mapped into this process through CUDA IPC, and rank 0's final image (mapped here too).
+struct GpuExchange {
+  void* mine = nullptr;
+  void* final0 = nullptr;  // rank 0: the final image it owns
+  void* finalMapped = nullptr;
+  std::vector<void*> peers;
+  cudaStream_t stream = nullptr;
+  std::string why;  // why it cannot be used (empty: ready)
+};
+
+/// Sets up `g` on every rank; true on every rank or on none (then `why` says why, on the rank
+/// that failed and on rank 0).
+bool setupGpuExchange(GpuExchange& g, int rank, int ranks, size_t bytes, MPI_Comm node) {
+  int nodeSize = 0;
+  MPI_Comm_size(node, &nodeSize);
+  auto fail = [&](const std::string& w) {
+    if (g.why.empty()) g.why = w;
+  };
+  auto ck = [&](cudaError_t e, const char* what) {
+    if (e != cudaSuccess) fail(std::string(what) + ": " + cudaGetErrorString(e));
+    return e == cudaSuccess;
+  };
+  if (nodeSize != ranks) fail("the ranks are not all on one host (CUDA IPC maps memory of one host)");
+  if (ranks > spaceskip::mpi::kMaxRanks) fail("more than " + std::to_string(spaceskip::mpi::kMaxRanks) + " ranks");
+  if (g.why.empty()) {
+    ck(cudaMalloc(&g.mine, bytes), "cudaMalloc (exchange buffer)");
+    if (rank == 0 && g.why.empty()) ck(cudaMalloc(&g.final0, bytes), "cudaMalloc (final image)");
+    if (g.why.empty()) ck(cudaStreamCreateWithFlags(&g.stream, cudaStreamNonBlocking), "cudaStreamCreate");
+  }
+  // Every rank takes part in each collective below, failed or not.
+  cudaIpcMemHandle_t h{}, hf{};
+  if (g.why.empty()) ck(cudaIpcGetMemHandle(&h, g.mine), "cudaIpcGetMemHandle");
+  if (rank == 0 && g.why.empty()) ck(cudaIpcGetMemHandle(&hf, g.final0), "cudaIpcGetMemHandle (final)");
+  int okHere = g.why.empty() ? 1 : 0, okAll = 0;
+  MPI_Allreduce(&okHere, &okAll, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  std::vector<cudaIpcMemHandle_t> all(static_cast<size_t>(ranks));
+  MPI_Allgather(&h, sizeof h, MPI_BYTE, all.data(), sizeof h, MPI_BYTE, MPI_COMM_WORLD);
+  MPI_Bcast(&hf, sizeof hf, MPI_BYTE, 0, MPI_COMM_WORLD);
+  if (okAll) {
+    g.peers.assign(size_t(ranks), nullptr);
+    for (int r = 0; r < ranks && g.why.empty(); ++r) {
+      if (r == rank) g.peers[size_t(r)] = g.mine;
+      else ck(cudaIpcOpenMemHandle(&g.peers[size_t(r)], all[size_t(r)], cudaIpcMemLazyEnablePeerAccess),
+              "cudaIpcOpenMemHandle (a rank's image)");
+    }
+    if (g.why.empty()) {
+      if (rank == 0) g.finalMapped = g.final0;
+      else ck(cudaIpcOpenMemHandle(&g.finalMapped, hf, cudaIpcMemLazyEnablePeerAccess),
+              "cudaIpcOpenMemHandle (rank 0's final image)");
+    }
+  } else if (g.why.empty()) {
+    g.why = "another rank could not set up its exchange buffer";
+  }
+  okHere = g.why.empty() ? 1 : 0;
+  MPI_Allreduce(&okHere, &okAll, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (!okAll && g.why.empty()) g.why = "another rank could not map the exchange buffers";
+  return okAll == 1;
+}
+
+void releaseGpuExchange(GpuExchange& g, int rank) {
+  for (size_t r = 0; r < g.peers.size(); ++r)
+    if (int(r) != rank && g.peers[r]) cudaIpcCloseMemHandle(g.peers[r]);
+  if (rank != 0 && g.finalMapped) cudaIpcCloseMemHandle(g.finalMapped);
+  if (g.stream) cudaStreamDestroy(g.stream);
+  cudaFree(g.mine);
+  cudaFree(g.final0);
+  g = GpuExchange{};
+}
+#endif
 
 }  // namespace
 
@@ -208,11 +295,89 @@ int main(int argc, char** argv) {
                 double(cells * (r + 1) / ranks)};
   Image img, final;
   if (rank == 0) final.width = w, final.height = h, final.rgba.resize(size_t(w) * h);
+  [[maybe_unused]] const size_t imageBytes = size_t(w) * size_t(h) * sizeof(vec4f);
+
+  // Compositing on the GPUs (the default where every rank has a CUDA device on one host).
+  bool gpuComposite = false;
+  std::string noGpuWhy;
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+  GpuExchange gx;
+  {
+    int have = device >= 0 ? 1 : 0, haveAll = 0;
+    MPI_Allreduce(&have, &haveAll, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    const bool want = a.composite == "gpu" || (a.composite.empty() && haveAll);
+    if (want && haveAll) {
+      const bool ok = setupGpuExchange(gx, rank, ranks, imageBytes, node);
+      int dev = ok && engine.setImageOnDevice(true) ? 1 : 0, devAll = 0;
+      MPI_Allreduce(&dev, &devAll, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+      gpuComposite = devAll == 1;
+      if (!gpuComposite) {
+        noGpuWhy = ok ? "an engine cannot keep its image on the device" : gx.why;
+        engine.setImageOnDevice(false);
+        if (ok) releaseGpuExchange(gx, rank);
+      }
+    } else if (want) {
+      noGpuWhy = "a rank has no CUDA device";
+    }
+  }
+#else
+  if (a.composite == "gpu") noGpuWhy = "built without CUDA";
+#endif
+  if (!noGpuWhy.empty())
+    std::fprintf(stderr, "[rank %d] GPU compositing not used (%s): compositing through host memory\n", rank,
+                 noGpuWhy.c_str());
 
   struct Times {
     double render = 0, exchange = 0, blend = 0, gather = 0, frame = 0;
   };
+  // The view direction in the volume's index space (spacing 1, axis-aligned generators).
+  auto order = [&](const Camera& cam) {
+    const double dir[3] = {-cam.view.m[2], -cam.view.m[6], -cam.view.m[10]};
+    const double eye[3] = {0, 0, 0};
+    return visibilityOrder(boxes, eye, dir, true);
+  };
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+  // GPU compositing: render (left on the device), copy into the exchange buffer; barrier; blend
+  // this rank's band from every rank's buffer into rank 0's final image; barrier. Waited for.
+  auto gpuFrame = [&](int f, Times& t) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    const auto s0 = Clock::now();
+    const Camera cam = camera(f);
+    engine.render(cam, w, h, img);
+    const void* di = engine.deviceImage();
+    auto* es = static_cast<cudaStream_t>(engine.deviceImageStream());
+    if (!di || cudaMemcpyAsync(gx.mine, di, imageBytes, cudaMemcpyDeviceToDevice, es) != cudaSuccess ||
+        cudaStreamSynchronize(es) != cudaSuccess) {
+      std::fprintf(stderr, "[rank %d] the frame is not on the device (%s)\n", rank,
+                   di ? cudaGetErrorString(cudaGetLastError()) : "the engine fell back to the host");
+      MPI_Abort(MPI_COMM_WORLD, 3);
+    }
+    const auto s1 = Clock::now();
+    MPI_Barrier(MPI_COMM_WORLD);  // every rank's image is in its exchange buffer
+    const auto s2 = Clock::now();
+    spaceskip::mpi::BandSources bs{};
+    const std::vector<size_t> ord = order(cam);
+    for (int r = 0; r < ranks; ++r) {
+      bs.src[r] = gx.peers[size_t(r)];
+      bs.order[r] = int(ord[size_t(r)]);
+    }
+    if (spaceskip::mpi::launchBandBlend(bs, ranks, gx.finalMapped, size_t(rowLo(rank)) * size_t(w),
+                                        size_t(myRows) * size_t(w), gx.stream) != 0 ||
+        cudaStreamSynchronize(gx.stream) != cudaSuccess) {
+      std::fprintf(stderr, "[rank %d] the band blend failed: %s\n", rank, cudaGetErrorString(cudaGetLastError()));
+      MPI_Abort(MPI_COMM_WORLD, 3);
+    }
+    const auto s3 = Clock::now();
+    MPI_Barrier(MPI_COMM_WORLD);  // rank 0's final image is whole
+    const auto s4 = Clock::now();
+    t.render += seconds(s0, s1), t.exchange += seconds(s1, s2), t.blend += seconds(s2, s3);
+    t.gather += seconds(s3, s4), t.frame += seconds(s0, s4);
+  };
+#endif
   auto frame = [&](int f, Times& t) {
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+    if (gpuComposite) return gpuFrame(f, t);
+#endif
     MPI_Barrier(MPI_COMM_WORLD);
     const auto s0 = Clock::now();
     const Camera cam = camera(f);
@@ -221,12 +386,8 @@ int main(int argc, char** argv) {
     MPI_Alltoallv(img.rgba.data(), counts.data(), displs.data(), MPI_FLOAT, recv.data(), recvCounts.data(),
                   recvDispls.data(), MPI_FLOAT, MPI_COMM_WORLD);
     const auto s2 = Clock::now();
-    // The view direction in the volume's index space (spacing 1, axis-aligned generators).
-    const double dir[3] = {-cam.view.m[2], -cam.view.m[6], -cam.view.m[10]};
-    const double eye[3] = {0, 0, 0};
-    const std::vector<size_t> order = visibilityOrder(boxes, eye, dir, true);
     std::fill(band.begin(), band.end(), vec4f{0, 0, 0, 0});
-    for (size_t r : order) over(band.data(), recv.data() + r * myRows * w, band.size());  // front first
+    for (size_t r : order(cam)) over(band.data(), recv.data() + r * myRows * w, band.size());  // front first
     const auto s3 = Clock::now();
     MPI_Gatherv(band.data(), myRows * w * 4, MPI_FLOAT, rank == 0 ? final.rgba.data() : nullptr, counts.data(),
                 displs.data(), MPI_FLOAT, 0, MPI_COMM_WORLD);
@@ -272,11 +433,19 @@ int main(int argc, char** argv) {
   std::vector<char> lines(rank == 0 ? size_t(ranks) * sizeof line : 0);
   MPI_Gather(line, sizeof line, MPI_CHAR, lines.data(), sizeof line, MPI_CHAR, 0, MPI_COMM_WORLD);
 
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+  // The last composite (the edit back's frame: the original function) to the host on rank 0.
+  if (gpuComposite && rank == 0 && cudaMemcpy(final.rgba.data(), gx.final0, imageBytes, cudaMemcpyDeviceToHost) != cudaSuccess) {
+    std::fprintf(stderr, "downloading the final image failed\n");
+    MPI_Abort(MPI_COMM_WORLD, 3);
+  }
+#endif
   if (rank == 0) {
     for (int r = 0; r < ranks; ++r) std::printf("%s\n", lines.data() + size_t(r) * sizeof line);
     const double n = a.frames;
-    std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s\n", ranks, a.shape.c_str(),
-                (long long)a.dims, w, h, a.frames, engine.backendName());
+    std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s composite %s\n", ranks,
+                a.shape.c_str(), (long long)a.dims, w, h, a.frames, engine.backendName(),
+                gpuComposite ? "gpu (CUDA IPC, blended on the GPUs into rank 0's)" : "host (MPI through host memory)");
     std::printf("setup_s %.3f first_frame_s %.4f device_GiB(max rank) %.2f volume_GiB %.2f\n", setup, first,
                 deviceGiBMax, double(wdims.x) * double(wdims.y) * double(wdims.z) * double(voxelSize(piece.type)) / double(1ull << 30));
     std::printf("tf_edit_frame_ms %.3f tf_edit_back_frame_ms %.3f\n", 1e3 * e1.frame, 1e3 * e2.frame);
@@ -313,10 +482,22 @@ int main(int argc, char** argv) {
       bad = maxDiff > 1;
     }
     MPI_Bcast(&bad, 1, MPI_INT, 0, MPI_COMM_WORLD);
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+    if (gpuComposite) {
+      MPI_Barrier(MPI_COMM_WORLD);  // no rank unmaps a buffer another still reads
+      releaseGpuExchange(gx, rank);
+    }
+#endif
     MPI_Comm_free(&node);
     MPI_Finalize();
     return bad ? 1 : 0;
   }
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+  if (gpuComposite) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    releaseGpuExchange(gx, rank);
+  }
+#endif
   MPI_Comm_free(&node);
   MPI_Finalize();
   return 0;

@@ -9,7 +9,9 @@
 # SCENES: shape:dims (default nbody:2048 richtmyer_meshkov:1024). FRAMES (default 60), SIZE
 # (default 1024), RANKS (default "1 2 4", cut to the GPU count), BUILDER (default Auto), SLABS=1
 # (each rank makes only its slab: volumes larger than one GPU), CHECK=0 (no whole-volume
-# reference: it needs the whole volume on rank 0's GPU).
+# reference: it needs the whole volume on rank 0's GPU), COMPOSITES (default "gpu": the images
+# composited on the GPUs through CUDA IPC; "host": through host memory with MPI; "gpu host": both,
+# one after the other).
 # The machine's own mpirun is used when it loads the carried binary's libmpi.so.40 (Open MPI 4.x
 # ABI); otherwise the carried Debian Open MPI (orterun, OPAL_PREFIX).
 set -u
@@ -47,22 +49,24 @@ builder=${BUILDER:-Auto}
 status=0
 for scene in $scenes; do
   shape=${scene%%:*} dims=${scene##*:}
+  for comp in ${COMPOSITES:-gpu}; do
   for n in ${RANKS:-1 2 4}; do
     [ "$n" -le "$gpus" ] || continue
     check=()
     [ "$n" -gt 1 ] && [ "${CHECK:-1}" = 1 ] && check=(--check)
     [ "${SLABS:-0}" = 1 ] && check+=(--slabs)
-    log="$out/$shape$dims-n$n.log"
-    echo "== $shape $dims^3, $n ranks" | tee -a "$out/summary.txt"
+    log="$out/$shape$dims-n$n-$comp.log"
+    echo "== $shape $dims^3, $n ranks, --composite $comp" | tee -a "$out/summary.txt"
     # NVLink multicast stays off (the machine's NCCL_NVLS_ENABLE=0 and friends, passed on).
     timeout "${RUN_TIMEOUT:-400}" "${mpirun[@]}" --allow-run-as-root --oversubscribe -n "$n" --bind-to none \
       -x LD_LIBRARY_PATH -x NCCL_NVLS_ENABLE -x TORCH_SYMM_MEM_DISABLE_MULTICAST -x NVSHMEM_DISABLE_NVLS \
       "$exe" --shape "$shape" --dims "$dims" --size "$size" --frames "$frames" --builder "$builder" \
-      --backend cuda "${check[@]}" --png "$out/$shape$dims-n$n.png" > "$log" 2>&1
+      --backend cuda --composite "$comp" "${check[@]}" --png "$out/$shape$dims-n$n-$comp.png" > "$log" 2>&1
     rc=$?
     [ $rc -eq 0 ] || status=1
-    grep -E "^rank|^setup|^frame|^tf_edit|^check" "$log" | tee -a "$out/summary.txt"
+    grep -E "^rank|^ranks|^setup|^frame|^tf_edit|^check|GPU compositing not used" "$log" | tee -a "$out/summary.txt"
     echo "rc=$rc" | tee -a "$out/summary.txt"
+  done
   done
 done
 exit $status

@@ -1,0 +1,21 @@
+// The blend kernel of the multi-GPU driver's GPU compositing (gpu_composite.cu); no CUDA types.
+#pragma once
+#include <cstddef>
+
+namespace spaceskip::mpi {
+
+constexpr int kMaxRanks = 16;
+
+/// The ranks' images (float4 premultiplied RGBA, device pointers mapped in this process) and the
+/// visibility order to blend them in (front first).
+struct BandSources {
+  const void* src[kMaxRanks];
+  int order[kMaxRanks];
+};
+
+/// Queues on `stream` (a cudaStream_t) the blend of pixels [first, first + count) of the `n`
+/// images in `s.order` into the same pixels of `dst` (a float4 device pointer, possibly another
+/// GPU's memory mapped through IPC). Returns the cudaError_t as an int (0: queued).
+int launchBandBlend(const BandSources& s, int n, void* dst, size_t first, size_t count, void* stream);
+
+}  // namespace spaceskip::mpi
