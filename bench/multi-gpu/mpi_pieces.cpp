@@ -17,7 +17,7 @@
 //
 //   mpiexec -n N spaceskip_mpi_pieces [--shape nbody] [--dims 2048] [--size 1024] [--frames 30]
 //       [--builder Auto] [--backend auto|cpu|cuda] [--tf ramp] [--check] [--png out.png]
-//       [--composite gpu|host]
+//       [--composite gpu|host] [--balance occupancy|equal]
 // --check: rank 0 also renders the whole volume alone and prints the largest difference of
 // the composited image from it (8-bit units). --slabs: each rank makes only its slab (volumes
 // larger than one host's share or one GPU: no rank holds the whole; with --check rank 0 makes
@@ -38,6 +38,8 @@
 #include <cuda_runtime.h>
 #endif
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -55,6 +57,7 @@ namespace {
 struct Args {
   std::string shape = "nbody", builder = "Auto", backend = "auto", tf = "ramp", png;
   std::string composite;  // gpu or host; empty: gpu where every rank has a CUDA device on one host
+  std::string balance = "occupancy";  // or equal
   int64_t dims = 256;
   int size = 512, frames = 20;
   bool check = false, slabs = false;
@@ -80,12 +83,17 @@ Args parse(int argc, char** argv) {
     else if (k == "--tf") a.tf = next();
     else if (k == "--png") a.png = next();
     else if (k == "--composite") a.composite = next();
+    else if (k == "--balance") a.balance = next();
     else if (k == "--check") a.check = true;
     else if (k == "--slabs") a.slabs = true;
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       MPI_Abort(MPI_COMM_WORLD, 2);
     }
+  }
+  if (a.balance != "occupancy" && a.balance != "equal") {
+    std::fprintf(stderr, "--balance takes occupancy or equal\n");
+    MPI_Abort(MPI_COMM_WORLD, 2);
   }
   if (!a.composite.empty() && a.composite != "gpu" && a.composite != "host") {
     std::fprintf(stderr, "--composite takes gpu or host\n");
@@ -118,6 +126,50 @@ void over(vec4f* acc, const vec4f* back, size_t n) {
 }
 
 int to8(float v) { return int(std::lround(std::min(1.f, std::max(0.f, v)) * 255.f)); }
+
+/// Slab cuts (cells along z: rank r draws [cuts[r], cuts[r + 1])) that give each rank about the
+/// same number of visible voxels (the transfer function's opacity > 0 at the voxel's value;
+/// every other voxel in x and y counted) plus 1/16 of a slice's voxels per slice, for the cost
+/// every ray pays in a slab whatever it holds. Integer counts: every rank finds the same cuts.
+/// uint8 and float32 volumes; others get equal slabs.
+std::vector<int64_t> balancedCuts(const Volume& v, const TransferFunction& tf, int ranks) {
+  const int64_t cells = v.dims.z - 1;
+  std::vector<int64_t> cuts(size_t(ranks) + 1);
+  for (int r = 0; r <= ranks; ++r) cuts[size_t(r)] = cells * r / ranks;
+  if ((v.type != VoxelType::UInt8 && v.type != VoxelType::Float32) || v.components != 1 || tf.table.empty() ||
+      !(tf.rangeMax > tf.rangeMin))
+    return cuts;
+  const int n = int(tf.table.size());
+  auto visible = [&](double x) {
+    const double u = (x - tf.rangeMin) / (tf.rangeMax - tf.rangeMin) * (n - 1);
+    const int i = int(std::lround(std::min(double(n - 1), std::max(0.0, u))));
+    return tf.table[size_t(i)].w > 0.f;
+  };
+  bool lut[256];
+  for (int i = 0; i < 256; ++i) lut[i] = visible(i);
+  const int64_t nx = v.dims.x, ny = v.dims.y, slice = nx * ny;
+  std::vector<int64_t> count(size_t(v.dims.z), 0);
+  tbb::parallel_for(int64_t(0), int64_t(v.dims.z), [&](int64_t z) {
+    int64_t c = 0;
+    for (int64_t y = 0; y < ny; y += 2)
+      for (int64_t x = 0; x < nx; x += 2) {
+        const size_t i = size_t(z * slice + y * nx + x);
+        c += v.type == VoxelType::UInt8 ? lut[static_cast<const uint8_t*>(v.data)[i]]
+                                        : visible(static_cast<const float*>(v.data)[i]);
+      }
+    count[size_t(z)] = c + (slice / 4) / 16;
+  });
+  // Cell z spans the slices z and z + 1.
+  std::vector<int64_t> prefix(size_t(cells) + 1, 0);
+  for (int64_t z = 0; z < cells; ++z) prefix[size_t(z) + 1] = prefix[size_t(z)] + count[size_t(z)] + count[size_t(z) + 1];
+  const int64_t total = prefix.back();
+  for (int r = 1; r < ranks; ++r) {
+    const int64_t want = total / ranks * r;
+    const auto it = std::lower_bound(prefix.begin(), prefix.end(), want);
+    cuts[size_t(r)] = std::clamp<int64_t>(int64_t(it - prefix.begin()), cuts[size_t(r) - 1] + 1, cells - (ranks - r));
+  }
+  return cuts;
+}
 
 #ifdef SPACESKIP_MPI_PIECES_CUDA
 /// The GPU compositing's buffers: this rank's exchange buffer (its frame's copy), every rank's
@@ -222,21 +274,44 @@ int main(int argc, char** argv) {
 
   // Every rank makes the whole volume (the generators are deterministic; with --slabs only its
   // slab) and draws a slab of it along z: cells [z0, z1), its points with one ghost layer on
-  // each side.
+  // each side. The slabs hold equal shares of the visible voxels (--balance occupancy, the
+  // default with the whole volume at hand) or equal numbers of cells (--balance equal, --slabs).
   const auto t0 = Clock::now();
   const vec3l wdims{a.dims, a.dims, a.dims};
   const int64_t cells = wdims.z - 1;
-  const int64_t z0 = cells * rank / ranks, z1 = cells * (rank + 1) / ranks;
-  const int64_t p0 = std::max<int64_t>(z0 - 1, 0), p1 = std::min<int64_t>(z1 + 1, wdims.z - 1);
+  std::vector<int64_t> cuts(size_t(ranks) + 1);
+  for (int r = 0; r <= ranks; ++r) cuts[size_t(r)] = cells * r / ranks;
   Volume whole, piece;
+  double lo = 0, hi = 0;
+  auto pointsOf = [&](int64_t c0, int64_t c1, int64_t& p0, int64_t& p1) {
+    p0 = std::max<int64_t>(c0 - 1, 0);
+    p1 = std::min<int64_t>(c1 + 1, wdims.z - 1);
+  };
+  int64_t p0 = 0, p1 = 0;
   if (a.slabs) {
+    pointsOf(cuts[size_t(rank)], cuts[size_t(rank) + 1], p0, p1);
     piece = generateSlab(a.shape, wdims, p0, p1);
     whole.dims = wdims;  // the header only: bounds and lattice
     whole.type = piece.type;
     std::copy(piece.origin, piece.origin + 3, whole.origin);
     std::copy(piece.spacing, piece.spacing + 3, whole.spacing);
+    // The transfer function spans the range over all ranks' pieces (the whole volume's).
+    double range[2] = {0, 1};
+    if (!piece.scalarRange(range[0], range[1])) range[0] = 1, range[1] = 0;
+    MPI_Allreduce(&range[0], &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(&range[1], &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   } else {
     whole = generateVolume(a.shape, wdims);
+    if (!whole.scalarRange(lo, hi)) lo = 1, hi = 0;
+  }
+  if (!(hi >= lo)) lo = 0, hi = 1;
+  const TransferFunction tf = TransferFunction::preset(a.tf, lo, hi);
+  const TransferFunction edited = TransferFunction::preset(a.tf, lo + 0.25 * (hi - lo), hi);
+  const bool balanced = !a.slabs && a.balance != "equal";
+  if (balanced) cuts = balancedCuts(whole, tf, ranks);
+  const int64_t z0 = cuts[size_t(rank)], z1 = cuts[size_t(rank) + 1];
+  if (!a.slabs) {
+    pointsOf(z0, z1, p0, p1);
     piece = whole;
     piece.storage.reset();
     piece.dims.z = p1 - p0 + 1;
@@ -244,15 +319,6 @@ int main(int argc, char** argv) {
                  size_t(p0) * size_t(whole.dims.x * whole.dims.y) * voxelSize(whole.type);
   }
   piece.origin[2] = whole.origin[2] + whole.spacing[2] * double(p0);
-  // The transfer function spans the range over all ranks' pieces (the whole volume's).
-  double range[2] = {0, 1};
-  if (!piece.scalarRange(range[0], range[1])) range[0] = 1, range[1] = 0;
-  double lo = 0, hi = 0;
-  MPI_Allreduce(&range[0], &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&range[1], &hi, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  if (!(hi >= lo)) lo = 0, hi = 1;
-  const TransferFunction tf = TransferFunction::preset(a.tf, lo, hi);
-  const TransferFunction edited = TransferFunction::preset(a.tf, lo + 0.25 * (hi - lo), hi);
   VolumePiece vp;
   vp.wholeDims = whole.dims;
   std::copy(whole.origin, whole.origin + 3, vp.wholeOrigin);
@@ -291,8 +357,8 @@ int main(int argc, char** argv) {
   for (int r = 0; r < ranks; ++r) recvDispls[r] = r * myRows * w * 4;
   std::vector<PieceBox> boxes(ranks);
   for (int r = 0; r < ranks; ++r)
-    boxes[r] = {0.0, double(whole.dims.x - 1), 0.0, double(whole.dims.y - 1), double(cells * r / ranks),
-                double(cells * (r + 1) / ranks)};
+    boxes[r] = {0.0, double(whole.dims.x - 1), 0.0, double(whole.dims.y - 1), double(cuts[size_t(r)]),
+                double(cuts[size_t(r) + 1])};
   Image img, final;
   if (rank == 0) final.width = w, final.height = h, final.rgba.resize(size_t(w) * h);
   [[maybe_unused]] const size_t imageBytes = size_t(w) * size_t(h) * sizeof(vec4f);
@@ -443,9 +509,10 @@ int main(int argc, char** argv) {
   if (rank == 0) {
     for (int r = 0; r < ranks; ++r) std::printf("%s\n", lines.data() + size_t(r) * sizeof line);
     const double n = a.frames;
-    std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s composite %s\n", ranks,
+    std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s composite %s slabs %s\n", ranks,
                 a.shape.c_str(), (long long)a.dims, w, h, a.frames, engine.backendName(),
-                gpuComposite ? "gpu (CUDA IPC, blended on the GPUs into rank 0's)" : "host (MPI through host memory)");
+                gpuComposite ? "gpu (CUDA IPC, blended on the GPUs into rank 0's)" : "host (MPI through host memory)",
+                balanced ? "balanced by visible voxels" : "equal cells");
     std::printf("setup_s %.3f first_frame_s %.4f device_GiB(max rank) %.2f volume_GiB %.2f\n", setup, first,
                 deviceGiBMax, double(wdims.x) * double(wdims.y) * double(wdims.z) * double(voxelSize(piece.type)) / double(1ull << 30));
     std::printf("tf_edit_frame_ms %.3f tf_edit_back_frame_ms %.3f\n", 1e3 * e1.frame, 1e3 * e2.frame);

@@ -11,7 +11,8 @@
 # (each rank makes only its slab: volumes larger than one GPU), CHECK=0 (no whole-volume
 # reference: it needs the whole volume on rank 0's GPU), COMPOSITES (default "gpu": the images
 # composited on the GPUs through CUDA IPC; "host": through host memory with MPI; "gpu host": both,
-# one after the other).
+# one after the other), BALANCE (default occupancy: slabs of equal visible voxels; equal: equal
+# cells; SLABS=1 always cuts equal cells).
 # The machine's own mpirun is used when it loads the carried binary's libmpi.so.40 (Open MPI 4.x
 # ABI); otherwise the carried Debian Open MPI (orterun, OPAL_PREFIX).
 set -u
@@ -61,7 +62,7 @@ for scene in $scenes; do
     timeout "${RUN_TIMEOUT:-400}" "${mpirun[@]}" --allow-run-as-root --oversubscribe -n "$n" --bind-to none \
       -x LD_LIBRARY_PATH -x NCCL_NVLS_ENABLE -x TORCH_SYMM_MEM_DISABLE_MULTICAST -x NVSHMEM_DISABLE_NVLS \
       "$exe" --shape "$shape" --dims "$dims" --size "$size" --frames "$frames" --builder "$builder" \
-      --backend cuda --composite "$comp" "${check[@]}" --png "$out/$shape$dims-n$n-$comp.png" > "$log" 2>&1
+      --backend cuda --composite "$comp" --balance "${BALANCE:-occupancy}" "${check[@]}" --png "$out/$shape$dims-n$n-$comp.png" > "$log" 2>&1
     rc=$?
     [ $rc -eq 0 ] || status=1
     grep -E "^rank|^ranks|^setup|^frame|^tf_edit|^check|GPU compositing not used" "$log" | tee -a "$out/summary.txt"
