@@ -149,6 +149,15 @@ class Engine {
   /// (0 when not rescaled). For one-component float32 volumes it is decided from the backend's
   /// brick ranges, i.e. known after update() (or the first render()).
   int valueExponent() const;
+  /// The volume's value range (one component, 8/16-bit integers or float32; NaN and infinities
+  /// aside) from the brick ranges the backend computes anyway where the voxels land (on the GPU
+  /// right after the upload): uploads the volume set, if it is not yet, and reduces them. For a
+  /// caller that needs the range before the first frame of a volume or time step (the VTK
+  /// mapper's table range) without a pass of its own over the voxels. False, with nothing
+  /// known, where the backend has no brick ranges at hand (sparse residency), for other
+  /// volumes, for a rescaled float volume (valueExponent) or where a value is infinite: the
+  /// caller's own pass is the fallback.
+  bool valueRange(double& lo, double& hi);
 
  private:
   struct Impl;

@@ -682,6 +682,24 @@ void Engine::setPiece(const VolumePiece& p) {
 const BuildParams& Engine::buildParams() const { return impl_->build; }
 const RenderParams& Engine::renderParams() const { return impl_->render; }
 
+bool Engine::valueRange(double& lo, double& hi) {
+  Impl& d = *impl_;
+  if (!d.haveVolume || d.volume.components != 1 || d.volume.type == VoxelType::Float64) return false;
+  try {
+    d.uploadIfNeeded();
+  } catch (const BackendError& e) {
+    if (d.backend->kind() != BackendKind::CUDA) throw;
+    d.fallBackToCpu(e.what());
+    d.uploadIfNeeded();
+  }
+  double a = 0, b = 0;
+  if (d.valueExponent != 0 || !d.backend->brickValueRange(a, b) || !std::isfinite(a) || !std::isfinite(b) || a > b)
+    return false;
+  lo = a;
+  hi = b;
+  return true;
+}
+
 void Engine::update() {
   Impl& d = *impl_;
   try {

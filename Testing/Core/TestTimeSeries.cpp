@@ -200,3 +200,58 @@ TEST(TimeSeries, CudaUploadRatesAreMeasured) {
   Engine cpu(BackendKind::CPU);
   EXPECT_EQ(cpu.measureUpload(size_t(1) << 20).pinned, 0.0);
 }
+
+namespace {
+/// Engine::valueRange equals the host's pass over the voxels for uint8, int16 and float32 steps,
+/// needs none of its own (the upload's brick ranges; update() then does not upload again), and
+/// declines (false) where it cannot know: no volume, a float volume with an infinity.
+void expectValueRangeFromBrickRanges(BackendKind backend) {
+  Engine none(backend);
+  double lo = 0, hi = 0;
+  EXPECT_FALSE(none.valueRange(lo, hi));
+  for (VoxelType type : {VoxelType::UInt8, VoxelType::Float32}) {
+    const std::vector<Volume> steps = nbodySteps(72, 2, type);
+    double a = 0, b = 0;
+    ASSERT_TRUE(steps[1].scalarRange(a, b));
+    // The same step with valueRange (e) and without (ref): the same passes over the voxels.
+    Engine e(backend), ref(backend);
+    for (Engine* x : {&e, &ref}) {
+      test::load(*x, steps[0], TransferFunction::preset("ramp", a, b), test::builder(BuilderKind::Grid));
+      x->update();
+      x->setVolume(steps[1]);
+    }
+    const int grids = e.counters().rangeGrids;
+    ASSERT_TRUE(e.valueRange(lo, hi)) << voxelTypeName(type);
+    EXPECT_EQ(lo, a) << voxelTypeName(type);
+    EXPECT_EQ(hi, b) << voxelTypeName(type);
+    EXPECT_EQ(e.counters().rangeGrids, grids + 1);  // the step's upload and brick ranges, done here
+    e.update();
+    ref.update();
+    EXPECT_EQ(e.counters().rangeGrids, ref.counters().rangeGrids);  // and not again in update()
+    EXPECT_EQ(e.counters().voxelPasses, ref.counters().voxelPasses);
+  }
+  // int16 with negative values.
+  const Volume s = test::makeVolume<int16_t>(20, 17, 9, VoxelType::Int16,
+                                            [](int i, int j, int k) { return (i * 7919 + j * 31 + k * 977) % 6001 - 3000; });
+  double a = 0, b = 0;
+  ASSERT_TRUE(s.scalarRange(a, b));
+  Engine e(backend);
+  test::load(e, s, TransferFunction::preset("ramp", a, b), test::builder(BuilderKind::Grid));
+  ASSERT_TRUE(e.valueRange(lo, hi));
+  EXPECT_EQ(lo, a);
+  EXPECT_EQ(hi, b);
+  // An infinity: not known from the brick ranges (the host's finite range is the caller's).
+  const Volume f = test::makeVolume<float>(16, 16, 16, VoxelType::Float32, [](int i, int j, int k) {
+    return i == 5 && j == 6 && k == 7 ? INFINITY : float(i + j + k) / 45.f;
+  });
+  Engine g(backend);
+  test::load(g, f, TransferFunction::preset("ramp", 0, 1), test::builder(BuilderKind::Grid));
+  EXPECT_FALSE(g.valueRange(lo, hi));
+}
+}  // namespace
+
+TEST(TimeSeries, ValueRangeComesFromTheBrickRanges) { expectValueRangeFromBrickRanges(BackendKind::CPU); }
+TEST(TimeSeries, CudaValueRangeComesFromTheBrickRanges) {
+  SKIP_WITHOUT_CUDA();
+  expectValueRangeFromBrickRanges(BackendKind::CUDA);
+}
