@@ -153,7 +153,7 @@ fi
 cxx=$src/VTKModule/Testing/Cxx/CMakeLists.txt
 testnames=$(sed -n '/vtk_add_test_cxx/,/)/p' "$cxx" | grep -oE 'Test[A-Za-z0-9]+\.cxx(,NO_VALID)?')
 run_tests() {  # BACKEND LOGNAME [WINDOW] (BACKEND "asis": each test's own Backend setting;
-  # WINDOW "egl": the tests draw into a vtkGenericOpenGLRenderWindow on an EGL pbuffer)
+  # WINDOW "egl": the tests draw into an EGL window: SpaceSkipEglWindow.h)
   local be=$1 name=$2 win=${3:-x} pass=0 fail=0 skip=0 ongpu=0 t exe valid rc env=()
   mkdir -p "$work/tmp-$be-$win" "$work/data"
   for t in $testnames; do
@@ -168,7 +168,7 @@ run_tests() {  # BACKEND LOGNAME [WINDOW] (BACKEND "asis": each test's own Backe
     cat "$work/one.log" >> "$work/$name"
     grep -q "image on the GPU" "$work/one.log" && ongpu=$((ongpu + 1))
     case $rc in 0) pass=$((pass + 1)) ;; 125) skip=$((skip + 1)) ;; *) fail=$((fail + 1)) ;; esac
-    echo "==== $exe rc=$rc renderer: $(grep -om1 'GL_RENDERER [^,]*' "$work/one.log")" >> "$work/$name"
+    echo "==== $exe rc=$rc renderer: $(grep -om1 'GL_RENDERER [^,]*' "$work/one.log")$(grep -om1 ' window: .*' <(sed -n 's/^SPACESKIP_TEST_WINDOW=egl: / window: /p' "$work/one.log"))" >> "$work/$name"
     log "  $be $win $exe rc=$rc"
   done
   log "tests $be $win: $pass passed, $fail failed, $skip skipped; $ongpu kept an image on the GPU"
@@ -247,7 +247,7 @@ if has bench-nbody1024 || has bench-nbody2048 || has bench-menger1024 || has ben
   if timeout 60 "$bench" --egl --shape nbody --dims 64 --frames 2 --size 128 --builders Naive --edits 0 \
       > "$work/probe-egl.log" 2>&1 && grep -q "GL_RENDERER.*NVIDIA" "$work/probe-egl.log"; then
     vg+=(--egl)
-    wgl="NVIDIA EGL ($egl_json), vtkGenericOpenGLRenderWindow on a pbuffer"
+    wgl="NVIDIA EGL ($egl_json), $(grep -om1 "[A-Za-z]* on EGL" "$work/probe-egl.log")"
   else
     wgl="the tests' X window ($gl): NVIDIA EGL failed, see probe-egl.log"
   fi

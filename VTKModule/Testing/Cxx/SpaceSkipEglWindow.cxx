@@ -120,6 +120,21 @@ namespace sstest
 {
 vtkSmartPointer<vtkRenderWindow> NewEglWindow(int width, int height, std::string& why)
 {
+#ifdef SPACESKIP_VTK_GLAD
+  // VTK >= 9.4 (glad) has its own EGL window, picked by its object factory at run time
+  // (VTK_DEFAULT_OPENGL_WINDOW): a vtkGenericOpenGLRenderWindow on our own EGL context crashes
+  // there, as glad loads GL through VTK's window and not through the current context.
+  setenv("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow", 1);
+  auto w = vtkSmartPointer<vtkRenderWindow>::New();
+  if (!w || std::strcmp(w->GetClassName(), "vtkEGLRenderWindow") != 0)
+  {
+    why = std::string("this VTK made a ") + (w ? w->GetClassName() : "null") +
+      " for VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow (built without EGL?)";
+    return nullptr;
+  }
+  w->SetSize(width, height);
+  return w;
+#else
   static bool made = false;
   static std::string failure;
   if (!made && failure.empty())
@@ -162,6 +177,7 @@ vtkSmartPointer<vtkRenderWindow> NewEglWindow(int width, int height, std::string
     return nullptr;
   }
   return gw;
+#endif
 }
 
 vtkSmartPointer<vtkRenderWindow> NewTestWindow()
@@ -176,6 +192,7 @@ vtkSmartPointer<vtkRenderWindow> NewTestWindow()
       std::fprintf(stderr, "SPACESKIP_TEST_WINDOW=egl: %s\n", why.c_str());
       std::exit(EXIT_FAILURE);
     }
+    std::fprintf(stderr, "SPACESKIP_TEST_WINDOW=egl: %s\n", w->GetClassName());
     return w;
   }
   return vtkSmartPointer<vtkRenderWindow>::New();

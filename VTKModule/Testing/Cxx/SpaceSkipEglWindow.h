@@ -14,7 +14,8 @@ namespace sstest
 {
 /// A vtkGenericOpenGLRenderWindow of `width` x `height` drawing on the process's EGL context
 /// (made on the first call: an OpenGL 3.2 core context of the first EGL device, on a 2048^2
-/// pbuffer, current for good). nullptr, with the reason in `why`, when EGL is not at hand.
+/// pbuffer, current for good); against VTK >= 9.4 (glad) VTK's own vtkEGLRenderWindow, chosen
+/// through VTK_DEFAULT_OPENGL_WINDOW. nullptr, with the reason in `why`, when EGL is not at hand.
 /// Executables using it must export the GLX interposers defined with it (ENABLE_EXPORTS).
 vtkSmartPointer<vtkRenderWindow> NewEglWindow(int width, int height, std::string& why);
 

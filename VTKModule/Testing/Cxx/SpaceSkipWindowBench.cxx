@@ -602,7 +602,7 @@ int main(int argc, char* argv[])
   const char* glr = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   const char* glv = reinterpret_cast<const char*>(glGetString(GL_VENDOR));
   std::printf("GL_RENDERER %s | GL_VENDOR %s | %s %dx%d%s\n", glr ? glr : "?", glv ? glv : "?",
-    egl ? "vtkGenericOpenGLRenderWindow on an EGL pbuffer" : "X window", size, size,
+    egl ? (std::string(win->GetClassName()) + " on EGL").c_str() : "X window", size, size,
     ogl ? "" : " (not OpenGL?)");
 
   std::ofstream csv;
