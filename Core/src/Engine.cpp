@@ -682,16 +682,25 @@ void Engine::setPiece(const VolumePiece& p) {
 const BuildParams& Engine::buildParams() const { return impl_->build; }
 const RenderParams& Engine::renderParams() const { return impl_->render; }
 
-bool Engine::valueRange(double& lo, double& hi) {
-  Impl& d = *impl_;
-  if (!d.haveVolume || d.volume.components != 1 || d.volume.type == VoxelType::Float64) return false;
+namespace {
+/// Runs `f` on `d`; where the CUDA backend fails (BackendError), falls back to the CPU backend and
+/// runs it again there.
+template <class Impl, class F>
+void withCpuFallback(Impl& d, F f) {
   try {
-    d.uploadIfNeeded();
+    f();
   } catch (const BackendError& e) {
     if (d.backend->kind() != BackendKind::CUDA) throw;
     d.fallBackToCpu(e.what());
-    d.uploadIfNeeded();
+    f();
   }
+}
+}  // namespace
+
+bool Engine::valueRange(double& lo, double& hi) {
+  Impl& d = *impl_;
+  if (!d.haveVolume || d.volume.components != 1 || d.volume.type == VoxelType::Float64) return false;
+  withCpuFallback(d, [&] { d.uploadIfNeeded(); });
   double a = 0, b = 0;
   if (d.valueExponent != 0 || !d.backend->brickValueRange(a, b) || !std::isfinite(a) || !std::isfinite(b) || a > b)
     return false;
@@ -702,13 +711,7 @@ bool Engine::valueRange(double& lo, double& hi) {
 
 void Engine::update() {
   Impl& d = *impl_;
-  try {
-    d.update();
-  } catch (const BackendError& e) {
-    if (d.backend->kind() != BackendKind::CUDA) throw;
-    d.fallBackToCpu(e.what());
-    d.update();
-  }
+  withCpuFallback(d, [&] { d.update(); });
 }
 
 namespace {

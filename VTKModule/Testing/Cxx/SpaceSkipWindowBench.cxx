@@ -371,6 +371,22 @@ std::vector<double> PlaySteps(vtkRenderWindow* win, vtkRenderer* ren, vtkImageDa
   return ms;
 }
 
+// VTK's own GPU ray caster for the same window: same property, sample distance half a voxel
+// (ours), no automatic adjustment, --scatter's blending and reach. It has no switch for early ray
+// termination.
+vtkSmartPointer<vtkGPUVolumeRayCastMapper> NewVtkGpuMapper(
+  vtkImageData* image, int blend, const float scatter[3])
+{
+  auto gpu = vtkSmartPointer<vtkGPUVolumeRayCastMapper>::New();
+  gpu->SetInputData(image);
+  gpu->AutoAdjustSampleDistancesOff();
+  gpu->SetSampleDistance(0.5);
+  gpu->SetBlendMode(blend);
+  gpu->SetVolumetricScatteringBlending(scatter[0]);
+  gpu->SetGlobalIlluminationReach(scatter[1]);
+  return gpu;
+}
+
 // `out` set to the value that `names` gives `m`; false (printing "unknown <what> <m><hint>")
 // where m is none of the names.
 bool Named(const std::string& m, std::initializer_list<std::pair<const char*, int>> names, int& out,
@@ -745,11 +761,7 @@ int main(int argc, char* argv[])
     }
     if (vtkGpu)
     {
-      vtkNew<vtkGPUVolumeRayCastMapper> gpu;
-      gpu->SetInputData(image);
-      gpu->AutoAdjustSampleDistancesOff();
-      gpu->SetSampleDistance(0.5);
-      gpu->SetBlendMode(blend);
+      auto gpu = NewVtkGpuMapper(image, blend, scatter);
       volume->SetMapper(gpu);
       image->GetPointData()->SetScalars(stepArrays[0]);
       Orbit(ren, b, 0, 15);
@@ -904,15 +916,7 @@ int main(int argc, char* argv[])
   mapper->SetTuning(baseTuning);
   if (vtkGpu)
   {
-    // VTK's own GPU ray caster in the same window: same property, sample distance half a voxel
-    // (ours), no automatic adjustment. It has no switch for early ray termination.
-    vtkNew<vtkGPUVolumeRayCastMapper> gpu;
-    gpu->SetInputData(image);
-    gpu->AutoAdjustSampleDistancesOff();
-    gpu->SetSampleDistance(0.5);
-    gpu->SetBlendMode(blend);
-    gpu->SetVolumetricScatteringBlending(scatter[0]);
-    gpu->SetGlobalIlluminationReach(scatter[1]);
+    auto gpu = NewVtkGpuMapper(image, blend, scatter);
     volume->SetMapper(gpu);
     Orbit(ren, b, 0, 15);
     const double first = TimedRender(win);
