@@ -220,17 +220,29 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
     v.data = this->Converted.data();
     this->Borrowed = nullptr;
   }
+  // A time step: a volume of the shape the engine was last given (the engine's other settings,
+  // memory budget and brick size among them, are already those of this view).
+  const bool step = this->HaveVolume && this->LastDims[0] == v.dims.x &&
+    this->LastDims[1] == v.dims.y && this->LastDims[2] == v.dims.z &&
+    this->LastType == static_cast<int>(v.type) && this->LastComponents == v.components;
+  this->LastDims[0] = v.dims.x;
+  this->LastDims[1] = v.dims.y;
+  this->LastDims[2] = v.dims.z;
+  this->LastType = static_cast<int>(v.type);
+  this->LastComponents = v.components;
   engine.setVolume(v);
-  // The table's range: one component from the engine's brick ranges, which it computes where the
-  // voxels land anyway (on the GPU right after the upload; a time step's host pass over its
-  // voxels was up to 60 % of the step: 174 ms of 278 ms for 1024^3 float32 on an H200);
-  // otherwise one parallel pass over the voxels the engine reads (vtkDataArray::GetFiniteRange
-  // was serial here: 267 s for the first frame of a 2048^3 uint8 volume).
+  // The table's range: for a time step of one component from the engine's brick ranges, which
+  // it computes where the voxels land anyway (on the GPU right after the upload; a step's host
+  // pass over its voxels was up to 60 % of the step: 174 ms of 278 ms for 1024^3 float32 on an
+  // H200). A first volume takes one parallel pass over the voxels the engine reads, before the
+  // upload, so that the view's memory budget and brick size (set after this) decide the upload
+  // (vtkDataArray::GetFiniteRange was serial here: 267 s for the first frame of a 2048^3 uint8
+  // volume).
   const auto tRange = std::chrono::steady_clock::now();
   // Dependent components: the colour TF spans component 0's range, the opacity function the
   // last component's (vtkVolumeInputHelper, ColorRangeType/ScalarOpacityRangeType SCALAR).
   if (!(this->Dependent ? v.componentRange(0, this->ScalarRange[0], this->ScalarRange[1])
-                        : (engine.valueRange(this->ScalarRange[0], this->ScalarRange[1]) ||
+                        : ((step && engine.valueRange(this->ScalarRange[0], this->ScalarRange[1])) ||
                             v.scalarRange(this->ScalarRange[0], this->ScalarRange[1]))))
   {
     this->ScalarRange[0] = 0; // no finite value at all: an empty table range
