@@ -385,9 +385,10 @@ public:
   /**
    * Where the last Render() spent its wall time, in seconds (host clocks; GL calls are
    * asynchronous, so the composite time is the texture upload and the draw's submission):
-   * - ScalarRange: the table's range, only when the data changed: for one component (8/16-bit
-   *   integers, float) the engine's upload and brick value ranges, reduced (no pass of its own
-   *   over the voxels; Engine::valueRange), else a pass over the voxels;
+   * - ScalarRange: the table's range, only when the data changed: for a time step (a volume of
+   *   the last one's shape) of one component (8/16-bit integers, float) the engine's upload and
+   *   brick value ranges, reduced (no pass of its own over the voxels; Engine::valueRange),
+   *   else a pass over the voxels;
    * - Update: the engine's upload and value ranges (data changed, where ScalarRange did not do
    *   them), classification (opacity edit) and hierarchy build (see
    *   GetLastBuildSeconds/GetLastClassifySeconds);
