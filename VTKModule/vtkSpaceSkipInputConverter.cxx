@@ -220,17 +220,11 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
     v.data = this->Converted.data();
     this->Borrowed = nullptr;
   }
-  // A time step: a volume of the shape the engine was last given (the engine's other settings,
-  // memory budget and brick size among them, are already those of this view).
-  const bool step = this->HaveVolume && this->LastDims[0] == v.dims.x &&
-    this->LastDims[1] == v.dims.y && this->LastDims[2] == v.dims.z &&
-    this->LastType == static_cast<int>(v.type) && this->LastComponents == v.components;
-  this->LastDims[0] = v.dims.x;
-  this->LastDims[1] = v.dims.y;
-  this->LastDims[2] = v.dims.z;
-  this->LastType = static_cast<int>(v.type);
-  this->LastComponents = v.components;
+  // A time step, as the engine counts one (a volume of the last one's shape: the engine's other
+  // settings, memory budget and brick size among them, are already those of this view).
+  const int steps = engine.counters().timeSteps;
   engine.setVolume(v);
+  const bool step = engine.counters().timeSteps > steps;
   // The table's range: for a time step of one component from the engine's brick ranges, which
   // it computes where the voxels land anyway (on the GPU right after the upload; a step's host
   // pass over its voxels was up to 60 % of the step: 174 ms of 278 ms for 1024^3 float32 on an

@@ -91,11 +91,6 @@ private:
   vtkMTimeType InputMTime = 0;
   vtkMTimeType ScalarsMTime = 0;
   bool HaveVolume = false;
-  // The shape of the volume last given (dims, voxel type, components): the next one of the same
-  // shape is a time step.
-  long long LastDims[3] = { 0, 0, 0 };
-  int LastType = -1;
-  int LastComponents = 0;
   int Selection = 0; // the component the volume was made from; -1: the magnitude; -2: all
   std::vector<float> Converted; // int/long scalars (or a component, the magnitude) as float
   // The array whose voxels the engine borrows: held so it outlives the engine's use of it.

@@ -168,7 +168,7 @@ run_tests() {  # BACKEND LOGNAME [WINDOW] (BACKEND "asis": each test's own Backe
     cat "$work/one.log" >> "$work/$name"
     grep -q "image on the GPU" "$work/one.log" && ongpu=$((ongpu + 1))
     case $rc in 0) pass=$((pass + 1)) ;; 125) skip=$((skip + 1)) ;; *) fail=$((fail + 1)) ;; esac
-    echo "==== $exe rc=$rc renderer: $(grep -om1 'GL_RENDERER [^,]*' "$work/one.log")$(grep -om1 ' window: .*' <(sed -n 's/^SPACESKIP_TEST_WINDOW=egl: / window: /p' "$work/one.log"))" >> "$work/$name"
+    echo "==== $exe rc=$rc renderer: $(grep -om1 'GL_RENDERER [^,]*' "$work/one.log")$(sed -n 's/^SPACESKIP_TEST_WINDOW=egl: / window: /p' "$work/one.log" | head -1)" >> "$work/$name"
     log "  $be $win $exe rc=$rc"
   done
   log "tests $be $win: $pass passed, $fail failed, $skip skipped; $ongpu kept an image on the GPU"

@@ -32,9 +32,9 @@
 #include "spaceskip/Volume.h"
 
 #include <mpi.h>
-#ifdef SPACESKIP_MPI_PIECES_CUDA
 #include "gpu_composite.h"
 
+#ifdef SPACESKIP_MPI_PIECES_CUDA
 #include <cuda_runtime.h>
 #endif
 
@@ -114,15 +114,9 @@ BackendKind backendOf(const std::string& s) {
   return BackendKind::Auto;
 }
 
-/// Premultiplied front-to-back "over": back is added where front leaves light through.
+/// `back` blended behind `acc`, pixel by pixel (gpu_composite.h, as the GPU path's kernel).
 void over(vec4f* acc, const vec4f* back, size_t n) {
-  for (size_t i = 0; i < n; ++i) {
-    const float t = 1.f - acc[i].w;
-    acc[i].x += t * back[i].x;
-    acc[i].y += t * back[i].y;
-    acc[i].z += t * back[i].z;
-    acc[i].w += t * back[i].w;
-  }
+  for (size_t i = 0; i < n; ++i) acc[i] = mpi::behind(acc[i], back[i]);
 }
 
 int to8(float v) { return int(std::lround(std::min(1.f, std::max(0.f, v)) * 255.f)); }
