@@ -27,6 +27,7 @@ inline const char* environmentValue(const char* name) {
 ///   SPACESKIP_RAY_SEGMENTS=N        raySegments (1..16; 0: automatic)
 ///   SPACESKIP_CUDA_PARTS_SHARE=X    partsShare
 ///   SPACESKIP_SUB_MASKS=0           subMasks off
+///   SPACESKIP_DEFER_SHADOWS=0       deferShadows off
 ///   SPACESKIP_SUB_MASK_MAX=N        subMaskMaxSet (0..64)
 ///   SPACESKIP_PART_RANGES=0         partRanges off
 ///   SPACESKIP_DG_CAP=N              distanceCap (1..127)
@@ -46,6 +47,7 @@ inline Tuning tuningFromEnvironment(Tuning t = Tuning{}) {
   if (const char* s = environmentValue("SPACESKIP_RAY_SEGMENTS")) t.raySegments = std::clamp(std::atoi(s), 0, 16);
   if (const char* s = environmentValue("SPACESKIP_CUDA_PARTS_SHARE")) t.partsShare = std::atof(s);
   if (const char* s = environmentValue("SPACESKIP_SUB_MASKS")) t.subMasks = s[0] != '0';
+  if (const char* s = environmentValue("SPACESKIP_DEFER_SHADOWS")) t.deferShadows = s[0] != '0';
   if (const char* s = environmentValue("SPACESKIP_SUB_MASK_MAX")) t.subMaskMaxSet = std::clamp(std::atoi(s), 0, 64);
   if (const char* s = environmentValue("SPACESKIP_PART_RANGES")) t.partRanges = s[0] != '0';
   if (const char* s = environmentValue("SPACESKIP_DG_CAP")) t.distanceCap = std::clamp(std::atoi(s), 1, 127);

@@ -181,7 +181,14 @@ class CudaBackend final : public Backend {
       f.traversal = TraversalKind::Grid;
       f.grid = GridView{nullptr, bdims_, brick_, nullptr, cls_.d_vmin.get(), cls_.d_vmax.get()};
     }
-    if (scatterSkips(f, traversal_)) f.scatter.occ = GridView{d_occ_[cur_].get(), bdims_, brick_};
+    // Shadow rays skip with the finest structure this classification has, whatever the builder
+    // and the frame's own traversal: the parts of sparse bricks where there are masks, and
+    // DistanceGrid's leaps where it made them.
+    if (scatterSkips(f, traversal_)) {
+      const bool masks = cls_.subMasks() && cls_.brickStates();
+      f.scatter.occ = GridView{masks ? cls_.brickStates() : d_occ_[cur_].get(), bdims_, brick_, d_distField_, nullptr,
+                               nullptr, masks ? cls_.subMasks() : nullptr};
+    }
     if (pool_.active() && f.sampling != kSampleTrilinear)
       throw BackendError("nearest and label-map sampling need the whole volume in device memory");
     if (pool_.active())
@@ -238,6 +245,7 @@ class CudaBackend final : public Backend {
     cls_.tuning = t;
   }
   double lastFrameDeviceSeconds() const override { return exec_.lastFrameDeviceSeconds(); }
+  int64_t lastFrameQueuedShadowRays() const override { return exec_.lastFrameQueuedShadowRays(); }
   bool brickValueRange(double& lo, double& hi) override {
     return !pool_.active() && cls_.valueRange(lo, hi, stream_);
   }

@@ -86,6 +86,51 @@ double CudaExecutor::lastFrameDeviceSeconds() const {
   return lastDeviceSeconds_;
 }
 
+int64_t CudaExecutor::lastFrameQueuedShadowRays() const {
+  if (!lastQueueCapacity_) return 0;
+  SS_CUDA_CHECK(cudaEventSynchronize(shadowCounted_));
+  return std::min<int64_t>(*static_cast<const unsigned*>(h_shadowCount_.get()), lastQueueCapacity_);
+}
+
+void CudaExecutor::prepareShadowQueue(FrameView& f, size_t pixels, cudaStream_t stream) {
+  lastQueueCapacity_ = 0;
+  f.scatter.queue = nullptr;
+  f.scatter.queueCount = nullptr;
+  f.scatter.queueCapacity = 0;
+  if (shadowCountPending_ && cudaEventQuery(shadowCounted_) == cudaSuccess) {  // not ready: keep the size
+    shadowNeed_ = *static_cast<const unsigned*>(h_shadowCount_.get());
+    shadowCountPending_ = false;
+  }
+  if (!f.scatter.on || !tuning_.deferShadows) {
+    d_shadowQueue_.release();  // only what a frame needs
+    return;
+  }
+  // One ray a pixel at first; then room for what the last frame offered and a quarter more, at
+  // most 16 a pixel and 512 MiB. A full queue costs no correctness: the rays beyond it are
+  // marched where their samples are.
+  const size_t most = std::min(pixels * 16, (size_t(512) << 20) / sizeof(ShadowRecord));
+  size_t want = d_shadowQueue_.capacity() ? d_shadowQueue_.capacity() : pixels;
+  if (shadowNeed_ > want || shadowNeed_ * 4 < want) want = std::max(pixels / 4, shadowNeed_ + shadowNeed_ / 4);
+  want = std::max<size_t>(1, std::min(want, most));
+  try {
+    if (want != d_shadowQueue_.capacity()) {
+      d_shadowQueue_.release();
+      d_shadowQueue_.reserve(want);
+    }
+    d_shadowCount_.reserve(1);
+    if (!h_shadowCount_.get()) h_shadowCount_.reserve(sizeof(unsigned));
+  } catch (const std::exception&) {  // no room: the shadow rays are marched in place
+    (void)cudaGetLastError();
+    d_shadowQueue_.release();
+    return;
+  }
+  SS_CUDA_CHECK(cudaMemsetAsync(d_shadowCount_.get(), 0, sizeof(unsigned), stream));
+  f.scatter.queue = d_shadowQueue_.get();
+  f.scatter.queueCount = d_shadowCount_.get();
+  f.scatter.queueCapacity = unsigned(d_shadowQueue_.capacity());
+  lastQueueCapacity_ = f.scatter.queueCapacity;
+}
+
 void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, DeviceVolume& vol,
                           const PoolView* pool, Image& out, cudaStream_t stream) {
   const size_t pixels = size_t(f.width) * size_t(f.height);
@@ -119,6 +164,7 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   const unsigned bx = shaped ? unsigned(tuning_.blockX) : 16u, by = shaped ? unsigned(tuning_.blockY) : 8u;
   const dim3 block(bx, by);
   const dim3 grid(unsigned((f.width + bx - 1) / bx), unsigned((f.height + by - 1) / by));
+  prepareShadowQueue(f, pixels, stream);
   SS_CUDA_CHECK(cudaEventRecord(ev0_, stream));
   const Volume& v = vol.volume();
   if (pool) {  // sparse residency: the resident bricks, exact sampling
@@ -149,6 +195,12 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   }
   SS_CUDA_CHECK_LAUNCH(renderKernel);
   SS_CUDA_CHECK(injectedRenderError());
+  if (f.scatter.queue) {  // how many rays the frame offered, for the next frame's queue
+    SS_CUDA_CHECK(cudaMemcpyAsync(h_shadowCount_.get(), d_shadowCount_.get(), sizeof(unsigned), cudaMemcpyDeviceToHost,
+                                  stream));
+    SS_CUDA_CHECK(cudaEventRecord(shadowCounted_, stream));
+    shadowCountPending_ = true;
+  }
   // A segmented frame's layers (launch) are composited into d_image_ here, or, when the image
   // stays on the device, when someone asks for d_image_ (deviceImage()): the CUDA blend into a
   // window reads the layers themselves (deviceImageView()), which spares writing and reading the

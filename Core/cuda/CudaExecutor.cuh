@@ -47,12 +47,21 @@ class CudaExecutor {
   /// The last frame's kernel time (CUDA events). A frame left on the device is not waited for by
   /// render(): this waits for it, the first time it is asked.
   double lastFrameDeviceSeconds() const;
+  /// Shadow rays the last frame queued (those its queue held), waiting for the frame.
+  int64_t lastFrameQueuedShadowRays() const;
 
  private:
   /// Queues the composite of layers_ (a segmented frame's, when set) into d_image_ on stream_.
   void compositeLayers() const;
   template <class Sampler>
   void launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes, cudaStream_t stream);
+  /// The frame's queued shadow rays (f.scatter.queue), marched into d_image_ after its kernel.
+  template <class Sampler>
+  void drainShadowQueue(const FrameView& f, const Sampler& s, cudaStream_t stream);
+  /// A shaded frame with scattering (Tuning::deferShadows): the queue for its shadow rays, sized
+  /// from the rays the last frame offered (read without waiting, when its copy is done);
+  /// otherwise (or when it cannot be allocated) none, and its memory given back.
+  void prepareShadowQueue(FrameView& f, size_t pixels, cudaStream_t stream);
 
   Event ev0_, ev1_;
   Tuning tuning_;
@@ -66,6 +75,13 @@ class CudaExecutor {
   DeviceBuffer<float> d_alphaIn_;
   DeviceBuffer<unsigned> d_counts_;
   DeviceBuffer<vec4f> d_image_;
+  DeviceBuffer<ShadowRecord> d_shadowQueue_;  ///< scattering: queued shadow rays (prepareShadowQueue)
+  DeviceBuffer<unsigned> d_shadowCount_;
+  PinnedBuffer h_shadowCount_;                ///< the last frame's count, copied back without a wait
+  Event shadowCounted_;
+  bool shadowCountPending_ = false;
+  size_t shadowNeed_ = 0;                     ///< rays the last counted frame offered
+  unsigned lastQueueCapacity_ = 0;            ///< the last frame's queue (0: none)
   DeviceBuffer<unsigned> d_tileCounter_;
   DeviceBuffer<vec4f> d_layers_;  ///< a segmented frame's layers (raySegments)
   DeviceBuffer<unsigned char> d_layerFlags_;  ///< which layers a segment coloured (1) or left empty (0)

@@ -91,6 +91,22 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
   }
 }
 
+// The second pass of a frame with queued shadow rays (ScatterView::queue, render/Scattering.h
+// scatterShade): each thread marches queued rays, grid-stride, and adds what each lets through
+// to its pixel. The queue's count is on the device, hence a fixed grid.
+template <class Sampler>
+__global__ void shadowQueueKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out) {
+  const unsigned count = *f.scatter.queueCount, n = count < f.scatter.queueCapacity ? count : f.scatter.queueCapacity;
+  for (unsigned i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) {
+    const ShadowRecord r = f.scatter.queue[i];
+    const vec3f c = queuedShadowColour(f, s, r);
+    vec4f* px = out + r.pixel;
+    if (c.x != 0.f) atomicAdd(&px->x, c.x);
+    if (c.y != 0.f) atomicAdd(&px->y, c.y);
+    if (c.z != 0.f) atomicAdd(&px->z, c.z);
+  }
+}
+
 template <class Sampler>
 struct IsPoolSampler : std::false_type {};
 template <class T>
@@ -185,6 +201,7 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
       return;
     }
     k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr, make_int4(0, 0, f.width, f.height), nullptr);
+    drainShadowQueue(f, s, stream);
     return;
   }
   d_tileCounter_.reserve(1);
@@ -193,6 +210,13 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
   const unsigned blocks = std::min(tiles, unsigned(residentBlocks) * unsigned(numSMs_));
   k<<<blocks, block, 0, stream>>>(f, s, d_image_.get(), d_tileCounter_.get(), make_int4(0, 0, f.width, f.height),
                                   nullptr);
+  drainShadowQueue(f, s, stream);
+}
+
+template <class Sampler>
+void CudaExecutor::drainShadowQueue(const FrameView& f, const Sampler& s, cudaStream_t stream) {
+  if (!f.scatter.queue) return;
+  shadowQueueKernel<Sampler><<<unsigned(numSMs_) * 8u, 256, 0, stream>>>(f, s, d_image_.get());
 }
 
 

@@ -70,6 +70,9 @@ class Backend {
   /// Seconds the last render() spent in device work (CUDA events), -1 when not measured. For a
   /// frame left on the device (not waited for by render()) this waits for the frame.
   virtual double lastFrameDeviceSeconds() const { return -1; }
+  /// Shadow rays the last render() queued for its second pass (FrameStats::queuedShadowRays);
+  /// waits for the frame as lastFrameDeviceSeconds does.
+  virtual int64_t lastFrameQueuedShadowRays() const { return 0; }
   /// Measures the host-to-device copy rates with buffers of `bytes` (best of 3 each); zeros
   /// without a device.
   virtual UploadRates measureUpload(size_t /*bytes*/) { return UploadRates{}; }

@@ -26,6 +26,9 @@ struct Tuning {
   /// at most this share of the occupied bricks' parts (CudaBackend.cu; measured in
   /// docs/results/h100-sub-brick-masks).
   double partsShare = 0.2;
+  /// Scattering: shadow rays are queued by the primary rays and marched by a second kernel
+  /// (render/Scattering.h scatterShade); off: each is marched where its sample is.
+  bool deferShadows = true;
 
   // --- classification (both backends) ---
   /// Sub-brick masks: without them an occupied brick is marched whole.

@@ -242,6 +242,8 @@ struct FrameStats {
   double seconds = 0;
   int64_t samples = -1;  ///< samples taken in the frame (RenderParams::countSamples), else -1
   double deviceSeconds = -1;  ///< render kernel time on the GPU (CUDA events), -1 on the CPU
+  /// Scattering on the GPU: shadow rays the frame queued for its second pass (Tuning::deferShadows).
+  int64_t queuedShadowRays = 0;
   std::string backend;
   ResidencyStats residency;
 };

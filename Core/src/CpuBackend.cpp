@@ -140,7 +140,13 @@ class CpuBackend final : public Backend {
       f.grid = GridView{nullptr, ranges_.dims, ranges_.brick, nullptr, ranges_.vmin.data(), ranges_.vmax.data()};
     }
     f.tf = TransferFunctionView{table_.data(), int(table_.size()), tfLo_, tfScale_};
-    if (scatterSkips(f, traversal_)) f.scatter.occ = GridView{occ_.occ.data(), occ_.dims, occ_.brick};
+    // Shadow rays skip with the finest structure this classification has, whatever the builder:
+    // the parts of sparse bricks where there are masks, and DistanceGrid's leaps where it made them.
+    if (scatterSkips(f, traversal_)) {
+      const bool masks = !sub_.mask.empty();
+      f.scatter.occ = GridView{masks ? sub_.state.data() : occ_.occ.data(), occ_.dims, occ_.brick,
+                               dist_.empty() ? nullptr : dist_.data(), nullptr, nullptr, masks ? sub_.mask.data() : nullptr};
+    }
     out.width = f.width;
     out.height = f.height;
     out.rgba.assign(size_t(f.width) * size_t(f.height), vec4f{0, 0, 0, 0});

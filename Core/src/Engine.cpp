@@ -182,6 +182,7 @@ struct Engine::Impl {
     if (deviceSecondsPending) {
       deviceSecondsPending = false;
       frame.deviceSeconds = backend->lastFrameDeviceSeconds();
+      frame.queuedShadowRays = backend->lastFrameQueuedShadowRays();
     }
     return frame.deviceSeconds;
   }

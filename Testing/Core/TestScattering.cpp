@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 using namespace spaceskip;
 
@@ -204,5 +205,43 @@ TEST(Scattering, CudaBuildersEqualNaive) {
     addLights(kit);
     test::expectCudaBuildersEqualNaive(v, tf, head, std::string(shape) + " headlight");
     test::expectCudaBuildersEqualNaive(v, tf, kit, std::string(shape) + " lights");
+  }
+}
+
+TEST(Scattering, CudaQueuedShadowRaysEqualMarchedInPlace) {
+  // On the GPU the primary rays queue their shadow rays and a second kernel marches them
+  // (Tuning::deferShadows, render/Scattering.h scatterShade); the image must be the one of the
+  // rays marched where their samples are, frame after frame (the queue is sized from the last
+  // frame's rays: the first frame may overflow it, and the rays beyond it are marched in place).
+  SKIP_WITHOUT_CUDA();
+  Volume v = generateVolume("nbody", vec3l{64, 61, 67});
+  v.spacing[1] = 0.7;
+  const TransferFunction tf = rampOf(v);
+  RenderParams head = scattering(1.5, 1.0, 0.5), kit = scattering(2.0, 0.6, -0.3);
+  addLights(kit);
+  for (const RenderParams& rp : {head, kit}) {
+    for (BuilderKind k : {BuilderKind::Naive, BuilderKind::DistanceGrid, BuilderKind::KdTreeGPUFast}) {
+      const std::string what = std::string(builderName(k)) + (rp.useLights ? " lights" : " headlight");
+      auto engine = [&](bool defer) {
+        auto e = std::make_unique<Engine>(BackendKind::CUDA);
+        test::load(*e, v, tf, test::builder(k));
+        Tuning t;
+        t.deferShadows = defer;
+        e->setTuning(t);
+        e->setRenderParams(rp);
+        return e;
+      };
+      auto inPlace = engine(false), queued = engine(true);
+      for (int frame = 0; frame < 3; ++frame) {
+        const Camera cam = test::orbit(v, 30 + 10 * frame, 20, true);
+        Image a, b;
+        inPlace->render(cam, 64, 64, a);
+        EXPECT_EQ(inPlace->frameStats().queuedShadowRays, 0) << what;
+        queued->render(cam, 64, 64, b);
+        EXPECT_GT(queued->frameStats().queuedShadowRays, 0) << what << " frame " << frame << ": nothing queued";
+        ASSERT_GT(test::coverage(a), 0.0) << what;
+        EXPECT_LE(compareImages(a, b).maxAbs, 1.f / 255.f) << what << " frame " << frame;
+      }
+    }
   }
 }

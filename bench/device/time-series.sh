@@ -22,14 +22,17 @@ export LD_LIBRARY_PATH=/tmp/c/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 } > "$out/env.txt" 2>&1
 B=/tmp/c/bin
 # Volumetric scattering (issue 34) in the CLI: shading alone, then scattering (SCATTER, default
-# 1,0.5,0), N-body 2048^3 and the dense stand-in rm 1024^3, kernel fps per builder.
+# 1,0.5,0) with its shadow rays queued for a second kernel and (SCATTER_DEFER="1 0") marched in
+# place, N-body 2048^3 and the dense stand-in rm 1024^3 (SCATTER_SPECS), kernel fps per builder.
 if [ "$what" = scatter ]; then
-  for spec in "nbody 2048" "rm 1024"; do
-    set -- $spec
-    for mode in "--shade on" "--scatter ${SCATTER:-1,0.5,0}"; do
-      echo "== spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} --size 1024x1024 --frames 8 $mode" >> "$out/scatter.log"
-      timeout 200 $B/spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} \
-        --size 1024x1024 --frames 8 $mode >> "$out/scatter.log" 2>&1
+  for spec in ${SCATTER_SPECS:-nbody:2048 rm:1024}; do
+    set -- ${spec/:/ }
+    for mode in "--shade on" $(for d in ${SCATTER_DEFER:-1 0}; do echo "defer=$d"; done); do
+      args="--shade on" env=""
+      case $mode in defer=*) args="--scatter ${SCATTER:-1,0.5,0}" env="SPACESKIP_DEFER_SHADOWS=${mode#defer=}";; esac
+      echo "== $env spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} --size 1024x1024 --frames 8 $args" >> "$out/scatter.log"
+      env $env timeout 200 $B/spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} \
+        --size 1024x1024 --frames 8 $args >> "$out/scatter.log" 2>&1
       echo "rc=$?" >> "$out/scatter.log"
     done
   done

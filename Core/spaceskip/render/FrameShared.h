@@ -82,6 +82,17 @@ struct GradientTFView {
   float gradScale[3] = {0.f, 0.f, 0.f};
 };
 
+/// A shadow ray left for later (ScatterView::queue, render/Scattering.h scatterShade): its
+/// start p (index space), its light (towards it in texture units, distance or INFINITY), its
+/// step L and cutoff scale `weight` as shadowTransmittance takes them, and the colour it adds to
+/// pixel `pixel` (row-major) at transmittance 1, the pixel's composite weight included.
+struct ShadowRecord {
+  vec3f p, towardT;
+  float distT, L, weight;
+  vec3f rgb;
+  int pixel;
+};
+
 /// Volumetric shadows and scattering as vtkGPUVolumeRayCastMapper (VTK 9.2) draws them with
 /// VolumetricScatteringBlending > 0, GlobalIlluminationReach and the volume property's
 /// ScatteringAnisotropy (render/Scattering.h). Shadow rays live in VTK's texture space: texture
@@ -104,6 +115,12 @@ struct ScatterView {
   /// The brick occupancy the shadow rays skip with (every builder's classification, no cuts:
   /// VTK's shadow rays ignore cropping and clipping); occ == nullptr: every sample is taken.
   GridView occ{};
+  /// The CUDA executor's shadow queue (nullptr: every shadow ray is marched where its sample
+  /// is): up to queueCapacity records; *queueCount counts the rays offered, those beyond the
+  /// capacity included (they were marched in place), so that the next frame can size it.
+  ShadowRecord* queue = nullptr;
+  unsigned* queueCount = nullptr;
+  unsigned queueCapacity = 0;
 };
 
 /// Everything a pixel needs, plain data (device pointers on the GPU).

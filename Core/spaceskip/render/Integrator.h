@@ -124,6 +124,7 @@ struct IntervalMarcher {
   int isoIndex;      ///< isosurface: the iso interval of the last sample, -1 before the first
   vec3f orgW{0, 0, 0}, dirW{0, 0, 0};  ///< the ray in world space (light list, positional lights)
   float shadowL = 0.f;  ///< scattering: the shadow rays' step, the primary step in texture units
+  int pixel = -1;       ///< scattering: the pixel (row-major), for queued shadow rays
 
   /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
   SS_FUNC bool active(float lo, float hi) const {
@@ -147,8 +148,9 @@ struct IntervalMarcher {
   /// A label map (LabelSampler.h) is lit by the gradient of the sampled label's interpolated
   /// indicator: its border is the surface, whatever the ids of the labels on either side.
   /// With `alpha` >= 0 (the sample's opacity) and FrameView::scatter on, the gradient shading is
-  /// blended with the scattered light (render/Scattering.h) as vtkGPUVolumeRayCastMapper does.
-  SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p, float alpha = -1.f) const {
+  /// blended with the scattered light (render/Scattering.h) as vtkGPUVolumeRayCastMapper does;
+  /// `compW` >= 0, the sample's weight in the pixel's composite, lets its shadow rays be queued.
+  SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p, float alpha = -1.f, float compW = -1.f) const {
     float gx, gy, gz;
     bool done = false;
     if constexpr (IsNearestSampler<Sampler>::value) {
@@ -181,8 +183,8 @@ struct IntervalMarcher {
     if (!(coef > 0.f)) return clamp01(phong);
     const vec3f e = S.eyeIdx - p;
     const vec3f viewU = normalize(vec3f{e.x * S.dirScale.x, e.y * S.dirScale.y, e.z * S.dirScale.z});
-    const vec3f sec = scatteredLight(*f, *s, p, f->useLights ? worldAt(p) : vec3f{0, 0, 0}, viewU, rgb, shadowL, coef);
-    return clamp01(phong * (1.f - coef) + sec * coef);
+    return clamp01(scatterShade(*f, *s, p, f->useLights ? worldAt(p) : vec3f{0, 0, 0}, viewU, rgb, shadowL, coef, phong,
+                                compW, pixel));
   }
   SS_FUNC static vec3f clamp01(vec3f c) {
     return vec3f{ss_clamp(c.x, 0.f, 1.f), ss_clamp(c.y, 0.f, 1.f), ss_clamp(c.z, 0.f, 1.f)};
@@ -284,13 +286,13 @@ struct IntervalMarcher {
 
   /// Front-to-back "over" of classified colour c at sample position p; false: terminate.
   SS_FUNC bool composite(vec4f c, vec3f p) {
+    const float w = (1.f - acc.w) * c.w;
     if (!Plain && f->shade) {
-      vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p, c.w);
+      vec3f rgb = shadeColor(vec3f{c.x, c.y, c.z}, p, c.w, w);
       c.x = rgb.x;
       c.y = rgb.y;
       c.z = rgb.z;
     }
-    float w = (1.f - acc.w) * c.w;
     acc.x += w * c.x;
     acc.y += w * c.y;
     acc.z += w * c.z;
@@ -578,6 +580,7 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py, 
   if (!Plain && f.scatter.on) {  // VTK's g_lengthStep: the primary step in texture units
     const vec3f st = rl.dir * f.dt;
     m.shadowL = length(vec3f{st.x / f.scatter.texN.x, st.y / f.scatter.texN.y, st.z / f.scatter.texN.z});
+    m.pixel = py * f.width + px;
   }
   if (!Plain && f.blend == BlendMode::Slice) {  // no marching: the sample on the plane, if drawn
     float a = tEnter, b = tExit;

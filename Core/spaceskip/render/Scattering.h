@@ -86,7 +86,7 @@ SS_FUNC float shadowTransmittance(const FrameView& f, const Sampler& s, vec3f p,
     intersectBox(sr, inv, vec3f{0, 0, 0}, f.boxHi, i0, i1);
     tGrid = ss_max(L, ss_min(i1, tLast));
     if (tGrid > L) {
-      GridIterT<false> it;
+      GridIterT<true> it;
       it.init(S.occ, sr, inv, L * 0.5f, tGrid);
       const AllBricksActive all;
       for (;;) {
@@ -105,55 +105,116 @@ SS_FUNC float shadowTransmittance(const FrameView& f, const Sampler& s, vec3f p,
   return T;
 }
 
-/// The scattered light at sample p (index space; pw: its origin-relative world position, viewU:
-/// the unit direction towards the eye in unadjusted texture units): per light, transmittance *
-/// phase * attenuation * diffuse * light colour * rgb, plus ambient * the lights' ambient
-/// colour; no N.L and no specular (VTK's secondary contribution). `coef`: the blend
-/// coefficient it will be weighted with (for the cutoff).
+/// One light's share of the scattered light at a sample, before its shadow ray: where the
+/// light is (`towardT`, `distT`, as shadowTransmittance takes them), the colour it adds at
+/// transmittance 1 (phase * attenuation * diffuse * light colour * the sample's colour; no N.L
+/// and no specular: VTK's secondary contribution) and the most it can add (`weight`: the
+/// cutoff's scale, the blend coefficient included).
+struct ScatterLight {
+  vec3f towardT;
+  float distT;
+  vec3f rgb;
+  float weight;
+};
+
+/// Light i's ScatterLight at the sample at pT (adjusted texture units; pw: its origin-relative
+/// world position, viewU: the unit direction towards the eye in unadjusted texture units).
+/// false: the light adds nothing there.
+SS_FUNC bool scatterLight(const FrameView& f, int i, vec3f pT, vec3f pw, vec3f viewU, vec3f rgb, float coef,
+                          ScatterLight& out) {
+  const ScatterView& S = f.scatter;
+  const bool positional = f.useLights ? f.lights[i].positional != 0 : S.headPositional != 0;
+  const vec3f lightDiffuse = f.useLights ? f.lights[i].diffuse : vec3f{1, 1, 1};
+  float phase, atten = 1.f;
+  out.distT = INFINITY;
+  if (positional) {
+    out.towardT = S.lightU[i] - pT;  // VTK mixes the light's unadjusted and the sample's adjusted coordinates
+    out.distT = length(out.towardT);
+    // The default headlight: a point light at the eye, its phase taken for light coming
+    // straight at the viewer (cos = -1), as VTK does.
+    phase = scatterPhase(S.g, f.useLights ? dot(normalize(pT - S.lightU[i]), viewU) : -1.f);
+    if (f.useLights) {
+      const LightView& Lv = f.lights[i];
+      const vec3f d = pw - Lv.pos;
+      const float dist = length(d);
+      atten = 1.f / (Lv.atten.x + Lv.atten.y * dist + Lv.atten.z * dist * dist);
+      if (Lv.cosCone > -2.f) {
+        const float coneDot = dist > 0.f ? dot(d * (1.f / dist), Lv.dir) : 1.f;
+        atten = coneDot >= Lv.cosCone ? atten * powf(coneDot, Lv.exponent) : 0.f;
+      }
+    }
+  } else {
+    out.towardT = S.lightU[i];
+    phase = scatterPhase(S.g, dot(normalize(out.towardT * -1.f), viewU));
+  }
+  const float lightMax = ss_max(lightDiffuse.x, ss_max(lightDiffuse.y, lightDiffuse.z));
+  const float rgbMax = ss_max(rgb.x, ss_max(rgb.y, rgb.z));
+  const float w = phase * atten * f.diffuse;
+  out.rgb = vec3f{rgb.x * lightDiffuse.x, rgb.y * lightDiffuse.y, rgb.z * lightDiffuse.z} * w;
+  out.weight = w * lightMax * rgbMax * coef;
+  return out.weight > 0.f;
+}
+
+/// Offers a shadow ray to the queue (device code only); false: full (or host), march it here.
+SS_FUNC bool pushShadow(const ScatterView& S, const ShadowRecord& r) {
+#ifdef __CUDA_ARCH__
+  // Once full, the count stops growing (but for the rays in flight), so it cannot wrap.
+  if (*static_cast<volatile unsigned*>(S.queueCount) >= S.queueCapacity) return false;
+  const unsigned i = atomicAdd(S.queueCount, 1u);
+  if (i >= S.queueCapacity) return false;
+  S.queue[i] = r;
+  return true;
+#else
+  (void)S;
+  (void)r;
+  return false;
+#endif
+}
+
+/// A shaded sample's colour with scattering, before VTK's clamp: phong * (1 - coef) + coef *
+/// (the lights' ambient colour * ambient + per light its ScatterLight colour * the transmittance
+/// of its shadow ray) (p: index space; pw, viewU: as scatterLight; L: the shadow step).
+/// With a shadow queue (ScatterView::queue: the CUDA executor) and the sample's weight in the
+/// pixel's front-to-back composite `compW` (>= 0), the shadow rays are not marched here: each goes
+/// to the queue with the colour it adds to the pixel at transmittance 1, and a second pass
+/// (queuedShadowColour) marches them in full warps and adds colour * transmittance to the pixel,
+/// instead of the few lanes of a warp whose samples cast a ray marching while the others wait.
+/// The pixel is linear in each transmittance wherever VTK's clamp to [0, 1] cannot act for any
+/// transmittance in [0, 1]; that is checked first, and a sample where it could marches its rays
+/// here. Either way the image is the same (up to the order of float additions).
 /// Out of line on the GPU: inlined, this path (a DDA and a march per light) made every shaded
 /// kernel several times larger and its compilation minutes longer.
 template <class Sampler>
-SS_NOINLINE_FUNC vec3f scatteredLight(const FrameView& f, const Sampler& s, vec3f p, vec3f pw, vec3f viewU, vec3f rgb, float L,
-                             float coef) {
+SS_NOINLINE_FUNC vec3f scatterShade(const FrameView& f, const Sampler& s, vec3f p, vec3f pw, vec3f viewU, vec3f rgb,
+                                    float L, float coef, vec3f phong, float compW, int pixel) {
   const ScatterView& S = f.scatter;
   const vec3f pT{(p.x + 0.5f) / S.texN.x, (p.y + 0.5f) / S.texN.y, (p.z + 0.5f) / S.texN.z};
-  const float rgbMax = ss_max(rgb.x, ss_max(rgb.y, rgb.z));
-  vec3f sum{0, 0, 0};
   const int numLights = f.useLights ? f.numLights : 1;
-  for (int i = 0; i < numLights; ++i) {
-    const bool positional = f.useLights ? f.lights[i].positional != 0 : S.headPositional != 0;
-    const vec3f lightDiffuse = f.useLights ? f.lights[i].diffuse : vec3f{1, 1, 1};
-    vec3f towardT;
-    float distT = INFINITY, phase, atten = 1.f;
-    if (positional) {
-      towardT = S.lightU[i] - pT;  // VTK mixes the light's unadjusted and the sample's adjusted coordinates
-      distT = length(towardT);
-      // The default headlight: a point light at the eye, its phase taken for light coming
-      // straight at the viewer (cos = -1), as VTK does.
-      phase = scatterPhase(S.g, f.useLights ? dot(normalize(pT - S.lightU[i]), viewU) : -1.f);
-      if (f.useLights) {
-        const LightView& Lv = f.lights[i];
-        const vec3f d = pw - Lv.pos;
-        const float dist = length(d);
-        atten = 1.f / (Lv.atten.x + Lv.atten.y * dist + Lv.atten.z * dist * dist);
-        if (Lv.cosCone > -2.f) {
-          const float coneDot = dist > 0.f ? dot(d * (1.f / dist), Lv.dir) : 1.f;
-          atten = coneDot >= Lv.cosCone ? atten * powf(coneDot, Lv.exponent) : 0.f;
-        }
-      }
-    } else {
-      towardT = S.lightU[i];
-      phase = scatterPhase(S.g, dot(normalize(towardT * -1.f), viewU));
+  vec3f c = phong * (1.f - coef);
+  if (f.useLights) c = c + f.lightAmbient * (f.ambient * coef);
+  bool defer = S.queue != nullptr && compW >= 0.f && pixel >= 0;
+  if (defer) {  // the brightest the sample can get: no channel may need the clamp
+    vec3f hi = c;
+    for (int i = 0; i < numLights; ++i) {
+      ScatterLight l;
+      if (scatterLight(f, i, pT, pw, viewU, rgb, coef, l)) hi = hi + l.rgb * coef;
     }
-    const float lightMax = ss_max(lightDiffuse.x, ss_max(lightDiffuse.y, lightDiffuse.z));
-    const float w = phase * atten * f.diffuse;
-    const float weight = w * lightMax * rgbMax * coef;
-    if (!(weight > 0.f)) continue;
-    const float T = shadowTransmittance(f, s, p, towardT, distT, L, weight);
-    sum = sum + vec3f{rgb.x * lightDiffuse.x, rgb.y * lightDiffuse.y, rgb.z * lightDiffuse.z} * (w * T);
+    defer = hi.x <= 1.f && hi.y <= 1.f && hi.z <= 1.f && c.x >= 0.f && c.y >= 0.f && c.z >= 0.f;
   }
-  if (f.useLights) sum = sum + f.lightAmbient * f.ambient;
-  return sum;
+  for (int i = 0; i < numLights; ++i) {
+    ScatterLight l;
+    if (!scatterLight(f, i, pT, pw, viewU, rgb, coef, l)) continue;
+    if (defer && pushShadow(S, ShadowRecord{p, l.towardT, l.distT, L, l.weight, l.rgb * (coef * compW), pixel}))
+      continue;
+    c = c + l.rgb * (coef * shadowTransmittance(f, s, p, l.towardT, l.distT, L, l.weight));
+  }
+  return c;
+}
+
+/// What a queued shadow ray adds to its pixel (the second pass of scatterShade's queue).
+template <class Sampler>
+SS_FUNC vec3f queuedShadowColour(const FrameView& f, const Sampler& s, const ShadowRecord& r) {
+  return r.rgb * shadowTransmittance(f, s, r.p, r.towardT, r.distT, r.L, r.weight);
 }
 
 /// Whether a frame's shadow rays skip over the brick occupancy (ScatterView::occ): every builder
