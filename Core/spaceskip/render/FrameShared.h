@@ -113,7 +113,9 @@ struct ScatterView {
   int headPositional = 1;       ///< the headlight model: 1: a point light at the eye; 0: directional
   vec3f eyeIdx{0, 0, 0};        ///< the eye in index space (the view direction of the phase function)
   /// The brick occupancy the shadow rays skip with (every builder's classification, no cuts:
-  /// VTK's shadow rays ignore cropping and clipping); occ == nullptr: every sample is taken.
+  /// VTK's shadow rays ignore cropping and clipping), with the sub-brick masks (brick states
+  /// in occ, masks in sub) and DistanceGrid's field (dist) where there are; occ == nullptr:
+  /// every sample is taken.
   GridView occ{};
   /// The CUDA executor's shadow queue (nullptr: every shadow ray is marched where its sample
   /// is): up to queueCapacity records; *queueCount counts the rays offered, those beyond the

@@ -5,10 +5,12 @@
 // divided by 4 pi), and it is blended with the gradient (Phong) shading by a coefficient of
 // VolumetricScatteringBlending, the sample's opacity and its gradient magnitude.
 // Unlike VTK's, the shadow rays skip empty space: a DDA over the brick occupancy the primary rays'
-// classification made (a brick it calls empty holds no sample of non-zero opacity, so skipping it
-// multiplies the transmittance by exactly 1), and they stop once their light can no longer
-// change the colour by ScatterView::cutoff. Both hold for the naive shadow march as well, so every
-// builder gives the image of Naive.
+// classification made, walking the set parts of sparse bricks and leaping with DistanceGrid's
+// field where there are (a brick or part it calls empty holds no sample of non-zero opacity, so
+// skipping it multiplies the transmittance by exactly 1), and they stop once their light can no
+// longer change the colour by ScatterView::cutoff. Both hold for the naive shadow march as well,
+// so every builder gives the image of Naive. On the GPU the primary rays queue their shadow rays
+// for a second kernel (scatterShade), which gives the same image.
 #pragma once
 #include "FrameShared.h"
 #include "Traversal.h"
