@@ -27,12 +27,12 @@ B=/tmp/c/bin
 if [ "$what" = scatter ]; then
   for spec in ${SCATTER_SPECS:-nbody:2048 rm:1024}; do
     set -- ${spec/:/ }
-    for mode in "--shade on" $(for d in ${SCATTER_DEFER:-1 0}; do echo "defer=$d"; done); do
+    for mode in shade ${SCATTER_DEFER:-1 0}; do  # shading alone, then scattering per queue setting
       args="--shade on" env=""
-      case $mode in defer=*) args="--scatter ${SCATTER:-1,0.5,0}" env="SPACESKIP_DEFER_SHADOWS=${mode#defer=}";; esac
-      echo "== $env spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} --size 1024x1024 --frames 8 $args" >> "$out/scatter.log"
-      env $env timeout 200 $B/spaceskip bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} \
-        --size 1024x1024 --frames 8 $args >> "$out/scatter.log" 2>&1
+      [ "$mode" = shade ] || { args="--scatter ${SCATTER:-1,0.5,0}"; env="SPACESKIP_DEFER_SHADOWS=$mode"; }
+      cmd="bench gen:$1:$2 --backend cuda --builders ${SCATTER_BUILDERS:-auto,grid,distance-grid} --size 1024x1024 --frames 8 $args"
+      echo "== $env spaceskip $cmd" >> "$out/scatter.log"
+      env $env timeout 200 $B/spaceskip $cmd >> "$out/scatter.log" 2>&1
       echo "rc=$?" >> "$out/scatter.log"
     done
   done
