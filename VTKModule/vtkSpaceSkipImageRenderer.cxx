@@ -1,9 +1,11 @@
 // vtkSpaceSkipImageRenderer: one vtkImageData through the engine into the window.
 #include "vtkSpaceSkipImageRenderer.h"
 
+#include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkLogger.h"
 #include "vtkOpenGLCamera.h"
+#include "vtkPointData.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkOpenGLShaderCache.h"
 #include "vtkOpenGLState.h"
@@ -242,9 +244,24 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
   WindowState window(renWin, this->Callouts);
   // Input conversion, first half: what to draw, or why nothing.
   std::string problem;
+  // A second array as the 2-D transfer function's y axis, where one is used (TF_2D with a
+  // table): a point array of the input, as vtkGPUVolumeRayCastMapper reads its
+  // Transfer2DYAxisArray.
+  vtkDataArray* yAxis = nullptr;
+  if (!s.Transfer2DYAxisArray.empty() && input &&
+    vtkSpaceSkipPropertyTranslator::Usable2D(vol->GetProperty()))
+  {
+    yAxis = input->GetPointData()->GetArray(s.Transfer2DYAxisArray.c_str());
+    if (!yAxis)
+    {
+      this->Warn("the 2-D transfer function's y-axis array '" + s.Transfer2DYAxisArray +
+        "' is not a point array of the input; the gradient magnitude is the y axis");
+    }
+  }
   if (!this->Input.Select(input, scalars, cellFlag, s.VectorMode, s.VectorComponent,
         vol->GetProperty()->GetIndependentComponents() != 0,
-        s.EffectiveBlendMode() == vtkVolumeMapper::COMPOSITE_BLEND, this->Warn, problem))
+        s.EffectiveBlendMode() == vtkVolumeMapper::COMPOSITE_BLEND, this->Warn, problem, yAxis,
+        s.Transfer2DYAxisComponent))
   {
     this->Fail(problem);
     return false;
@@ -266,7 +283,8 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
       : s.WholeScalarRange[0] <= s.WholeScalarRange[1] ? s.WholeScalarRange
                                                          : this->Input.GetScalarRange();
     this->Properties.UpdateTransferFunction(engine, vol->GetProperty(), range,
-      this->Input.GetOpacityRange(), this->Input.GetOpacityComponent());
+      this->Input.GetOpacityRange(), this->Input.GetOpacityComponent(),
+      this->Input.GetSecondAxis());
     this->Properties.UpdateParameters(engine, s, ren, vol, range, this->Warn);
     const spaceskip::Camera camera = vtkSpaceSkipPropertyTranslator::ToCamera(ren, cam, vol);
     int width, height, x0, y0;

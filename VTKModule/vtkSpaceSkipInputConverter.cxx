@@ -60,9 +60,10 @@ bool ConvertibleToFloat(int vtkType)
   }
 }
 
-// The selected component (or the magnitude) of every tuple, as float, in parallel; all
-// components (interleaved) when `component` < 0.
-void ConvertToFloat(vtkDataArray* scalars, bool magnitude, int component, float* out)
+// The selected component (or the magnitude) of every tuple, as float, in parallel, tuple i at
+// out[i * stride]; all components (interleaved) when `component` < 0.
+void ConvertToFloat(
+  vtkDataArray* scalars, bool magnitude, int component, float* out, vtkIdType stride = 1)
 {
   const int ncomp = scalars->GetNumberOfComponents();
   if (component < 0)
@@ -90,11 +91,11 @@ void ConvertToFloat(vtkDataArray* scalars, bool magnitude, int component, float*
         {
           m += c * c;
         }
-        out[i] = static_cast<float>(std::sqrt(m));
+        out[i * stride] = static_cast<float>(std::sqrt(m));
       }
       else
       {
-        out[i] = static_cast<float>(scalars->GetComponent(i, component));
+        out[i * stride] = static_cast<float>(scalars->GetComponent(i, component));
       }
     }
   });
@@ -104,7 +105,7 @@ void ConvertToFloat(vtkDataArray* scalars, bool magnitude, int component, float*
 //------------------------------------------------------------------------------
 bool vtkSpaceSkipInputConverter::Select(vtkImageData* input, vtkDataArray* scalars, int cellFlag,
   int vectorMode, int vectorComponent, bool independentComponents, bool composite,
-  const WarnFunction& warnOnce, std::string& problem)
+  const WarnFunction& warnOnce, std::string& problem, vtkDataArray* yAxis, int yComponent)
 {
   this->Input = input;
   this->Scalars = scalars;
@@ -167,6 +168,37 @@ bool vtkSpaceSkipInputConverter::Select(vtkImageData* input, vtkDataArray* scala
       "to float): nothing drawn";
     return false;
   }
+  // A second array as the 2-D transfer function's y axis: the drawn value and that array's
+  // component become the engine's two components (Update). The 2-D table is composite only.
+  this->SecondAxis = false;
+  this->YAxis = nullptr;
+  if (yAxis && composite)
+  {
+    const std::string name = yAxis->GetName() ? yAxis->GetName() : "";
+    const std::string fallback = "; the gradient magnitude is the y axis";
+    const int ytype = yAxis->GetDataType();
+    if (ncomp > 1 && !independentComponents)
+    {
+      warnOnce("a second array ('" + name + "') as the 2-D transfer function's y axis is not "
+        "supported with dependent components" + fallback);
+    }
+    else if (yAxis->GetNumberOfTuples() != input->GetNumberOfPoints())
+    {
+      warnOnce("the 2-D transfer function's y-axis array '" + name +
+        "' does not have one value per point" + fallback);
+    }
+    else if (!CoreTypeOf(ytype, vtype) && !ConvertibleToFloat(ytype))
+    {
+      warnOnce("the 2-D transfer function's y-axis array '" + name + "' is of type " +
+        yAxis->GetDataTypeAsString() + ", which is not supported" + fallback);
+    }
+    else
+    {
+      this->SecondAxis = true;
+      this->YAxis = yAxis;
+      this->YComponent = std::min(std::max(yComponent, 0), yAxis->GetNumberOfComponents() - 1);
+    }
+  }
   return true;
 }
 
@@ -176,9 +208,11 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   vtkImageData* input = this->Input;
   vtkDataArray* scalars = this->Scalars;
   const int selection = this->Dependent ? -2 : (this->Magnitude ? -1 : this->Component);
+  vtkDataArray* yAxis = this->SecondAxis ? this->YAxis : nullptr;
   if (this->HaveVolume && this->InputKey == input && this->InputMTime == input->GetMTime() &&
     this->ScalarsKey == scalars && this->ScalarsMTime == scalars->GetMTime() &&
-    this->Selection == selection)
+    this->Selection == selection && this->YAxisKey == yAxis &&
+    (!yAxis || (this->YAxisMTime == yAxis->GetMTime() && this->YAxisComponent == this->YComponent)))
   {
     return 0.0;
   }
@@ -196,7 +230,18 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   spaceskip::VoxelType vtype = spaceskip::VoxelType::Float32;
   const bool native = CoreTypeOf(scalars->GetDataType(), vtype);
   v.components = this->Dependent ? this->NumberOfComponents : 1;
-  if (native && (this->NumberOfComponents == 1 || this->Dependent) &&
+  if (yAxis)
+  {
+    // The drawn value and the y axis's value, interleaved as float (the engine's two components).
+    v.components = 2;
+    this->Converted.resize(static_cast<size_t>(input->GetNumberOfPoints()) * 2);
+    ConvertToFloat(scalars, this->Magnitude, this->Component, this->Converted.data(), 2);
+    ConvertToFloat(yAxis, false, this->YComponent, this->Converted.data() + 1, 2);
+    v.type = spaceskip::VoxelType::Float32;
+    v.data = this->Converted.data();
+    this->Borrowed = nullptr;
+  }
+  else if (native && (this->NumberOfComponents == 1 || this->Dependent) &&
     scalars->HasStandardMemoryLayout())
   {
     // Borrowed as it is: dependent components stay interleaved, no copy.
@@ -234,15 +279,17 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   // volume).
   const auto tRange = std::chrono::steady_clock::now();
   // Dependent components: the colour TF spans component 0's range, the opacity function the
-  // last component's (vtkVolumeInputHelper, ColorRangeType/ScalarOpacityRangeType SCALAR).
-  if (!(this->Dependent ? v.componentRange(0, this->ScalarRange[0], this->ScalarRange[1])
+  // last component's (vtkVolumeInputHelper, ColorRangeType/ScalarOpacityRangeType SCALAR). A
+  // second axis: the 2-D table's rows span its component's range.
+  const bool two = this->Dependent || yAxis;
+  if (!(two ? v.componentRange(0, this->ScalarRange[0], this->ScalarRange[1])
                         : ((step && engine.valueRange(this->ScalarRange[0], this->ScalarRange[1])) ||
                             v.scalarRange(this->ScalarRange[0], this->ScalarRange[1]))))
   {
     this->ScalarRange[0] = 0; // no finite value at all: an empty table range
     this->ScalarRange[1] = 1;
   }
-  if (this->Dependent &&
+  if (two &&
     !v.componentRange(v.components - 1, this->OpacityRange[0], this->OpacityRange[1]))
   {
     this->OpacityRange[0] = 0;
@@ -254,6 +301,9 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   this->InputMTime = input->GetMTime();
   this->ScalarsKey = scalars;
   this->ScalarsMTime = scalars->GetMTime();
+  this->YAxisKey = yAxis;
+  this->YAxisMTime = yAxis ? yAxis->GetMTime() : 0;
+  this->YAxisComponent = this->YComponent;
   this->HaveVolume = true;
   return seconds;
 }
@@ -261,8 +311,8 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
 //------------------------------------------------------------------------------
 void vtkSpaceSkipInputConverter::Reset()
 {
-  this->InputKey = this->ScalarsKey = nullptr;
-  this->InputMTime = this->ScalarsMTime = 0;
+  this->InputKey = this->ScalarsKey = this->YAxisKey = nullptr;
+  this->InputMTime = this->ScalarsMTime = this->YAxisMTime = 0;
   this->HaveVolume = false;
   this->Borrowed = nullptr;
 }

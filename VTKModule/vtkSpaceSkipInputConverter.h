@@ -32,10 +32,15 @@ public:
    * value + opacity value, 4: RGB + opacity value). Other dependent cases are said once and
    * drawn as the selected component. False, with `problem` set, when nothing can be drawn (no
    * image, empty extent, no point scalars, wrong length, unsupported type).
+   * `yAxis` (with composite blending and one drawn component): a second point array whose
+   * component `yComponent` is the 2-D transfer function's y axis (vtkGPUVolumeRayCastMapper's
+   * Transfer2DYAxisArray); the engine then gets two float components, the drawn value and
+   * that one. Where it cannot be used (dependent components, another length or type) it is
+   * said once and the gradient magnitude stays the y axis.
    */
   bool Select(vtkImageData* input, vtkDataArray* scalars, int cellFlag, int vectorMode,
     int vectorComponent, bool independentComponents, bool composite, const WarnFunction& warnOnce,
-    std::string& problem);
+    std::string& problem, vtkDataArray* yAxis = nullptr, int yComponent = 0);
 
   /**
    * Hands the selected volume to the engine when the data, the array or the component changed
@@ -50,10 +55,16 @@ public:
   const double* GetScalarRange() const { return this->ScalarRange; }
 
   /// Dependent components: the finite range of the opacity component (the last), over which
-  /// the scalar opacity function is sampled; nullptr otherwise.
-  const double* GetOpacityRange() const { return this->Dependent ? this->OpacityRange : nullptr; }
+  /// the scalar opacity function is sampled; with a second array as the 2-D transfer
+  /// function's y axis, that array's range (its rows span it); nullptr otherwise.
+  const double* GetOpacityRange() const
+  {
+    return this->Dependent || this->SecondAxis ? this->OpacityRange : nullptr;
+  }
   /// Dependent components: the opacity component's index (its unit distance is used, as VTK's).
   int GetOpacityComponent() const { return this->Dependent ? this->NumberOfComponents - 1 : 0; }
+  /// A second array is the 2-D transfer function's y axis this frame (Select's `yAxis`).
+  bool GetSecondAxis() const { return this->SecondAxis; }
 
   /**
    * The cells of `image` its vtkGhostType cell array does not mark as duplicates of another
@@ -84,12 +95,18 @@ private:
   bool Magnitude = false;
   int Component = 0;
   bool Dependent = false; // all components, vtkGPUVolumeRayCastMapper's dependent modes
+  bool SecondAxis = false; // the drawn component + YAxis's component YComponent
+  vtkDataArray* YAxis = nullptr;
+  int YComponent = 0;
 
   // What the engine was last given; compared by identity and MTime to redo only what changed.
   const void* InputKey = nullptr;
   const void* ScalarsKey = nullptr;
   vtkMTimeType InputMTime = 0;
   vtkMTimeType ScalarsMTime = 0;
+  const void* YAxisKey = nullptr; // the second axis's array, component and MTime
+  int YAxisComponent = 0;
+  vtkMTimeType YAxisMTime = 0;
   bool HaveVolume = false;
   int Selection = 0; // the component the volume was made from; -1: the magnitude; -2: all
   std::vector<float> Converted; // int/long scalars (or a component, the magnitude) as float

@@ -64,9 +64,10 @@ spaceskip::mat4 ToCore(const vtkMatrix4x4* m)
   return out;
 }
 
-// The property's 2-D transfer function when vtkGPUVolumeRayCastMapper would use it: TF_2D mode
-// and an image of 4-component scalars, one slice deep (ParaView's vtkPVTransferFunction2D).
-vtkImageData* Usable2D(vtkVolumeProperty* prop)
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkImageData* vtkSpaceSkipPropertyTranslator::Usable2D(vtkVolumeProperty* prop)
 {
   if (prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_2D)
   {
@@ -84,12 +85,11 @@ vtkImageData* Usable2D(vtkVolumeProperty* prop)
     int64_t(dims[0]) * dims[1] <= (int64_t(1) << 24) && a->GetNumberOfTuples() == vtkIdType(dims[0]) * dims[1];
   return ok ? img : nullptr;
 }
-} // namespace
 
 //------------------------------------------------------------------------------
 void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& engine,
   vtkVolumeProperty* prop, const double scalarRange[2], const double* opacityRange,
-  int opacityComponent)
+  int opacityComponent, bool secondAxis)
 {
   const bool gray = prop->GetColorChannels(0) == 1;
   vtkObject* color = gray ? static_cast<vtkObject*>(prop->GetGrayTransferFunction(0))
@@ -127,7 +127,8 @@ void vtkSpaceSkipPropertyTranslator::UpdateTransferFunction(spaceskip::Engine& e
   // GetStoredGradientOpacity both create a default function on the user's property, which then
   // turns gradient opacity on for every other mapper drawing with it (vtkSmartVolumeMapper drew
   // nothing on TestSpaceSkippingVolumeComponents after ours had created one).
-  vtkImageData* table2D = opacityRange ? nullptr : Usable2D(prop);
+  // With a second array as its y axis (`secondAxis`) the 2-D table reads two components.
+  vtkImageData* table2D = opacityRange && !secondAxis ? nullptr : Usable2D(prop);
   vtkPiecewiseFunction* gradient = opacityRange || prop->GetTransferFunctionMode() != vtkVolumeProperty::TF_1D ||
       !prop->HasGradientOpacity(0) || prop->GetDisableGradientOpacity(0)
     ? nullptr

@@ -59,9 +59,17 @@ public:
    * (vtkVolumeInputHelper::UpdateOpacityTransferFunction). One-component volumes also get the
    * property's 2-D transfer function (TF_2D mode) or its gradient opacity (1-D mode, unless
    * disabled), as vtkGPUVolumeRayCastMapper reads them; an edit of either re-classifies.
+   * `secondAxis`: the volume's two components are the 2-D table's x and y values (a second
+   * array as its y axis, over `opacityRange`), so the 2-D table is given with them.
    */
   void UpdateTransferFunction(spaceskip::Engine& engine, vtkVolumeProperty* prop,
-    const double scalarRange[2], const double* opacityRange = nullptr, int opacityComponent = 0);
+    const double scalarRange[2], const double* opacityRange = nullptr, int opacityComponent = 0,
+    bool secondAxis = false);
+
+  /// The property's 2-D transfer function when vtkGPUVolumeRayCastMapper would use it: TF_2D
+  /// mode and an image of 4-component scalars, one slice deep (ParaView's
+  /// vtkPVTransferFunction2D); else nullptr.
+  static vtkImageData* Usable2D(vtkVolumeProperty* prop);
 
   /**
    * Gives the engine the build parameters and the render parameters of `settings` (its

@@ -36,6 +36,8 @@ struct vtkSpaceSkipSettings
   vtkIdType DeviceMemoryBudget = 0;
   int VectorMode = 1;
   int VectorComponent = 0;
+  std::string Transfer2DYAxisArray; // empty: none
+  int Transfer2DYAxisComponent = 0;
   int BlendModeOverride = -1;
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   double WholeOrigin[3] = { 0, 0, 0 };
@@ -81,6 +83,8 @@ struct vtkSpaceSkipSettings
     s.DeviceMemoryBudget = m->GetDeviceMemoryBudget();
     s.VectorMode = m->GetVectorMode();
     s.VectorComponent = m->GetVectorComponent();
+    s.Transfer2DYAxisArray = m->GetTransfer2DYAxisArray() ? m->GetTransfer2DYAxisArray() : "";
+    s.Transfer2DYAxisComponent = m->GetTransfer2DYAxisComponent();
     s.BlendModeOverride = m->GetBlendModeOverride();
     m->GetWholeExtent(s.WholeExtent);
     m->GetWholeOrigin(s.WholeOrigin);
@@ -134,6 +138,8 @@ struct vtkSpaceSkipSettings
     to->SetLabelEdits(s.LabelEdits);
     to->SetVectorMode(s.VectorMode);
     to->SetVectorComponent(s.VectorComponent);
+    to->SetTransfer2DYAxisArray(s.Transfer2DYAxisArray.empty() ? nullptr : s.Transfer2DYAxisArray.c_str());
+    to->SetTransfer2DYAxisComponent(s.Transfer2DYAxisComponent);
     to->SetBlendModeOverride(s.BlendModeOverride);
     to->SetBlendMode(s.BlendMode);
     to->SetAverageIPScalarRange(s.AverageIPScalarRange[0], s.AverageIPScalarRange[1]);

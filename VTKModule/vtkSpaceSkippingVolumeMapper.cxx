@@ -300,7 +300,10 @@ vtkSpaceSkippingVolumeMapper::vtkSpaceSkippingVolumeMapper()
   : Internals(new vtkInternals(this))
 {
 }
-vtkSpaceSkippingVolumeMapper::~vtkSpaceSkippingVolumeMapper() = default;
+vtkSpaceSkippingVolumeMapper::~vtkSpaceSkippingVolumeMapper()
+{
+  this->SetTransfer2DYAxisArray(nullptr);
+}
 
 //------------------------------------------------------------------------------
 const char* vtkSpaceSkippingVolumeMapper::GetBuilderAsString()
@@ -829,6 +832,9 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DeviceMemoryBudget: " << this->DeviceMemoryBudget << " MiB\n";
   os << indent << "VectorMode: " << this->VectorMode << "\n";
   os << indent << "VectorComponent: " << this->VectorComponent << "\n";
+  os << indent << "Transfer2DYAxisArray: "
+     << (this->Transfer2DYAxisArray ? this->Transfer2DYAxisArray : "(none)") << "\n";
+  os << indent << "Transfer2DYAxisComponent: " << this->Transfer2DYAxisComponent << "\n";
   os << indent << "BlendModeOverride: " << this->BlendModeOverride << "\n";
   this->Internals->Statistics(true).Print(os, indent);
 }

@@ -321,6 +321,22 @@ public:
 
   ///@{
   /**
+   * A second point array as the y axis of the volume property's 2-D transfer function
+   * (vtkGPUVolumeRayCastMapper::SetTransfer2DYAxisArray; ParaView: Use Transfer 2D with Use
+   * Gradient For Transfer 2D off and a Color Array 2): the table is read at (the drawn value,
+   * component Transfer2DYAxisComponent of this array), each normalised over its own range, and a
+   * brick is skipped when its values of this array reach no row of the table with opacity.
+   * nullptr (default): the gradient magnitude is the y axis. Composite blending of one drawn
+   * component; the two values are drawn as float (8 bytes a voxel).
+   */
+  vtkSetStringMacro(Transfer2DYAxisArray);
+  vtkGetStringMacro(Transfer2DYAxisArray);
+  vtkSetClampMacro(Transfer2DYAxisComponent, int, 0, VTK_INT_MAX);
+  vtkGetMacro(Transfer2DYAxisComponent, int);
+  ///@}
+
+  ///@{
+  /**
    * When >= 0, the blend mode used instead of vtkVolumeMapper::BlendMode (same values). -1
    * (default): BlendMode. For front ends whose BlendMode menu lacks modes this mapper has
    * (ParaView 5.11 offers composite, isosurface and slice only).
@@ -568,6 +584,8 @@ protected:
   vtkIdType DeviceMemoryBudget = 0;
   int VectorMode = 1; // vtkScalarsToColors::COMPONENT
   int VectorComponent = 0;
+  char* Transfer2DYAxisArray = nullptr;
+  int Transfer2DYAxisComponent = 0;
   int BlendModeOverride = -1;
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   double WholeOrigin[3] = { 0, 0, 0 };

@@ -49,7 +49,10 @@ struct TransferFunction {
   /// texture: column position u * width2D - 1/2 for u = (v - rangeMin) / (rangeMax - rangeMin),
   /// row position g * height2D - 1/2 for the normalised gradient magnitude g (gradientMagnitude
   /// in render/GradientTF.h), bilinear, clamped at the edges; opacity raw (VTK corrects it not
-  /// for the sample distance). Composite blending of one-component volumes. Empty: the 1-D table.
+  /// for the sample distance). Composite blending of one-component volumes, or of two components
+  /// holding the x and y values (a second array as the y axis, vtkGPUVolumeRayCastMapper's
+  /// Transfer2DYAxisArray): then the row position is u * height2D - 1/2 for component 1's
+  /// u = (y - alphaMin()) / (alphaMax() - alphaMin()). Empty: the 1-D table.
   std::vector<vec4f> table2D;
   int width2D = 0, height2D = 0;
   /// Gradient opacity (vtkVolumeProperty::GetGradientOpacity, 1-D mode): the factor on a
@@ -72,11 +75,19 @@ struct TransferFunction {
 /// (every gradient magnitude), so a brick is empty only when no value it can take has opacity
 /// at any gradient; with gradient opacity the 1-D table (the factor only lowers opacity), all
 /// transparent when the factor is 0 everywhere. Lossless without any per-brick gradient range.
-TransferFunction classificationTF(const TransferFunction& tf);
+/// With `components` 2 (a 2-D table read at component 0 and component 1) the table runs over
+/// the rows instead, height2D + 1 entries over [alphaMin(), alphaMax()] (the range grid's
+/// component), entry j the largest opacity of rows j-1 and j over every column: a brick whose
+/// y values reach no row with opacity is empty, whatever its x values.
+TransferFunction classificationTF(const TransferFunction& tf, int components = 1);
 
 /// The 2-D table's column mapping in float: position x = (v - lo) * scale - 1/2 with scale =
 /// width2D / (rangeMax - rangeMin), the same floats classificationTF's table is queried with.
 void gradientColumnMapping(const TransferFunction& tf, float& lo, float& scale);
+/// The 2-D table's row mapping for a second array as its y axis (component 1): position
+/// y = (v - lo) * scale - 1/2 with scale = height2D / (alphaMax() - alphaMin()), the same floats
+/// classificationTF(tf, 2)'s table is queried with (OpacityRangeMax maps over alphaMin/Max).
+void secondAxisRowMapping(const TransferFunction& tf, float& lo, float& scale);
 
 /// Appends the 2-D table and the gradient-opacity factors (in .w) to `table` (the table a backend
 /// uploads), returning their offsets (-1: none): they travel to the device with the 1-D table.

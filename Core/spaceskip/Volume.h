@@ -37,7 +37,8 @@ decltype(auto) dispatchVoxelType(VoxelType t, F&& f) {
 /// With `components` > 1 the voxels are interleaved tuples (component c of voxel n at
 /// n*components + c) rendered as vtkVolumeProperty's dependent components
 /// (IndependentComponentsOff): 2 = colour value + opacity value, 4 = RGB + opacity value; the
-/// last component is always the one opacity (and so classification) reads.
+/// last component is always the one opacity (and so classification) reads. With a 2-D transfer
+/// function (TransferFunction::table2D), 2 = its x value + its y value (a second array).
 struct Volume {
   vec3l dims{0, 0, 0};
   VoxelType type = VoxelType::UInt8;

@@ -316,10 +316,12 @@ struct Engine::Impl {
   }
 
   /// The TF's 2-D table or gradient opacity is used: composite blending of one-component
-  /// volumes (otherwise the 1-D tables draw, said once by fillGradientTF). Classification
-  /// follows it (classificationTF), so a change of it re-classifies (setRenderParams).
+  /// volumes, or a 2-D table over two components (its x and y values); otherwise the 1-D tables
+  /// draw, said once by fillGradientTF. Classification follows it (classificationTF), so a
+  /// change of it re-classifies (setRenderParams).
   bool gradientTablesUsed() const {
-    return (tf.uses2D() || tf.usesGradientOpacity()) && volume.components == 1 && render.blend == BlendMode::Composite;
+    if (render.blend != BlendMode::Composite) return false;
+    return volume.components == 1 ? tf.uses2D() || tf.usesGradientOpacity() : volume.components == 2 && tf.uses2D();
   }
   /// The 2-D table's and the gradient opacity's first entries in the uploaded table (updateTable).
   int gradOffset2D = -1, gradOffsetGO = -1;
@@ -430,7 +432,7 @@ struct Engine::Impl {
     report(0.3, "classification");
     auto t0 = Clock::now();
     const bool changed = labelOn ? backend->classifyLabels(labelSets, drawn, cropClip)
-                                 : backend->classify(gradientTablesUsed() ? classificationTF(scaledTF()) : scaledTF(), cropClip);
+                                 : backend->classify(gradientTablesUsed() ? classificationTF(scaledTF(), volume.components) : scaledTF(), cropClip);
     if (backend->lastClassifyReadVoxels()) ++counters.voxelPasses;
     stats.classifySeconds = since(t0);
     stats.classifyWaitSeconds = backend->lastClassifyWaitSeconds();
@@ -921,7 +923,8 @@ void fillGradientTF(Impl& d, FrameView& f) {
   const TransferFunction& tf = d.tf;
   if (!tf.uses2D() && !tf.usesGradientOpacity()) return;
   const char* what = tf.uses2D() ? "2-D transfer function" : "gradient opacity";
-  if (d.volume.components != 1) {
+  const bool secondAxis = tf.uses2D() && d.volume.components == 2;  // x and y values (Transfer2DYAxisArray)
+  if (d.volume.components != 1 && !secondAxis) {
     d.warn(std::string(what) + " with dependent components is not supported: drawn with the 1-D tables");
     return;
   }
@@ -933,11 +936,12 @@ void fillGradientTF(Impl& d, FrameView& f) {
   const TransferFunction s = d.scaledTF();
   GradientTFView& g = f.gtf;
   if (tf.uses2D() && d.gradOffset2D >= 0) {
-    g.mode = 2;
+    g.mode = secondAxis ? 3 : 2;
     g.offset = d.gradOffset2D;
     g.width = tf.width2D;
     g.height = tf.height2D;
     gradientColumnMapping(s, g.xLo, g.xScale);
+    if (secondAxis) secondAxisRowMapping(s, g.yLo, g.yScale);
   } else if (tf.usesGradientOpacity() && d.gradOffsetGO >= 0) {
     g.mode = 1;
     g.offset = d.gradOffsetGO;

@@ -97,7 +97,27 @@ bool TransferFunction::sameGradientTables(const TransferFunction& o) const {
   return true;
 }
 
-TransferFunction classificationTF(const TransferFunction& tf) {
+TransferFunction classificationTF(const TransferFunction& tf, int components) {
+  if (tf.uses2D() && components == 2) {
+    const int W = tf.width2D, H = tf.height2D;
+    std::vector<float> row(size_t(H), 0.f);  // each row's largest opacity over all columns
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const float a = tf.table2D[size_t(y) * size_t(W) + size_t(x)].w;
+        if (a > row[size_t(y)]) row[size_t(y)] = a;
+      }
+    TransferFunction c;
+    c.rangeMin = tf.rangeMin;
+    c.rangeMax = tf.rangeMax;
+    c.ownOpacityRange = true;  // the entries span the y values' range (OpacityRangeMax reads alphaMin/Max)
+    c.opacityRangeMin = tf.alphaMin();
+    c.opacityRangeMax = tf.alphaMax();
+    c.unitDistance = tf.unitDistance;
+    c.table.resize(size_t(H) + 1);
+    for (int j = 0; j <= H; ++j)
+      c.table[size_t(j)] = vec4f{0, 0, 0, std::max(row[size_t(std::max(j - 1, 0))], row[size_t(std::min(j, H - 1))])};
+    return c;
+  }
   if (tf.uses2D()) {
     const int W = tf.width2D, H = tf.height2D;
     std::vector<float> col(size_t(W), 0.f);  // each column's largest opacity over all rows
@@ -131,6 +151,13 @@ TransferFunction classificationTF(const TransferFunction& tf) {
 
 void gradientColumnMapping(const TransferFunction& tf, float& lo, float& scale) {
   tableMapping(tf, tf.width2D + 1, lo, scale);
+}
+
+void secondAxisRowMapping(const TransferFunction& tf, float& lo, float& scale) {
+  TransferFunction y;
+  y.rangeMin = tf.alphaMin();
+  y.rangeMax = tf.alphaMax();
+  tableMapping(y, tf.height2D + 1, lo, scale);
 }
 
 void appendGradientTables(const TransferFunction& tf, std::vector<vec4f>& table, int& offset2D, int& offsetGO) {

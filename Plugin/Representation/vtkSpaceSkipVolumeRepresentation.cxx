@@ -246,17 +246,13 @@ vtkSpaceSkipVolumeRepresentation::~vtkSpaceSkipVolumeRepresentation() = default;
 void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
 {
   this->Superclass::UpdateMapperParameters();
-  // The base class sets the property's 2-D transfer-function mode (Use Transfer 2D) and function,
-  // which the mapper honours with the gradient magnitude as its y axis; a second array as the y
-  // axis (vtkMultiBlockVolumeMapper's Transfer2DYAxisArray) it does not read.
+  // The base class sets the property's 2-D transfer-function mode (Use Transfer 2D) and function;
+  // its y axis is the gradient magnitude, or with Use Gradient For Transfer 2D off the second
+  // array (Color Array 2, as the base class gives vtkMultiBlockVolumeMapper's
+  // Transfer2DYAxisArray), which the mapper reads from the delivered piece.
   const bool secondArray = this->UseTransfer2D && !this->UseGradientForTransfer2D && !this->ColorArray2Name.empty();
-  if (secondArray && !this->WarnedSecondArray)
-  {
-    vtkWarningMacro(<< "Use Transfer 2D with a second array ('" << this->ColorArray2Name
-                    << "') is not supported by the Space Skipping Volume: its y axis is the "
-                       "gradient magnitude, as with Use Gradient For Transfer 2D");
-  }
-  this->WarnedSecondArray = this->WarnedSecondArray || secondArray;
+  this->SpaceSkipMapper->SetTransfer2DYAxisArray(secondArray ? this->ColorArray2Name.c_str() : nullptr);
+  this->SpaceSkipMapper->SetTransfer2DYAxisComponent(std::max(this->ColorArray2Component, 0));
   this->UpdateLabelMap();
   // Same rule as the base class for vtkSmartVolumeMapper: with independent components the
   // colour map's vector mode and component, else component 0.

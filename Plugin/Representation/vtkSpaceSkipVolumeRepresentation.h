@@ -167,9 +167,6 @@ protected:
   /// Sets the mapper's LabelMap from LabelMapMode, the colour map and the drawn array.
   void UpdateLabelMap();
 
-  /// Use Transfer 2D with a second array (not the gradient) was said (once).
-  bool WarnedSecondArray = false;
-
   ///@{
   /// FXAA under MPI: serially VTK's renderer applies FXAA before it draws volumes (volumes are
   /// never smoothed); ParaView 5.11's parallel (IceT) path applies it to the composited frame,

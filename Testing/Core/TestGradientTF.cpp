@@ -55,7 +55,72 @@ GradientCases gradientCases(const Volume& v) {
   for (size_t i = 0; i < c.go.gradientOpacity.size(); ++i) c.go.gradientOpacity[i] = float(i) / 1023.f;
   return c;
 }
+// A second array as the 2-D table's y axis (vtkGPUVolumeRayCastMapper's Transfer2DYAxisArray):
+// two float components, x = a ball of value 200 fading to 0 at its rim (radius 0.45 of the box),
+// y = 250 i / (w - 1), a ramp across the volume's first axis. The table is opaque for x in the
+// upper 0.8 of its range and y in the upper half of [0, 250]: only the half i > w/2 is drawn.
+Volume secondArrayVolume(int w, int h, int d) {
+  Volume v;
+  v.allocate(vec3l{w, h, d}, VoxelType::Float32, 2);
+  float* p = reinterpret_cast<float*>(v.mutableData());
+  for (int k = 0; k < d; ++k)
+    for (int j = 0; j < h; ++j)
+      for (int i = 0; i < w; ++i) {
+        const float dx = (float(i) + 0.5f) / float(w) - 0.5f, dy = (float(j) + 0.5f) / float(h) - 0.5f,
+                    dz = (float(k) + 0.5f) / float(d) - 0.5f;
+        const float r = std::sqrt(dx * dx + dy * dy + dz * dz);
+        const int64_t n = i + int64_t(w) * (j + int64_t(h) * k);
+        p[2 * n] = std::max(0.f, 200.f * (1.f - r / 0.45f));
+        p[2 * n + 1] = 250.f * float(i) / float(w - 1);
+      }
+  return v;
+}
+TransferFunction secondArrayTF(float y0, float y1) {
+  TransferFunction tf = TransferFunction::preset("ramp", 0, 200, 256);
+  tf.ownOpacityRange = true;  // the y axis spans the second array's range
+  tf.opacityRangeMin = 0;
+  tf.opacityRangeMax = 250;
+  setBox(tf, 40, 20, 0.2f, 1.f, y0, y1, 0.3f);
+  return tf;
+}
+int64_t occupiedBricks(const Volume& v, const TransferFunction& tf) {
+  Engine e(BackendKind::CPU);
+  test::load(e, v, tf, test::builder(BuilderKind::Grid));
+  Image img;
+  e.render(test::orbit(v, 0, 0), 16, 16, img);
+  int64_t n = 0;
+  for (uint8_t o : e.occupancy().occ) n += o != 0;
+  return n;
+}
 }  // namespace
+
+TEST(GradientTF, SecondArrayAsYAxis) {
+  const Volume v = secondArrayVolume(48, 40, 36);
+  const TransferFunction upper = secondArrayTF(0.5f, 1.f), all = secondArrayTF(0.f, 1.f);
+  // Front view: the image's x runs along the volume's first axis, one way or the other; the
+  // middle row is drawn on exactly one side of the centre (where y >= 125), on both with `all`.
+  const Image img = test::renderWith(v, upper, test::builder(BuilderKind::Naive), 0, 0, false, 64);
+  const Image both = test::renderWith(v, all, test::builder(BuilderKind::Naive), 0, 0, false, 64);
+  const float left = at(img, 20, 32).w, right = at(img, 44, 32).w;
+  EXPECT_TRUE((left == 0.f) != (right == 0.f)) << "left " << left << " right " << right;
+  EXPECT_GT(std::max(left, right), 0.2f);
+  EXPECT_GT(at(both, 20, 32).w, 0.2f);
+  EXPECT_GT(at(both, 44, 32).w, 0.2f);
+  // Skipping: the bricks whose y values reach only empty rows are empty (about half), losslessly.
+  const int64_t nUpper = occupiedBricks(v, upper), nAll = occupiedBricks(v, all);
+  EXPECT_GT(nUpper, 0);
+  EXPECT_LT(double(nUpper), 0.7 * double(nAll)) << nUpper << " of " << nAll;
+  for (bool shade : {false, true}) {
+    RenderParams rp;
+    rp.shade = shade;
+    expectBuildersEqualNaive(v, upper, rp, shade ? "second array shaded" : "second array");
+  }
+  // A brick's x values alone never empty it: a box over low x only (where the ball is absent)
+  // keeps the x-empty bricks occupied, and the image still equals Naive's.
+  TransferFunction lowX = upper;
+  setBox(lowX, 40, 20, 0.f, 0.1f, 0.5f, 1.f, 0.3f);
+  expectBuildersEqualNaive(v, lowX, RenderParams{}, "second array, low x");
+}
 
 TEST(GradientTF, EveryBuilderEqualsNaiveWith2DTableAndGradientOpacity) {
   for (const char* shape : {"nbody", "vessels", "rm"}) {
@@ -151,4 +216,9 @@ TEST(GradientTF, CudaBuildersEqualNaive) {
     test::expectCudaBuildersEqualNaive(v, tf2, shaded, std::string(shape) + " 2-D shaded");
     test::expectCudaBuildersEqualNaive(v, go, rp, std::string(shape) + " gradient opacity");
   }
+  const Volume two = secondArrayVolume(64, 58, 61);
+  RenderParams rp, shaded;
+  shaded.shade = true;
+  test::expectCudaBuildersEqualNaive(two, secondArrayTF(0.5f, 1.f), rp, "second array");
+  test::expectCudaBuildersEqualNaive(two, secondArrayTF(0.5f, 1.f), shaded, "second array shaded");
 }

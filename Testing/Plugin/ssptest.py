@@ -92,17 +92,21 @@ def show_space_skipping(source, view, builder="KdTreeCPU", backend="CPU"):
     return disp
 
 
-def show_float_shell_vs_stock(view, opacity_top):
+def show_float_shell_vs_stock(view, opacity_top, second=None):
     """The bundled shell as a float copy shown as Space Skipping Volume (Naive, CPU) for tests that
     compare with ParaView's own Volume: llvmpipe filters the stock Volume's 8-bit texture in whole
     1/255 steps, which quantises its gradients (see test_stock_slice_lights.py); the opacity ramp
     from 40 up to `opacity_top` at 255, unit distance 1, composite blending; and both drawn at the
     stock sample distance: ParaView's Volume locks it to the input spacing
     (vtkVolumeMapper::SpacingAdjustedSampleDistance: half the mean spacing, scaled down below 100
-    voxels per axis), ours defaults to half the smallest spacing. Returns the display."""
+    voxels per axis), ours defaults to half the smallest spacing. `second`: a Calculator
+    expression for a second float point array named "second". Returns the display."""
     from paraview.simple import Calculator
     as_float = Calculator(Input=open_data(), AttributeType="Point Data", ResultArrayName=ARRAY,
                           Function="%s*1.0" % ARRAY, ResultArrayType="Float")
+    if second:
+        as_float = Calculator(Input=as_float, AttributeType="Point Data", ResultArrayName="second",
+                              Function=second, ResultArrayType="Float")
     disp = show_space_skipping(as_float, view, builder="Naive", backend="CPU")
     set_camera(view)
     set_transfer_functions(opacity_points=[0.0, 0.0, 0.5, 0.0, 40.0, 0.0, 0.5, 0.0,

@@ -71,12 +71,14 @@ struct LightView {
 
 /// A 2-D transfer function or gradient opacity (TransferFunction::table2D / gradientOpacity) as
 /// the integrator reads it (render/GradientTF.h): their entries follow the 1-D table in the
-/// table the backend uploads (FrameView::tf.table + offset). Composite, one component.
+/// table the backend uploads (FrameView::tf.table + offset). Composite; one component, or for
+/// mode 3 two (the table's x and y values: vtkGPUVolumeRayCastMapper's Transfer2DYAxisArray).
 struct GradientTFView {
-  int mode = 0;            ///< 0: none; 1: gradient opacity; 2: 2-D table
+  int mode = 0;  ///< 0: none; 1: gradient opacity; 2: 2-D table at (value, gradient); 3: at (component 0, 1)
   int offset = 0;          ///< first entry in tf.table
   int width = 0, height = 0;  ///< 2-D: columns, rows; gradient opacity: entries (width)
   float xLo = 0.f, xScale = 0.f;  ///< 2-D: column position (v - xLo) * xScale - 1/2
+  float yLo = 0.f, yScale = 0.f;  ///< mode 3: row position (component 1 - yLo) * yScale - 1/2
   /// Per index axis: the factor taking the central difference f(p+e) - f(p-e) to VTK's
   /// normalised gradient component, avgSpacing / (2 spacing) / (range / 4).
   float gradScale[3] = {0.f, 0.f, 0.f};

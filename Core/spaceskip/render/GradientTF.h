@@ -3,10 +3,13 @@
 // the gradient by central differences one voxel apart, each component divided by
 // 2 spacing / average spacing, its length divided by a quarter of the scalar range and clamped
 // to [0, 1]; then the 2-D texture at (normalised value, that magnitude) gives colour and raw
-// opacity, or the 1-D opacity is multiplied by the gradient-opacity texture at it. Written once
+// opacity, or the 1-D opacity is multiplied by the gradient-opacity texture at it. With a second
+// array as the y axis (Transfer2DYAxisArray) the volume holds two components, the table's x and
+// y values, and the texture is read at both, each normalised over its own range. Written once
 // for the oneTBB and CUDA executors; skipping stays lossless through classificationTF
 // (TransferFunction.h), which needs no gradient per brick.
 #pragma once
+#include "Components.h"  // IsChannelSampler (Integrator.h includes this after it)
 #include "FrameShared.h"
 
 namespace spaceskip {
@@ -34,25 +37,37 @@ SS_FUNC vec4f lerp4(vec4f a, vec4f b, float w) {
   return vec4f{a.x + (b.x - a.x) * w, a.y + (b.y - a.y) * w, a.z + (b.z - a.z) * w, a.w + (b.w - a.w) * w};
 }
 
+/// The 2-D table bilinear at texel-centred column position x and row position y.
+SS_FUNC vec4f table2DAt(const FrameView& f, float x, float y) {
+  const GradientTFView& g = f.gtf;
+  const vec4f* T = f.tf.table + g.offset;
+  int x0, x1, y0, y1;
+  float wx, wy;
+  texelAxis(x, g.width, x0, x1, wx);
+  texelAxis(y, g.height, y0, y1, wy);
+  const vec4f a = T[y0 * g.width + x0], b = T[y0 * g.width + x1];
+  const vec4f c = T[y1 * g.width + x0], d = T[y1 * g.width + x1];
+  return lerp4(lerp4(a, b, wx), lerp4(c, d, wx), wy);
+}
+
 /// Colour and opacity of a sample of value v at p (not premultiplied): the 2-D table, or the 1-D
 /// table's (opacity-corrected) entry with its opacity times the gradient-opacity factor.
 template <class Sampler>
 SS_FUNC vec4f classifyWithGradient(const FrameView& f, const Sampler& s, vec3f p) {
+  const GradientTFView& g = f.gtf;
+  if constexpr (IsChannelSampler<Sampler>::value) {
+    if (g.mode != 3) return classifySample(f, s, p);  // the engine sets no other mode for these
+    // Mode 3: x from component 0, y from component 1 (NaN in either: transparent, which the
+    // classification's NaN-free ranges of component 1 agree with).
+    const float v = s.sampleChannel(p, 0), y = s.sampleChannel(p, 1);
+    if (!(v == v) || !(y == y)) return vec4f{0, 0, 0, 0};
+    return table2DAt(f, (v - g.xLo) * g.xScale - 0.5f, (y - g.yLo) * g.yScale - 0.5f);
+  }
   const float v = s.sample(p);
   if (!(v == v)) return vec4f{0, 0, 0, 0};  // NaN: transparent, as the 1-D lookup
-  const GradientTFView& g = f.gtf;
   const vec4f* T = f.tf.table + g.offset;
-  if (g.mode == 2) {
-    int x0, x1, y0, y1;
-    float wx, wy;
-    texelAxis((v - g.xLo) * g.xScale - 0.5f, g.width, x0, x1, wx);
-    const float gm = gradientMagnitude(f, s, p);
-    texelAxis(gm * float(g.height) - 0.5f, g.height, y0, y1, wy);
-    const vec4f a = T[y0 * g.width + x0], b = T[y0 * g.width + x1];
-    const vec4f c = T[y1 * g.width + x0], d = T[y1 * g.width + x1];
-    const vec4f r0 = lerp4(a, b, wx), r1 = lerp4(c, d, wx);
-    return lerp4(r0, r1, wy);
-  }
+  if (g.mode == 2)
+    return table2DAt(f, (v - g.xLo) * g.xScale - 0.5f, gradientMagnitude(f, s, p) * float(g.height) - 0.5f);
   vec4f c = lookup(f.tf, v);
   if (!(c.w > 0.f)) return vec4f{0, 0, 0, 0};
   int i0, i1;

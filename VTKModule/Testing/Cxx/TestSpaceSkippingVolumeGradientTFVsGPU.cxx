@@ -1,7 +1,8 @@
-// 2-D transfer functions (vtkVolumeProperty TF_2D: value x gradient magnitude) and gradient
-// opacity through vtkGPUVolumeRayCastMapper and vtkSpaceSkippingVolumeMapper in the same scene:
-// prints the PSNR per case and checks it, that each case draws something and that it differs
-// from the same property without the 2-D table / gradient opacity (so ignoring them fails).
+// 2-D transfer functions (vtkVolumeProperty TF_2D: value x gradient magnitude, or value x a second
+// array: Transfer2DYAxisArray) and gradient opacity through vtkGPUVolumeRayCastMapper and
+// vtkSpaceSkippingVolumeMapper in the same scene: prints the PSNR per case and checks it, that
+// each case draws something and that it differs from the same property without the 2-D table /
+// gradient opacity (so ignoring them fails), and the second array from the gradient's image.
 #include "vtkFloatArray.h"
 #include "vtkPointData.h"
 
@@ -53,6 +54,23 @@ int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
   vtkRenderWindow* win = scene.Window;
   const std::string dir = sstest::TempDir(argc, argv);
 
+  // The second array: a ramp from -3 to 5 along the image's first axis, so that the y axis
+  // picks a slab the gradient magnitude would not.
+  {
+    vtkImageData* img = vs.Image;
+    int dims[3];
+    img->GetDimensions(dims);
+    vtkNew<vtkFloatArray> second;
+    second->SetName("second");
+    second->SetNumberOfTuples(img->GetNumberOfPoints());
+    for (vtkIdType n = 0; n < img->GetNumberOfPoints(); ++n)
+    {
+      const int i = static_cast<int>(n % dims[0]);
+      second->SetValue(n, static_cast<float>(-3.0 + 8.0 * i / (dims[0] - 1)));
+    }
+    img->GetPointData()->AddArray(second);
+  }
+
   auto box = MakeBox2D(64, 32, 0.3, 0.95, 0.08, 0.5, 0.15);
   auto plain = [&](vtkVolumeProperty* p) { sstest::SetupProperty(p, lo, hi, 0.6); };
   auto twoD = [&](vtkVolumeProperty* p) {
@@ -82,13 +100,16 @@ int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
     std::function<void(vtkVolumeProperty*)> setup;
   };
   const Case cases[] = { { "1d", plain }, { "2d", twoD }, { "2d-shade", twoDShaded },
-    { "gradient-opacity", gradient } };
-  vtkSmartPointer<vtkImageData> plainImage;
+    { "gradient-opacity", gradient }, { "2d-second-array", twoD }, { "2d-second-array-shade", twoDShaded } };
+  vtkSmartPointer<vtkImageData> plainImage, gradientYImage;
   for (const Case& c : cases)
   {
     vtkNew<vtkVolumeProperty> fresh;
     prop->DeepCopy(fresh);
     c.setup(prop);
+    const bool second = std::string(c.name).find("second-array") != std::string::npos;
+    gpu->SetTransfer2DYAxisArray(second ? "second" : nullptr);
+    ours->SetTransfer2DYAxisArray(second ? "second" : nullptr);
     prop->SetInterpolationTypeToLinear();
     prop->SetScalarOpacityUnitDistance(1.0);
     ren->ResetCameraClippingRange();
@@ -99,6 +120,15 @@ int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
     win->Render();
     auto b = sstest::Capture(win);
     vs.Judge(dir, "TestSpaceSkippingVolumeGradientTFVsGPU", c.name, a, b, kMinPSNR);
+    if (std::string(c.name) == "2d")
+    {
+      gradientYImage = b;
+    }
+    if (std::string(c.name) == "2d-second-array" && sstest::MaxDiff(gradientYImage, b) < 20)
+    {
+      std::cout << "  FAILED: the second array draws the gradient's image\n";
+      ++vs.Failures;
+    }
     if (!plainImage)
     {
       plainImage = b;
