@@ -41,12 +41,15 @@ __global__ void rangeKernel(const T* data, vec3l dims, vec3i bdims, int brick, f
 __global__ void classifyKernel(const float* vmin, const float* vmax, vec3i bdims, int brick, vec3i cellDims,
                                OpacityRangeMaxView rmq, CropClip cc, const uint8_t* prev, uint8_t* occ,
                                unsigned long long* occupied, int* changed, int* grew, uint8_t* state,
-                               uint32_t* list, unsigned* listCount) {
+                               uint32_t* list, unsigned* listCount, GradientRowsView rows) {
   const int64_t i = int64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
   int o = 0, diff = 0, more = 0;
   if (i < n) {
-    o = brickOccupied(i, vmin[i], vmax[i], rmq, bdims, brick, cellDims, cc) ? 1 : 0;
+    o = brickOccupied(i, vmin[i], vmax[i], rmq, bdims, brick, cellDims, cc) &&
+                gradientRowsAllow(i, vmin, vmax, bdims, rows)
+            ? 1
+            : 0;
     occ[i] = uint8_t(o);
     diff = prev ? (prev[i] != o) : 1;
     more = prev ? (o && !prev[i]) : 1;
@@ -279,12 +282,13 @@ cudaError_t brickRanges(const void* d_voxels, VoxelType type, int components, ve
 
 cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims, int brick, vec3i cellDims,
                            const OpacityRangeMaxView& rmq, const CropClip& cc, const uint8_t* d_prev, uint8_t* d_occ,
-                           ClassifyFlags* d_flags, cudaStream_t stream, uint8_t* d_state, uint32_t* d_list) {
+                           ClassifyFlags* d_flags, cudaStream_t stream, uint8_t* d_state, uint32_t* d_list,
+                           const GradientRowsView& rows) {
   const int64_t n = int64_t(bdims.x) * bdims.y * bdims.z;
   classifyKernel<<<blocksFor(n, kThreads), kThreads, 0, stream>>>(d_vmin, d_vmax, bdims, brick, cellDims, rmq, cc,
                                                                   d_prev, d_occ, &d_flags->occupied,
                                                                   &d_flags->changed, &d_flags->grew, d_state, d_list,
-                                                                  &d_flags->listCount);
+                                                                  &d_flags->listCount, rows);
   return cudaPeekAtLastError();
 }
 
@@ -299,6 +303,7 @@ void BrickClassification::setVolume(const DeviceVolume& v, int b, cudaStream_t s
   type_ = vol.type;
   dims_ = vol.dims;
   components_ = vol.components;
+  std::copy(vol.spacing, vol.spacing + 3, spacing_);
   bdims = vec3i{(cellDims.x + brick - 1) / brick, (cellDims.y + brick - 1) / brick, (cellDims.z + brick - 1) / brick};
   const size_t nb = size_t(numBricks());
   d_vmin.reserve(nb);
@@ -404,6 +409,7 @@ void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaS
   partRangeBytes_ = 0;
   brick = r.brick;
   cellDims = vol.cellDims();
+  std::copy(vol.spacing, vol.spacing + 3, spacing_);
   bdims = r.dims;
   const size_t nb = size_t(numBricks());
   d_vmin.reserve(nb);
@@ -441,6 +447,18 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   SS_CUDA_CHECK(cudaMemcpyAsync(d_levels_.get(), h_levels_.get(), levelBytes, cudaMemcpyHostToDevice, stream));
   OpacityRangeMaxView rmq = table.view();
   rmq.levels = d_levels_.get();
+  // A 2-D function over the gradient: its row-prefix tables, queried with each brick's
+  // neighbourhood range (GradientBound.h), as on the CPU.
+  const GradientRows gradRows(tf, spacing_);
+  GradientRowsView rows = gradRows.view();
+  if (!gradRows.empty()) {
+    const size_t rowBytes = gradRows.levels().size() * sizeof(float);
+    d_rowLevels_.reserve(gradRows.levels().size());
+    h_rowLevels_.reserve(rowBytes);
+    std::memcpy(h_rowLevels_.get(), gradRows.levels().data(), rowBytes);
+    SS_CUDA_CHECK(cudaMemcpyAsync(d_rowLevels_.get(), h_rowLevels_.get(), rowBytes, cudaMemcpyHostToDevice, stream));
+    rows.prefix.levels = d_rowLevels_.get();
+  }
 
   const uint8_t* prev = haveOcc ? d_occ[cur].get() : nullptr;
   uint8_t* next = d_occ[1 - cur].get();
@@ -454,7 +472,7 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
     d_list_.reserve(size_t(nb));
   }
   SS_CUDA_CHECK(classifyBricks(d_vmin.get(), d_vmax.get(), bdims, brick, cellDims, rmq, cc, prev, next, d_flags_.get(),
-                               stream, haveSub_ ? d_state_.get() : nullptr, haveSub_ ? d_list_.get() : nullptr));
+                               stream, haveSub_ ? d_state_.get() : nullptr, haveSub_ ? d_list_.get() : nullptr, rows));
   rmq_ = rmq;
   // The masks on the edit's path where the part walk can pay: at most 1/editMaskShare of the
   // bricks occupied (the kernel learns the count on the device and does nothing above it).

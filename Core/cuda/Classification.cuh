@@ -3,6 +3,7 @@
 #pragma once
 #include "DeviceVolume.cuh"
 #include "spaceskip/Classification.h"
+#include "spaceskip/GradientBound.h"
 #include "spaceskip/LabelMap.h"
 
 namespace spaceskip::cuda {
@@ -26,11 +27,12 @@ cudaError_t brickRanges(const void* d_voxels, VoxelType type, int components, ve
 /// by brickOccupied: its range can have opacity > 0 (rmq.levels on the device) and `cc` leaves
 /// some of it drawn; counts into d_flags and flags any difference from d_prev (nullptr:
 /// everything changed). With d_state and d_list: the bricks' states (whole or empty) and the
-/// occupied bricks' indices (d_flags->listCount of them).
+/// occupied bricks' indices (d_flags->listCount of them). `rows` (height > 0, levels on the
+/// device): a 2-D function's gradient rule too (GradientBound.h: gradientRowsAllow).
 cudaError_t classifyBricks(const float* d_vmin, const float* d_vmax, vec3i bdims, int brick, vec3i cellDims,
                            const OpacityRangeMaxView& rmq, const CropClip& cc, const uint8_t* d_prev, uint8_t* d_occ,
                            ClassifyFlags* d_flags, cudaStream_t stream, uint8_t* d_state = nullptr,
-                           uint32_t* d_list = nullptr);
+                           uint32_t* d_list = nullptr, const GradientRowsView& rows = GradientRowsView{});
 
 /// The brick grid of the current volume: value ranges (once per volume) and a double-buffered
 /// occupancy (once per opacity edit), with a host copy of the occupancy made on demand.
@@ -124,6 +126,9 @@ class BrickClassification {
 
  private:
   DeviceBuffer<float> d_levels_;  ///< OpacityRangeMax's levels
+  DeviceBuffer<float> d_rowLevels_;  ///< GradientRows' levels (a 2-D function over the gradient)
+  PinnedBuffer h_rowLevels_;
+  double spacing_[3] = {1, 1, 1};  ///< the volume's (the gradient rule's normalisation)
   /// Part ranges: per brick its slot in d_partRanges_ (kUniformBrick: every part's range is the
   /// brick's), and per slot 64 lower then 64 upper bounds (PartRangeStore of the voxel type).
   DeviceBuffer<uint32_t> d_partSlot_;

@@ -1,5 +1,6 @@
 // Per-brick value ranges (once per volume) and conservative occupancy (per opacity edit).
 #include "spaceskip/Classification.h"
+#include "spaceskip/GradientBound.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -68,6 +69,54 @@ RangeGrid computeRangeGrid(const Volume& v, int brick) {
 }
 
 OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, const CropClip& cc) {
+  return classifyWithGradientRows(ranges, tf, cc, GradientRowsView{});
+}
+
+void gradientScale(const double spacing[3], double rangeMin, double rangeMax, float k[3]) {
+  const double avg = (std::fabs(spacing[0]) + std::fabs(spacing[1]) + std::fabs(spacing[2])) / 3.0;
+  double range = rangeMax - rangeMin;
+  if (!(range > 0) || !std::isfinite(range)) range = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    const double h = std::fabs(spacing[a]);
+    k[a] = h > 0 ? float(avg / (2.0 * h) / (0.25 * range)) : 0.f;
+  }
+}
+
+GradientRows::GradientRows(const TransferFunction& tf, const double spacing[3]) {
+  if (!tf.uses2D()) return;
+  const int W = tf.width2D, H = tf.height2D;
+  // Rows 0..r as classificationTF builds all rows: W + 1 entries, entry j the larger of columns
+  // j-1 and j, over [rangeMin, rangeMax] (its column mapping).
+  TransferFunction prefix;
+  prefix.rangeMin = tf.rangeMin;
+  prefix.rangeMax = tf.rangeMax;
+  prefix.table.assign(size_t(W) + 1, vec4f{0, 0, 0, 0});
+  std::vector<float> col(size_t(W), 0.f);
+  for (int r = 0; r < H; ++r) {
+    for (int x = 0; x < W; ++x) {
+      const float a = tf.table2D[size_t(r) * size_t(W) + size_t(x)].w;
+      if (a > col[size_t(x)]) col[size_t(x)] = a;  // NaN never raises it
+    }
+    for (int j = 0; j <= W; ++j)
+      prefix.table[size_t(j)].w = std::max(col[size_t(std::max(j - 1, 0))], col[size_t(std::min(j, W - 1))]);
+    const OpacityRangeMax rows(prefix);
+    if (r == 0) {
+      if (rows.levels().size() * size_t(H) > kMaxFloats) return;  // too large: the 1-D rule alone
+      view_.prefix = rows.view();
+      view_.stride = int64_t(rows.levels().size());
+      levels_.reserve(rows.levels().size() * size_t(H));
+    }
+    levels_.insert(levels_.end(), rows.levels().begin(), rows.levels().end());
+  }
+  float k[3];
+  gradientScale(spacing, tf.rangeMin, tf.rangeMax, k);
+  view_.gradNorm = std::sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
+  view_.prefix.levels = levels_.data();
+  view_.height = H;
+}
+
+OccupancyGrid classifyWithGradientRows(const RangeGrid& ranges, const TransferFunction& tf, const CropClip& cc,
+                                       const GradientRowsView& rows) {
   OccupancyGrid o;
   o.brick = ranges.brick;
   o.cellDims = ranges.cellDims;
@@ -79,7 +128,10 @@ OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, cons
       [&](const tbb::blocked_range<int64_t>& r, int64_t acc) {
         for (int64_t i = r.begin(); i != r.end(); ++i) {
           const uint8_t occ = brickOccupied(i, ranges.vmin[size_t(i)], ranges.vmax[size_t(i)], rmq, ranges.dims,
-                                            ranges.brick, ranges.cellDims, cc) ? 1 : 0;
+                                            ranges.brick, ranges.cellDims, cc) &&
+                                      gradientRowsAllow(i, ranges.vmin.data(), ranges.vmax.data(), ranges.dims, rows)
+                                  ? 1
+                                  : 0;
           o.occ[size_t(i)] = occ;
           acc += occ;
         }

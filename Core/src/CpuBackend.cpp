@@ -4,6 +4,7 @@
 #include "spaceskip/BrickPool.h"
 #include "spaceskip/Builders.h"
 #include "spaceskip/DistanceField.h"
+#include "spaceskip/GradientBound.h"
 #include "src/CpuMarch.h"
 
 #include <tbb/blocked_range2d.h>
@@ -48,7 +49,9 @@ class CpuBackend final : public Backend {
   void setTuning(const Tuning& t) override { tuning_ = t; }
 
   bool classify(const TransferFunction& tf, const CropClip& cc) override {
-    OccupancyGrid o = spaceskip::classify(ranges_, tf, cc);
+    // A 2-D function over the gradient (classificationTF keeps its table): the gradient rule too.
+    const GradientRows rows(tf, volume_.spacing);
+    OccupancyGrid o = classifyWithGradientRows(ranges_, tf, cc, rows.view());
     const bool sameDims = o.dims.x == occ_.dims.x && o.dims.y == occ_.dims.y && o.dims.z == occ_.dims.z &&
                           o.occ.size() == occ_.occ.size();
     bool changed = !sameDims || o.occ != occ_.occ;

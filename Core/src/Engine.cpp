@@ -4,6 +4,7 @@
 #include "spaceskip/AutoBuilder.h"
 #include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
+#include "spaceskip/GradientBound.h"
 
 #include <algorithm>
 #include <chrono>
@@ -326,6 +327,14 @@ struct Engine::Impl {
   /// The 2-D table's and the gradient opacity's first entries in the uploaded table (updateTable).
   int gradOffset2D = -1, gradOffsetGO = -1;
 
+  /// scaledTF without a 2-D table (one that is not drawn: the backends classify with any they get).
+  TransferFunction oneDTF() const {
+    TransferFunction t = scaledTF();
+    t.table2D.clear();
+    t.width2D = t.height2D = 0;
+    return t;
+  }
+
   TransferFunction scaledTF() const {
     if (valueExponent == 0) return tf;
     TransferFunction t = tf;
@@ -432,7 +441,7 @@ struct Engine::Impl {
     report(0.3, "classification");
     auto t0 = Clock::now();
     const bool changed = labelOn ? backend->classifyLabels(labelSets, drawn, cropClip)
-                                 : backend->classify(gradientTablesUsed() ? classificationTF(scaledTF(), volume.components) : scaledTF(), cropClip);
+                                 : backend->classify(gradientTablesUsed() ? classificationTF(scaledTF(), volume.components) : oneDTF(), cropClip);
     if (backend->lastClassifyReadVoxels()) ++counters.voxelPasses;
     stats.classifySeconds = since(t0);
     stats.classifyWaitSeconds = backend->lastClassifyWaitSeconds();
@@ -950,15 +959,9 @@ void fillGradientTF(Impl& d, FrameView& f) {
     return;
   }
   // vtkVolumeShaderComposer (computeGradient with gradient opacity): (f(p+e) - f(p-e)) divided
-  // by 2 spacing / average spacing per axis, the length over a quarter of the scalar range.
-  const double* sp = d.volume.spacing;
-  const double avg = (std::fabs(sp[0]) + std::fabs(sp[1]) + std::fabs(sp[2])) / 3.0;
-  double range = s.rangeMax - s.rangeMin;
-  if (!(range > 0) || !std::isfinite(range)) range = 1.0;
-  for (int a = 0; a < 3; ++a) {
-    const double h = std::fabs(sp[a]);
-    g.gradScale[a] = h > 0 ? float(avg / (2.0 * h) / (0.25 * range)) : 0.f;
-  }
+  // by 2 spacing / average spacing per axis, the length over a quarter of the scalar range; the
+  // classification's gradient bound uses the same factors (GradientBound.h).
+  gradientScale(d.volume.spacing, s.rangeMin, s.rangeMax, g.gradScale);
 }
 /// Volumetric shadows and scattering (render/Scattering.h): VTK's texture space for this
 /// volume, the lights there, the reach as VTK maps GlobalIlluminationReach, the blend's gradient

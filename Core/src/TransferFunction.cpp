@@ -130,6 +130,11 @@ TransferFunction classificationTF(const TransferFunction& tf, int components) {
     c.rangeMin = tf.rangeMin;
     c.rangeMax = tf.rangeMax;
     c.unitDistance = tf.unitDistance;
+    // The 2-D table stays with it: the backends' classification bounds each brick's gradient
+    // and reads only the rows it can reach (GradientBound.h); this 1-D table is its first rule.
+    c.table2D = tf.table2D;
+    c.width2D = W;
+    c.height2D = H;
     c.table.resize(size_t(W) + 1);
     // Position x in [j, j+1] of this table is column position x - 1/2: columns j-1, j, j+1,
     // which entries j and j+1 (the query takes both) cover.

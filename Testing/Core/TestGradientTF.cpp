@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 
 using namespace spaceskip;
 
@@ -181,6 +182,45 @@ TEST(GradientTF, FlatRegionTransparentIn2DOpaqueIn1D) {
   int64_t occupied1 = 0;
   for (uint8_t o : e1.occupancy().occ) occupied1 += o != 0;
   EXPECT_LT(occupied, occupied1);  // the cube's inner bricks (value 200 only) are empty with `none`
+}
+
+TEST(GradientTF, GradientBoundEmptiesFlatBricks) {
+  // Three flat slabs along z (values 60, 140, 220) with steps two voxels wide at z = 20 and 44
+  // (normalised gradient up to about 0.49): a 2-D box over every value at gradients from 0.15
+  // only is transparent inside the slabs, whose bricks' 3x3x3 neighbourhoods hold one value (10
+  // of the 16 bricks along z); the 1-D rule (any gradient) keeps them all.
+  auto slabs = [](int, int, int k) {
+    return 60.f + 80.f * std::min(std::max(float(k - 20) / 2.f, 0.f), 1.f) +
+           80.f * std::min(std::max(float(k - 44) / 2.f, 0.f), 1.f);
+  };
+  Volume v = test::makeVolume<float>(40, 36, 128, VoxelType::Float32, slabs);
+  v.spacing[2] = 1.5;  // anisotropic: the bound's per-axis factors matter
+  TransferFunction tf = TransferFunction::preset("ramp", 0, 255, 256);
+  TransferFunction high = tf, all = tf;
+  setBox(high, 32, 16, 0.f, 1.f, 0.15f, 1.f, 0.5f);
+  setBox(all, 32, 16, 0.f, 1.f, 0.f, 1.f, 0.5f);
+  auto occupied = [&](const TransferFunction& t, BackendKind kind) {
+    Engine e(kind);
+    test::load(e, v, t, test::builder(BuilderKind::Grid));
+    Image img;
+    e.render(test::orbit(v, 0, 0), 16, 16, img);
+    return e.occupancy().occupied;
+  };
+  const int64_t nHigh = occupied(high, BackendKind::CPU), nAll = occupied(all, BackendKind::CPU);
+  std::cout << "occupied bricks: box at gradients >= 0.15 " << nHigh << ", over every gradient " << nAll << "\n";
+  EXPECT_GT(nHigh, 0);
+  EXPECT_LT(double(nHigh), 0.6 * double(nAll)) << nHigh << " of " << nAll;
+  // Lossless: every builder draws Naive's image (Naive marches every brick).
+  expectBuildersEqualNaive(v, high, RenderParams{}, "slabs, high gradients");
+  RenderParams shaded;
+  shaded.shade = true;
+  expectBuildersEqualNaive(v, high, shaded, "slabs, high gradients, shaded");
+  // (A box above the steps' gradients keeps their bricks: the bound R |k| takes the
+  // neighbourhood's whole range R along every axis at once, 1.14 here against 0.49.)
+  if (cudaAvailable()) {  // the CUDA classification applies the same rule
+    EXPECT_EQ(occupied(high, BackendKind::CUDA), nHigh);
+    EXPECT_EQ(occupied(all, BackendKind::CUDA), nAll);
+  }
 }
 
 TEST(GradientTF, ZeroGradientOpacityEmptiesEverything) {
