@@ -1,5 +1,5 @@
-// `spaceskip bench gen:nbody:N --time-series STEPS`: playback of a simulation's time steps (issue
-// 38). Each step is a new volume of the same shape: the engine's time-step path (Engine::setVolume
+// `spaceskip bench gen:nbody:N --time-series STEPS` (or gen:rm:N, the mixing layer widening over
+// the steps): playback of a simulation's time steps (issue 38). Each step is a new volume of the same shape: the engine's time-step path (Engine::setVolume
 // keeps Builder Auto's choice; the upload reuses the device allocation through pinned staging)
 // uploads it, computes its brick ranges where it lands, classifies, rebuilds the kept structure
 // and draws it at an orbiting camera; each step's frame is waited for. Beside it: the upload bound
@@ -71,7 +71,7 @@ void printPlayback(const char* what, const Playback& p, int played, double bound
 }  // namespace
 
 int cmdBenchTimeSeries(const Options& o) {
-  if (o.positional.size() != 1) throw std::invalid_argument("bench --time-series needs one VOLUME: gen:nbody:N");
+  if (o.positional.size() != 1) throw std::invalid_argument("bench --time-series needs one VOLUME: gen:nbody:N or gen:rm:N");
   const int played = int(o.getInt("--time-series", 100, 1, 1000000));
   const int held = int(o.getInt("--steps-held", std::min(played, 10), 1, 100000));
   const std::string typeName = o.get("--step-type", "uint8");
@@ -83,7 +83,7 @@ int cmdBenchTimeSeries(const Options& o) {
   vec3l dims;
   const uint64_t cap = maxVolumeBytes(o);
   if (!parseGeneratorSpec(o.positional[0], cap, shape, dims))
-    throw std::invalid_argument("bench --time-series: " + o.positional[0] + " is not gen:nbody:N");
+    throw std::invalid_argument("bench --time-series: " + o.positional[0] + " is not gen:nbody:N or gen:rm:N");
   int w = 1024, h = 1024;
   imageSize(o, w, h);
 

@@ -275,19 +275,30 @@ Volume noise(vec3l dims, unsigned seed) {
 
 // A mixing layer: a perturbed interface at mid-height; values fall off with the distance
 // to the interface and carry turbulent noise, so about half the volume is non-empty.
-Volume rm(vec3l dims, unsigned seed) {
+// `halfWidth`: the layer's half-thickness (0.26 for the stand-in); `drift`: the turbulence
+// carried along z (a time step's advection).
+Volume rm(vec3l dims, unsigned seed, double halfWidth = 0.26, double drift = 0.0) {
   Volume v;
   v.allocate(dims, VoxelType::UInt8);
   fill(v, [&](int64_t x, int64_t y, int64_t z) -> unsigned char {
     double px = double(x) / dims.x, py = double(y) / dims.y, pz = double(z) / dims.z;
     double h = 0.5 + 0.12 * (fbm(6 * px, 6 * py, 0.5, seed) - 0.5) * 2;
     double dist = std::fabs(pz - h);
-    double layer = std::max(0.0, 1.0 - dist / 0.26);
-    double turb = fbm(16 * px, 16 * py, 16 * pz, seed + 7);
+    double layer = std::max(0.0, 1.0 - dist / halfWidth);
+    double turb = fbm(16 * px, 16 * py, 16 * (pz - drift), seed + 7);
     double val = layer * (0.4 + 0.6 * turb);
     return (unsigned char)std::lround(255.0 * std::clamp(val, 0.0, 1.0));
   });
   return v;
+}
+
+// The mixing layer's time step `step` (issue 38's denser stand-in): the layer widens from a
+// half-thickness of 0.04 at step 0 to the stand-in's 0.26 at step 24 (held after: a playback
+// holding 25 steps sees the whole growth), the turbulence drifting 0.4 % of the box along z a
+// step, so each step differs everywhere and the drawn share grows about sixfold.
+Volume rmStep(vec3l dims, unsigned seed, int step) {
+  const double t = std::min(std::max(step, 0), 24) / 24.0;
+  return rm(dims, seed, 0.04 + 0.22 * t, 0.004 * step);
 }
 
 // Branching tubes from a random walk (a vessel tree stand-in, ~1% occupied); radii x `thick`.
@@ -711,10 +722,11 @@ std::vector<std::string> generatorShapes() {
 }
 
 Volume generateTimeStep(const std::string& shape, vec3l dims, int step, VoxelType type, unsigned seed) {
-  if (shape != "nbody") throw std::invalid_argument("time series: shape '" + shape + "' has no time steps (nbody has)");
+  if (shape != "nbody" && shape != "rm")
+    throw std::invalid_argument("time series: shape '" + shape + "' has no time steps (nbody and rm have)");
   if (type != VoxelType::UInt8 && type != VoxelType::Float32)
     throw std::invalid_argument(std::string("time series: voxel type ") + voxelTypeName(type) + " (uint8 or float32)");
-  Volume v = nbodySlab(dims, 0, dims.z - 1, seed, step);
+  Volume v = shape == "rm" ? rmStep(dims, seed, step) : nbodySlab(dims, 0, dims.z - 1, seed, step);
   if (type == VoxelType::UInt8) return v;
   Volume f;
   f.allocate(dims, VoxelType::Float32);

@@ -49,6 +49,30 @@ void expectPlaybackEqualsStatic(BackendKind backend, const std::vector<Volume>& 
 
 }  // namespace
 
+TEST(TimeSeries, MixingLayerStepsGrowDenser) {
+  // The rm time series: every step differs from the one before, and the drawn share grows.
+  const vec3l d{48, 48, 48};
+  auto nonZero = [](const Volume& v) {
+    const auto* p = static_cast<const unsigned char*>(v.data);
+    int64_t n = 0;
+    for (int64_t i = 0; i < v.voxelCount(); ++i) n += p[i] != 0;
+    return n;
+  };
+  const Volume s0 = generateTimeStep("rm", d, 0), s1 = generateTimeStep("rm", d, 1), s99 = generateTimeStep("rm", d, 24);
+  int64_t differ = 0;
+  for (int64_t i = 0; i < s0.voxelCount(); ++i)
+    differ += static_cast<const unsigned char*>(s0.data)[i] != static_cast<const unsigned char*>(s1.data)[i];
+  EXPECT_GT(differ, 0);
+  EXPECT_GT(nonZero(s99), 3 * nonZero(s0));
+  EXPECT_GT(nonZero(s0), 0);
+  const Volume f = generateTimeStep("rm", d, 5, VoxelType::Float32);
+  EXPECT_EQ(f.type, VoxelType::Float32);
+  // Played steps equal their static renders, as for the N-body.
+  std::vector<Volume> steps;
+  for (int k : {0, 12, 24}) steps.push_back(generateTimeStep("rm", d, k));
+  expectPlaybackEqualsStatic(BackendKind::CPU, steps, test::builder(BuilderKind::Grid), 1.f / 255.f);
+}
+
 TEST(TimeSeries, StepsDifferAndStaySparse) {
   const std::vector<Volume> s = nbodySteps(64, 3, VoxelType::UInt8);
   for (int k = 1; k < 3; ++k) {

@@ -2,7 +2,7 @@
 # On the GPU machine (issue 38): the carried Core tests (`tests`: .vtkbundle-core/core.tar.xz) run
 # the time-series tests, compute-sanitizer memcheck on the CUDA ones and the whole Core suite; the
 # carried CLI (`bench`: .vtkbundle-cli/cli.tar.xz) the playback benchmark at 512^3 and 1024^3,
-# uint8 and float32, 1024x1024 (bench/device/pack-core.sh packs both).
+# uint8 and float32, 1024x1024 (bench/device/pack-core.sh packs both; TS_SPECS picks others).
 # `scatter`: the CLI's volumetric-scattering benchmark instead (issue 34).
 #   bash bench/device/time-series.sh OUT tests|bench|scatter
 set -uo pipefail
@@ -48,12 +48,16 @@ if [ "$what" != bench ]; then
   echo "core tests rc=$?" >> "$out/env.txt"
   tail -3 "$out/core-tests.log" >> "$out/env.txt"
 fi
+# TS_SPECS: "SHAPE N TYPE HELD" items (default the N-body at 512^3 and 1024^3; rm: the mixing
+# layer, widening over its first 25 steps).
 if [ "$what" != tests ]; then
-  for spec in "512 uint8 10" "512 float32 10" "1024 uint8 8" "1024 float32 4"; do
+  specs=${TS_SPECS:-"nbody 512 uint8 10,nbody 512 float32 10,nbody 1024 uint8 8,nbody 1024 float32 4"}
+  IFS=, read -ra items <<< "$specs"
+  for spec in "${items[@]}"; do
     set -- $spec
-    echo "== spaceskip bench gen:nbody:$1 --time-series 100 --steps-held $3 --step-type $2 --backend cuda --size 1024x1024" >> "$out/bench.log"
-    timeout 140 $B/spaceskip bench gen:nbody:$1 --time-series 100 --steps-held $3 --step-type $2 --backend cuda \
-      --size 1024x1024 --check >> "$out/bench.log" 2>&1
+    cmd="bench gen:$1:$2 --time-series 100 --steps-held $4 --step-type $3 --backend cuda --size 1024x1024 --check"
+    echo "== spaceskip $cmd" >> "$out/bench.log"
+    timeout ${TS_TIMEOUT:-140} $B/spaceskip $cmd >> "$out/bench.log" 2>&1
     echo "rc=$?" >> "$out/bench.log"
   done
 fi

@@ -27,8 +27,10 @@ Volume generateVolume(const std::string& shape, vec3l dims, unsigned seed = 1);
 Volume generateSlab(const std::string& shape, vec3l dims, int64_t z0, int64_t z1, unsigned seed = 1);
 std::vector<std::string> generatorShapes();
 /// Time step `step` of a generated simulation (issue 38's playback): "nbody" advected, its
-/// particles drifting step by step (step 0 is generateVolume("nbody")), as uint8 or float32
-/// (value / 255). Throws std::invalid_argument for other shapes or types.
+/// particles drifting step by step (step 0 is generateVolume("nbody")); "rm", the mixing layer
+/// widening from a thin sheet at step 0 to the dense stand-in at step 24, its turbulence
+/// drifting; as uint8 or float32 (value / 255). Throws std::invalid_argument for other shapes
+/// or types.
 Volume generateTimeStep(const std::string& shape, vec3l dims, int step, VoxelType type = VoxelType::UInt8,
                         unsigned seed = 1);
 
