@@ -85,11 +85,13 @@ struct LaneRuns {
   float ra = 0.f, rb = 0.f;
   bool have = false, done = false;
   int64_t nextK = 0;
+  float wa = 0.f, wb = 0.f;  ///< the drawn part of the ray the iterator walks (snapToDrawn)
 
   /// The next run with samples: k in [kBegin, kEnd). false: the ray has no samples left.
   bool next(float t0, float dt, int64_t& kBegin, int64_t& kEnd) {
     float a, b;
     while (run(a, b)) {
+      snapToDrawn(a, b, wa, wb);
       kBegin = sampleIndexCeil((a - t0) / dt);
       kEnd = sampleIndexCeil((b - t0) / dt);
       if (kBegin < nextK) kBegin = nextK;
@@ -299,6 +301,8 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
     P.dz[l] = s.r.dir.z;
     P.t0[l] = s.t0;
     P.runs[l] = march_detail::LaneRuns<Iter>{};
+    P.runs[l].wa = s.a;
+    P.runs[l].wb = s.b;
     march_detail::initIter(P.runs[l].it, f, s);
     int64_t kb = 0, kEnd = 0;
     if (P.runs[l].next(s.t0, f.dt, kb, kEnd)) {

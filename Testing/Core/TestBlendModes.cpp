@@ -262,7 +262,9 @@ TEST(Shading, AnisotropicSpacingTiltsTheNormal) {
   const vec4f la = centre(test::renderWith(a, tf, test::builder(BuilderKind::Grid), 90, 0, false, 32, BackendKind::CPU, lit));
   const vec4f lb = centre(test::renderWith(b, tf, test::builder(BuilderKind::Grid), 90, 0, false, 32, BackendKind::CPU, lit));
   ASSERT_GT(ra.x, 0.05f);
-  EXPECT_NEAR(la.x, lb.x, 1e-3f);
+  // Within 0.01, not closer: the two boxes' sample lattices meet the exit face differently (one
+  // ray takes a sample on it, the other not: 0.0045 apart with Naive as with Grid).
+  EXPECT_NEAR(la.x, lb.x, 1e-2f);
   EXPECT_NEAR(la.x / ra.x, 4.f / std::sqrt(17.f), 0.02f);
 }
 

@@ -19,6 +19,20 @@ SS_FUNC int64_t sampleIndexCeil(float x) {
   return x == x ? int64_t(ceilf(ss_clamp(x, -kLimit, kLimit))) : int64_t(0);
 }
 
+/// A traversal's interval [a, b) inside the drawn part [wa, wb) of a ray, its ends snapped to
+/// wa and wb where they lie within rounding of them. The iterators compute where the ray enters
+/// its first brick and leaves its last by their own float arithmetic, a few ulps off the box's
+/// entry and exit that Naive marches between, and a sample in that sliver was lost (measured:
+/// rm 512^3, 1024^2, orbit 148,15: Grid left out the last sample of one ray, 2.85/255 off
+/// Naive's pixel; the CPU's packets alike). Snapping only adds samples of [wa, wb), which
+/// Naive takes too. No snapping without a drawn part (wa >= wb).
+SS_FUNC void snapToDrawn(float& a, float& b, float wa, float wb) {
+  if (!(wa < wb)) return;
+  const float tol = (fabsf(wa) + fabsf(wb)) * 1e-5f;
+  if (a - wa <= tol) a = wa;
+  if (wb - b <= tol) b = wb;
+}
+
 /// Blend modes whose result a brick can change although the TF gives it no opacity (MIP, MinIP:
 /// the extreme sample is mapped after the march; average: transparent samples count), or whose
 /// skipping test depends on the ray (isosurface). They march the range grid with the ray-dependent
@@ -125,6 +139,7 @@ struct IntervalMarcher {
   vec3f orgW{0, 0, 0}, dirW{0, 0, 0};  ///< the ray in world space (light list, positional lights)
   float shadowL = 0.f;  ///< scattering: the shadow rays' step, the primary step in texture units
   int pixel = -1;       ///< scattering: the pixel (row-major), for queued shadow rays
+  float drawnA = 0.f, drawnB = 0.f;  ///< the part of the ray a traversal walks (snapToDrawn; none: equal)
 
   /// Can a brick whose samples lie in [lo, hi] change this ray's result, given what it has seen?
   SS_FUNC bool active(float lo, float hi) const {
@@ -350,6 +365,7 @@ struct IntervalMarcher {
 
   /// The samples of interval [a, b) not taken yet: k in [kBegin, kEnd). Marks them as taken.
   SS_FUNC void range(float a, float b, int64_t& kBegin, int64_t& kEnd) {
+    snapToDrawn(a, b, drawnA, drawnB);
     const float dt = f->dt;
     kBegin = sampleIndexCeil((a - t0) / dt);
     kEnd = sampleIndexCeil((b - t0) / dt);
@@ -616,6 +632,8 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py, 
       b = ss_min(b, ownB);
       if (!(a < b)) return true;
     }
+    m.drawnA = a;
+    m.drawnB = b;
     switch (Traversal >= 0 ? TraversalKind(Traversal) : f.traversal) {
       case TraversalKind::Naive: return m(a, b);
       case TraversalKind::Grid: {
