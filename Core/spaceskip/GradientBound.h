@@ -19,6 +19,7 @@
 #include "Classification.h"
 #include "TransferFunction.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,16 @@ namespace spaceskip {
 /// to the normalised gradient component, avgSpacing / (2 spacing) / (range / 4) over the
 /// transfer function's scalar range (the integrator's GradientTFView::gradScale).
 void gradientScale(const double spacing[3], double rangeMin, double rangeMax, float k[3]);
+
+/// The classification table of per-position maxima `m` (texel-centred, as a 2-D table's columns
+/// or rows): m.size() + 1 entries in `table`'s alpha, entry j the larger of m[j-1] and m[j]
+/// (a position between two texel centres reads both). classificationTF's two 2-D rules and
+/// GradientRows build their tables with it.
+inline void pairMaxEntries(const std::vector<float>& m, std::vector<vec4f>& table) {
+  const size_t n = m.size();
+  table.assign(n + 1, vec4f{0, 0, 0, 0});
+  for (size_t j = 0; j <= n && n > 0; ++j) table[j].w = std::max(m[j > 0 ? j - 1 : 0], m[j < n ? j : n - 1]);
+}
 
 /// The row-prefix tables' view (plain data: host pointers on the CPU, device ones on the GPU).
 struct GradientRowsView {

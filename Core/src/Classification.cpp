@@ -90,15 +90,13 @@ GradientRows::GradientRows(const TransferFunction& tf, const double spacing[3]) 
   TransferFunction prefix;
   prefix.rangeMin = tf.rangeMin;
   prefix.rangeMax = tf.rangeMax;
-  prefix.table.assign(size_t(W) + 1, vec4f{0, 0, 0, 0});
   std::vector<float> col(size_t(W), 0.f);
   for (int r = 0; r < H; ++r) {
     for (int x = 0; x < W; ++x) {
       const float a = tf.table2D[size_t(r) * size_t(W) + size_t(x)].w;
       if (a > col[size_t(x)]) col[size_t(x)] = a;  // NaN never raises it
     }
-    for (int j = 0; j <= W; ++j)
-      prefix.table[size_t(j)].w = std::max(col[size_t(std::max(j - 1, 0))], col[size_t(std::min(j, W - 1))]);
+    pairMaxEntries(col, prefix.table);
     const OpacityRangeMax rows(prefix);
     if (r == 0) {
       if (rows.levels().size() * size_t(H) > kMaxFloats) return;  // too large: the 1-D rule alone

@@ -1,6 +1,6 @@
 // Transfer-function tables, presets and the sparse-table range-max query.
 #include "spaceskip/TransferFunction.h"
-
+#include "spaceskip/GradientBound.h"  // pairMaxEntries
 
 #include <algorithm>
 #include <cmath>
@@ -113,9 +113,7 @@ TransferFunction classificationTF(const TransferFunction& tf, int components) {
     c.opacityRangeMin = tf.alphaMin();
     c.opacityRangeMax = tf.alphaMax();
     c.unitDistance = tf.unitDistance;
-    c.table.resize(size_t(H) + 1);
-    for (int j = 0; j <= H; ++j)
-      c.table[size_t(j)] = vec4f{0, 0, 0, std::max(row[size_t(std::max(j - 1, 0))], row[size_t(std::min(j, H - 1))])};
+    pairMaxEntries(row, c.table);
     return c;
   }
   if (tf.uses2D()) {
@@ -135,11 +133,9 @@ TransferFunction classificationTF(const TransferFunction& tf, int components) {
     c.table2D = tf.table2D;
     c.width2D = W;
     c.height2D = H;
-    c.table.resize(size_t(W) + 1);
     // Position x in [j, j+1] of this table is column position x - 1/2: columns j-1, j, j+1,
     // which entries j and j+1 (the query takes both) cover.
-    for (int j = 0; j <= W; ++j)
-      c.table[size_t(j)] = vec4f{0, 0, 0, std::max(col[size_t(std::max(j - 1, 0))], col[size_t(std::min(j, W - 1))])};
+    pairMaxEntries(col, c.table);
     return c;
   }
   if (tf.usesGradientOpacity()) {
