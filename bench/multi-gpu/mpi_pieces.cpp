@@ -1,8 +1,15 @@
-// One MPI rank per GPU: each rank renders its slab of one volume with the engine (the whole
-// volume's sample lattice, its own cells only: VolumePiece.h), the ranks composite the float
-// images by direct send (each rank blends one band of rows from every rank in visibility
-// order, PieceOrder.h) and rank 0 gathers the bands. Frames are waited for; the frame time is
-// the slowest rank's render, the exchange, the blend and the gather.
+// One MPI rank per GPU, two ways to split the work (--split):
+// - `slabs` (sort-last, ParaView's way): each rank renders its slab of one volume with the
+//   engine (the whole volume's sample lattice, its own cells only: VolumePiece.h), the ranks
+//   composite the float images by direct send (each rank blends one band of rows from every rank
+//   in visibility order, PieceOrder.h) and rank 0 gathers the bands.
+// - `image` (sort-first, for volumes every GPU holds whole): each rank renders one band of the
+//   image's rows over the whole volume (the same rays as the whole image: the band's projection
+//   is the whole one's, cut in y) and rank 0 gathers the bands; no blend. The bands' heights
+//   follow the last frame's render times (--balance frame-time, the default here), since a
+//   row's cost varies over the image.
+// Frames are waited for; the frame time is the slowest rank's render, the exchange, the blend
+// and the gather.
 // Two ways to composite (--composite): `host` downloads every image and exchanges it with MPI
 // through host memory (MPI_Alltoallv, then MPI_Gatherv to rank 0); `gpu` (the default where the
 // ranks have CUDA devices on one host) keeps the images on the GPUs: each rank copies its frame
@@ -17,7 +24,8 @@
 //
 //   mpiexec -n N spaceskip_mpi_pieces [--shape nbody] [--dims 2048] [--size 1024] [--frames 30]
 //       [--builder Auto] [--backend auto|cpu|cuda] [--tf ramp] [--check] [--png out.png]
-//       [--composite gpu|host] [--balance occupancy|equal]
+//       [--composite gpu|host] [--split slabs|image] [--balance occupancy|equal|frame-time]
+//       [--ray-segments N] [--resident N]
 // --check: rank 0 also renders the whole volume alone and prints the largest difference of
 // the composited image from it (8-bit units). --slabs: each rank makes only its slab (volumes
 // larger than one host's share or one GPU: no rank holds the whole; with --check rank 0 makes
@@ -57,9 +65,12 @@ namespace {
 struct Args {
   std::string shape = "nbody", builder = "Auto", backend = "auto", tf = "ramp", png;
   std::string composite;  // gpu or host; empty: gpu where every rank has a CUDA device on one host
-  std::string balance = "occupancy";  // or equal
+  std::string split = "slabs";  // or image
+  std::string balance;          // slabs: occupancy (default) or equal; image: frame-time (default) or equal
   int64_t dims = 256;
   int size = 512, frames = 20;
+  int raySegments = 0;  // Tuning::raySegments (0: the engine's choice)
+  int resident = -1;    // Tuning::resident (-1: the engine's choice)
   bool check = false, slabs = false;
 };
 
@@ -84,6 +95,9 @@ Args parse(int argc, char** argv) {
     else if (k == "--png") a.png = next();
     else if (k == "--composite") a.composite = next();
     else if (k == "--balance") a.balance = next();
+    else if (k == "--split") a.split = next();
+    else if (k == "--ray-segments") a.raySegments = std::atoi(next().c_str());
+    else if (k == "--resident") a.resident = std::atoi(next().c_str());
     else if (k == "--check") a.check = true;
     else if (k == "--slabs") a.slabs = true;
     else {
@@ -91,8 +105,19 @@ Args parse(int argc, char** argv) {
       MPI_Abort(MPI_COMM_WORLD, 2);
     }
   }
-  if (a.balance != "occupancy" && a.balance != "equal") {
-    std::fprintf(stderr, "--balance takes occupancy or equal\n");
+  if (a.split != "slabs" && a.split != "image") {
+    std::fprintf(stderr, "--split takes slabs or image\n");
+    MPI_Abort(MPI_COMM_WORLD, 2);
+  }
+  const bool image = a.split == "image";
+  if (a.balance.empty()) a.balance = image ? "frame-time" : "occupancy";
+  if (a.balance != "equal" && a.balance != (image ? "frame-time" : "occupancy")) {
+    std::fprintf(stderr, "--balance takes %s or equal with --split %s\n", image ? "frame-time" : "occupancy",
+                 a.split.c_str());
+    MPI_Abort(MPI_COMM_WORLD, 2);
+  }
+  if (image && a.slabs) {
+    std::fprintf(stderr, "--split image draws the whole volume on every rank: no --slabs\n");
     MPI_Abort(MPI_COMM_WORLD, 2);
   }
   if (!a.composite.empty() && a.composite != "gpu" && a.composite != "host") {
@@ -163,6 +188,43 @@ std::vector<int64_t> balancedCuts(const Volume& v, const TransferFunction& tf, i
     cuts[size_t(r)] = std::clamp<int64_t>(int64_t(it - prefix.begin()), cuts[size_t(r) - 1] + 1, cells - (ranks - r));
   }
   return cuts;
+}
+
+/// The camera that draws rows [lo, hi) of an image `h` rows high (row 0 at the bottom) as an image
+/// of its own: the projection followed by the map of that band's NDC y range onto [-1, 1], so
+/// that the band's pixel centres unproject to the whole image's rays.
+Camera bandCamera(const Camera& whole, int lo, int hi, int h) {
+  const double a = double(hi - lo) / h, b = double(lo + hi) / h - 1.0;  // y_ndc = a * y_band + b
+  mat4 cut = identity4();  // clip y' = (y - b w) / a
+  cut.m[1 * 4 + 1] = 1.0 / a;
+  cut.m[3 * 4 + 1] = -b / a;
+  Camera c = whole;
+  c.proj = multiply(cut, whole.proj);
+  return c;
+}
+
+/// Row cuts (rank r draws rows [cuts[r], cuts[r + 1])) for the next frame from this frame's
+/// cuts and the ranks' render times: each band's time spread evenly over its rows, the new cuts
+/// at equal shares of the total, half way from the old ones (damped: a camera moves between
+/// frames), at least `minRows` rows a band. Every rank computes the same cuts from the same times.
+std::vector<int> rebalancedRows(const std::vector<int>& cuts, const std::vector<double>& times, int minRows) {
+  const int n = int(times.size()), h = cuts.back();
+  double total = 0;
+  for (double t : times) total += std::max(t, 0.0);
+  if (!(total > 0)) return cuts;
+  std::vector<int> next(cuts);
+  int r = 0;
+  double before = 0;  // the time of bands [0, r)
+  for (int k = 1; k < n; ++k) {
+    const double want = total * k / n;
+    while (r < n - 1 && before + std::max(times[size_t(r)], 0.0) < want) before += std::max(times[size_t(r)], 0.0), ++r;
+    const double t = std::max(times[size_t(r)], 0.0);
+    const double rows = double(cuts[size_t(r) + 1] - cuts[size_t(r)]);
+    const double target = cuts[size_t(r)] + (t > 0 ? (want - before) / t * rows : 0.0);
+    const int moved = int(std::lround(0.5 * (cuts[size_t(k)] + target)));
+    next[size_t(k)] = std::clamp(moved, next[size_t(k) - 1] + minRows, h - (n - k) * minRows);
+  }
+  return next;
 }
 
 #ifdef SPACESKIP_MPI_PIECES_CUDA
@@ -301,9 +363,11 @@ int main(int argc, char** argv) {
   if (!(hi >= lo)) lo = 0, hi = 1;
   const TransferFunction tf = TransferFunction::preset(a.tf, lo, hi);
   const TransferFunction edited = TransferFunction::preset(a.tf, lo + 0.25 * (hi - lo), hi);
+  const bool image = a.split == "image";
   const bool balanced = !a.slabs && a.balance != "equal";
-  if (balanced) cuts = balancedCuts(whole, tf, ranks);
-  const int64_t z0 = cuts[size_t(rank)], z1 = cuts[size_t(rank) + 1];
+  if (balanced && !image) cuts = balancedCuts(whole, tf, ranks);
+  if (image) cuts = {0, cells};  // every rank draws the whole volume
+  const int64_t z0 = cuts[size_t(image ? 0 : rank)], z1 = cuts[size_t(image ? 1 : rank + 1)];
   if (!a.slabs) {
     pointsOf(z0, z1, p0, p1);
     piece = whole;
@@ -329,8 +393,14 @@ int main(int argc, char** argv) {
     MPI_Abort(MPI_COMM_WORLD, 2);
   }
   engine.setBuildParams(bp);
-  engine.setVolume(piece);
-  engine.setPiece(vp);
+  if (a.raySegments > 0 || a.resident >= 0) {  // the GPU launch's knobs (Tuning.h)
+    Tuning tu = engine.tuning();
+    if (a.raySegments > 0) tu.raySegments = a.raySegments;
+    if (a.resident >= 0) tu.resident = a.resident;
+    engine.setTuning(tu);
+  }
+  engine.setVolume(image ? whole : piece);
+  if (!image) engine.setPiece(vp);
   engine.setTransferFunction(tf);
 
   double b6[6];
@@ -350,7 +420,7 @@ int main(int argc, char** argv) {
   std::vector<int> recvCounts(ranks, myRows * w * 4), recvDispls(ranks);
   for (int r = 0; r < ranks; ++r) recvDispls[r] = r * myRows * w * 4;
   std::vector<PieceBox> boxes(ranks);
-  for (int r = 0; r < ranks; ++r)
+  for (int r = 0; r < ranks && !image; ++r)
     boxes[r] = {0.0, double(whole.dims.x - 1), 0.0, double(whole.dims.y - 1), double(cuts[size_t(r)]),
                 double(cuts[size_t(r) + 1])};
   Image img, final;
@@ -389,6 +459,7 @@ int main(int argc, char** argv) {
 
   struct Times {
     double render = 0, exchange = 0, blend = 0, gather = 0, frame = 0;
+    double call = 0, kernel = 0;  // render()'s return on the host; the engine's kernel (device) time
   };
   // The view direction in the volume's index space (spacing 1, axis-aligned generators).
   auto order = [&](const Camera& cam) {
@@ -404,6 +475,7 @@ int main(int argc, char** argv) {
     const auto s0 = Clock::now();
     const Camera cam = camera(f);
     engine.render(cam, w, h, img);
+    const auto sr = Clock::now();
     const void* di = engine.deviceImage();
     auto* es = static_cast<cudaStream_t>(engine.deviceImageStream());
     if (!di || cudaMemcpyAsync(gx.mine, di, imageBytes, cudaMemcpyDeviceToDevice, es) != cudaSuccess ||
@@ -432,9 +504,59 @@ int main(int argc, char** argv) {
     const auto s4 = Clock::now();
     t.render += seconds(s0, s1), t.exchange += seconds(s1, s2), t.blend += seconds(s2, s3);
     t.gather += seconds(s3, s4), t.frame += seconds(s0, s4);
+    t.call += seconds(s0, sr), t.kernel += std::max(0.0, engine.frameStats().deviceSeconds);
   };
 #endif
+  // --split image: rank r draws rows [rows[r], rows[r + 1]) over the whole volume, straight into
+  // rank 0's final image (GPU: a copy into it through CUDA IPC; host: MPI_Gatherv). No blend.
+  std::vector<int> rows(static_cast<size_t>(ranks) + 1);
+  for (int r = 0; r <= ranks; ++r) rows[size_t(r)] = rowLo(r);
+  std::vector<double> bandTimes(static_cast<size_t>(ranks));
+  bool moveBands = false;  // not while Auto measures (a new band height starts its measuring again)
+  auto imageFrame = [&](int f, Times& t) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    const auto s0 = Clock::now();
+    const int lo = rows[size_t(rank)], hi = rows[size_t(rank) + 1];
+    engine.render(bandCamera(camera(f), lo, hi, h), w, hi - lo, img);
+    const auto sr = Clock::now();
+    const size_t bandBytes = size_t(hi - lo) * size_t(w) * sizeof(vec4f);
+#ifdef SPACESKIP_MPI_PIECES_CUDA
+    if (gpuComposite) {
+      const void* di = engine.deviceImage();
+      auto* es = static_cast<cudaStream_t>(engine.deviceImageStream());
+      if (!di || cudaMemcpyAsync(static_cast<vec4f*>(gx.finalMapped) + size_t(lo) * size_t(w), di, bandBytes,
+                                 cudaMemcpyDeviceToDevice, es) != cudaSuccess ||
+          cudaStreamSynchronize(es) != cudaSuccess) {
+        std::fprintf(stderr, "[rank %d] the band is not on the device (%s)\n", rank,
+                     di ? cudaGetErrorString(cudaGetLastError()) : "the engine fell back to the host");
+        MPI_Abort(MPI_COMM_WORLD, 3);
+      }
+    }
+#endif
+    const auto s1 = Clock::now();
+    if (gpuComposite) {
+      MPI_Barrier(MPI_COMM_WORLD);  // rank 0's final image is whole
+    } else {
+      std::vector<int> cnt(static_cast<size_t>(ranks)), dsp(static_cast<size_t>(ranks));
+      for (int r = 0; r < ranks; ++r) {
+        cnt[size_t(r)] = (rows[size_t(r) + 1] - rows[size_t(r)]) * w * 4;
+        dsp[size_t(r)] = rows[size_t(r)] * w * 4;
+      }
+      MPI_Gatherv(img.rgba.data(), int(bandBytes / sizeof(float)), MPI_FLOAT,
+                  rank == 0 ? final.rgba.data() : nullptr, cnt.data(), dsp.data(), MPI_FLOAT, 0, MPI_COMM_WORLD);
+    }
+    const auto s4 = Clock::now();
+    t.render += seconds(s0, s1), t.gather += seconds(s1, s4), t.frame += seconds(s0, s4);
+    t.call += seconds(s0, sr), t.kernel += std::max(0.0, engine.frameStats().deviceSeconds);
+    // The next frame's bands, from this frame's render times (outside the frame's time).
+    if (a.balance == "frame-time" && ranks > 1 && moveBands) {
+      const double mine = seconds(s0, s1);
+      MPI_Allgather(&mine, 1, MPI_DOUBLE, bandTimes.data(), 1, MPI_DOUBLE, MPI_COMM_WORLD);
+      rows = rebalancedRows(rows, bandTimes, std::min(8, h / ranks));
+    }
+  };
   auto frame = [&](int f, Times& t) {
+    if (image) return imageFrame(f, t);
 #ifdef SPACESKIP_MPI_PIECES_CUDA
     if (gpuComposite) return gpuFrame(f, t);
 #endif
@@ -462,6 +584,24 @@ int main(int argc, char** argv) {
   const double first = seconds(firstStart, Clock::now());
   const double setup = seconds(t0, firstStart);
   for (int i = 0; i < 3; ++i) frame(0, warm);  // Auto measures its candidates
+  if (image) {
+    // Bands of rows change height from frame to frame, and Builder Auto measures its candidates
+    // again at every new frame size: each rank measures on its first band until it decides,
+    // then keeps its choice; then the bands settle on the render times before the orbit.
+    for (int i = 0; i < 40; ++i) {
+      int busy = engine.exploring() ? 1 : 0, any = 0;
+      MPI_Allreduce(&busy, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+      if (!any) break;
+      frame(0, warm);
+    }
+    if (bp.builder == BuilderKind::Auto) {
+      BuildParams kept = bp;
+      kept.builder = engine.buildStats().builder;
+      engine.setBuildParams(kept);
+    }
+    moveBands = true;
+    for (int i = 0; i < 10; ++i) frame(0, warm);
+  }
   Times t;
   for (int f = 0; f < a.frames; ++f) frame(f, t);
   // Device memory in use on this rank's GPU after the orbit (the volume in core, the structure).
@@ -487,9 +627,14 @@ int main(int argc, char** argv) {
 
   // Each rank's device and builder, in rank order.
   char line[256];
-  std::snprintf(line, sizeof line, "rank %d: local rank %d, device %d (%s), builder %s, slab z cells [%lld, %lld)",
-                rank, localRank, device, deviceName.c_str(), builderName(engine.buildStats().builder),
-                (long long)z0, (long long)z1);
+  if (image)
+    std::snprintf(line, sizeof line, "rank %d: local rank %d, device %d (%s), builder %s, image rows [%d, %d)",
+                  rank, localRank, device, deviceName.c_str(), builderName(engine.buildStats().builder),
+                  rows[size_t(rank)], rows[size_t(rank) + 1]);
+  else
+    std::snprintf(line, sizeof line, "rank %d: local rank %d, device %d (%s), builder %s, slab z cells [%lld, %lld)",
+                  rank, localRank, device, deviceName.c_str(), builderName(engine.buildStats().builder),
+                  (long long)z0, (long long)z1);
   std::vector<char> lines(rank == 0 ? size_t(ranks) * sizeof line : 0);
   MPI_Gather(line, sizeof line, MPI_CHAR, lines.data(), sizeof line, MPI_CHAR, 0, MPI_COMM_WORLD);
 
@@ -503,10 +648,13 @@ int main(int argc, char** argv) {
   if (rank == 0) {
     for (int r = 0; r < ranks; ++r) std::printf("%s\n", lines.data() + size_t(r) * sizeof line);
     const double n = a.frames;
-    std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s composite %s slabs %s\n", ranks,
-                a.shape.c_str(), (long long)a.dims, w, h, a.frames, engine.backendName(),
-                gpuComposite ? "gpu (CUDA IPC, blended on the GPUs into rank 0's)" : "host (MPI through host memory)",
-                balanced ? "balanced by visible voxels" : "equal cells");
+    std::printf("ranks %d shape %s dims %lld size %dx%d frames %d backend %s split %s composite %s %s\n", ranks,
+                a.shape.c_str(), (long long)a.dims, w, h, a.frames, engine.backendName(), a.split.c_str(),
+                gpuComposite ? (image ? "gpu (CUDA IPC, each band copied into rank 0's)"
+                                      : "gpu (CUDA IPC, blended on the GPUs into rank 0's)")
+                             : "host (MPI through host memory)",
+                image ? (balanced ? "bands of rows by the last frame's render times" : "bands of equal rows")
+                      : (balanced ? "slabs balanced by visible voxels" : "slabs of equal cells"));
     std::printf("setup_s %.3f first_frame_s %.4f device_GiB(max rank) %.2f volume_GiB %.2f\n", setup, first,
                 deviceGiBMax, double(wdims.x) * double(wdims.y) * double(wdims.z) * double(voxelSize(piece.type)) / double(1ull << 30));
     std::printf("tf_edit_frame_ms %.3f tf_edit_back_frame_ms %.3f\n", 1e3 * e1.frame, 1e3 * e2.frame);
@@ -514,6 +662,8 @@ int main(int argc, char** argv) {
                 "exchange_ms %.3f blend_ms %.3f gather_ms %.3f last_kernel_ms %.3f\n",
                 1e3 * t.frame / n, n / t.frame, 1e3 * t.render / n, 1e3 * renderMax / n, 1e3 * renderMin / n,
                 1e3 * t.exchange / n, 1e3 * t.blend / n, 1e3 * t.gather / n, 1e3 * kernel);
+    // Where rank 0's render goes: the render() call's return on the host, and the kernel.
+    std::printf("rank0 render_call_ms %.3f kernel_ms %.3f\n", 1e3 * t.call / n, 1e3 * t.kernel / n);
     if (!a.png.empty()) savePng(final, a.png);
   }
 

@@ -11,8 +11,12 @@
 # (each rank makes only its slab: volumes larger than one GPU), CHECK=0 (no whole-volume
 # reference: it needs the whole volume on rank 0's GPU), COMPOSITES (default "gpu": the images
 # composited on the GPUs through CUDA IPC; "host": through host memory with MPI; "gpu host": both,
-# one after the other), BALANCE (default occupancy: slabs of equal visible voxels; equal: equal
-# cells; SLABS=1 always cuts equal cells).
+# one after the other), SPLITS (default "slabs": each rank draws a slab of the volume, the images
+# blended; "image": each rank draws a band of the image's rows over the whole volume; "slabs
+# image": both), BALANCE (default: slabs of equal visible voxels, bands by the last frame's render
+# times; equal: equal cells or rows; SLABS=1 always cuts equal cells), RAY_SEGMENTS (segments a
+# ray is cut into on the GPU; default: the engine's choice), RESIDENT (blocks per SM of a
+# persistent launch; default: the engine's choice).
 # The machine's own mpirun is used when it loads the carried binary's libmpi.so.40 (Open MPI 4.x
 # ABI); otherwise the carried Debian Open MPI (orterun, OPAL_PREFIX).
 set -u
@@ -50,23 +54,28 @@ builder=${BUILDER:-Auto}
 status=0
 for scene in $scenes; do
   shape=${scene%%:*} dims=${scene##*:}
+  for split in ${SPLITS:-slabs}; do
   for comp in ${COMPOSITES:-gpu}; do
   for n in ${RANKS:-1 2 4}; do
     [ "$n" -le "$gpus" ] || continue
     check=()
     [ "$n" -gt 1 ] && [ "${CHECK:-1}" = 1 ] && check=(--check)
     [ "${SLABS:-0}" = 1 ] && check+=(--slabs)
-    log="$out/$shape$dims-n$n-$comp.log"
-    echo "== $shape $dims^3, $n ranks, --composite $comp" | tee -a "$out/summary.txt"
+    [ -n "${BALANCE:-}" ] && check+=(--balance "$BALANCE")
+    [ -n "${RAY_SEGMENTS:-}" ] && check+=(--ray-segments "$RAY_SEGMENTS")
+    [ -n "${RESIDENT:-}" ] && check+=(--resident "$RESIDENT")
+    log="$out/$shape$dims-n$n-$split-$comp.log"
+    echo "== $shape $dims^3, $n ranks, --split $split --composite $comp" | tee -a "$out/summary.txt"
     # NVLink multicast stays off (the machine's NCCL_NVLS_ENABLE=0 and friends, passed on).
     timeout "${RUN_TIMEOUT:-400}" "${mpirun[@]}" --allow-run-as-root --oversubscribe -n "$n" --bind-to none \
       -x LD_LIBRARY_PATH -x NCCL_NVLS_ENABLE -x TORCH_SYMM_MEM_DISABLE_MULTICAST -x NVSHMEM_DISABLE_NVLS \
       "$exe" --shape "$shape" --dims "$dims" --size "$size" --frames "$frames" --builder "$builder" \
-      --backend cuda --composite "$comp" --balance "${BALANCE:-occupancy}" "${check[@]}" --png "$out/$shape$dims-n$n-$comp.png" > "$log" 2>&1
+      --backend cuda --composite "$comp" --split "$split" "${check[@]}" --png "$out/$shape$dims-n$n-$split-$comp.png" > "$log" 2>&1
     rc=$?
     [ $rc -eq 0 ] || status=1
     grep -E "^rank|^ranks|^setup|^frame|^tf_edit|^check|GPU compositing not used" "$log" | tee -a "$out/summary.txt"
     echo "rc=$rc" | tee -a "$out/summary.txt"
+  done
   done
   done
 done
