@@ -282,9 +282,15 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
     const double* range = mode.TableRange ? mode.TableRange
       : s.WholeScalarRange[0] <= s.WholeScalarRange[1] ? s.WholeScalarRange
                                                          : this->Input.GetScalarRange();
-    this->Properties.UpdateTransferFunction(engine, vol->GetProperty(), range,
-      this->Input.GetOpacityRange(), this->Input.GetOpacityComponent(),
-      this->Input.GetSecondAxis());
+    // A second array as the y axis: the rows span the whole data's range of it where given
+    // (MPI, blocks), rounded to float as the converter's own range is.
+    const double* yWhole = s.WholeSecondAxisRange;
+    const double secondRange[2] = { static_cast<float>(yWhole[0]), static_cast<float>(yWhole[1]) };
+    const double* opacityRange = this->Input.GetSecondAxis() && yWhole[0] <= yWhole[1]
+      ? secondRange
+      : this->Input.GetOpacityRange();
+    this->Properties.UpdateTransferFunction(engine, vol->GetProperty(), range, opacityRange,
+      this->Input.GetOpacityComponent(), this->Input.GetSecondAxis());
     this->Properties.UpdateParameters(engine, s, ren, vol, range, this->Warn);
     const spaceskip::Camera camera = vtkSpaceSkipPropertyTranslator::ToCamera(ren, cam, vol);
     int width, height, x0, y0;

@@ -33,6 +33,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -207,6 +208,7 @@ void vtkSpaceSkipMultiBlockVolumeMapper::Render(vtkRenderer* ren, vtkVolume* vol
   {
     return;
   }
+  this->SecondAxisRange(images);
   this->UpdateLattice(images, vol);
   this->ConfigureBlocks(range, ren, vol);
   int width = 0, height = 0, x0 = 0, y0 = 0;
@@ -369,6 +371,39 @@ bool vtkSpaceSkipMultiBlockVolumeMapper::TableRange(
 }
 
 //------------------------------------------------------------------------------
+// A second array as the 2-D transfer function's y axis: its rows span the array's range over
+// all blocks (one image of the blocks would), unless the whole data's range was given (MPI).
+void vtkSpaceSkipMultiBlockVolumeMapper::SecondAxisRange(const std::vector<vtkImageData*>& images)
+{
+  vtkSpaceSkipSettings& s = this->Settings;
+  if (s.Transfer2DYAxisArray.empty() || s.WholeSecondAxisRange[0] <= s.WholeSecondAxisRange[1])
+  {
+    return;
+  }
+  double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+  for (vtkImageData* image : images)
+  {
+    vtkDataArray* y = image->GetPointData()->GetArray(s.Transfer2DYAxisArray.c_str());
+    if (!y || y->GetNumberOfTuples() == 0)
+    {
+      continue;
+    }
+    double r[2];
+    y->GetFiniteRange(r, std::min(std::max(s.Transfer2DYAxisComponent, 0), y->GetNumberOfComponents() - 1));
+    if (r[0] <= r[1])
+    {
+      lo = std::min(lo, r[0]);
+      hi = std::max(hi, r[1]);
+    }
+  }
+  if (lo <= hi)
+  {
+    s.WholeSecondAxisRange[0] = lo;
+    s.WholeSecondAxisRange[1] = hi;
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkipMultiBlockVolumeMapper::UpdateLattice(
   const std::vector<vtkImageData*>& images, vtkVolume* vol)
 {
@@ -396,7 +431,7 @@ void vtkSpaceSkipMultiBlockVolumeMapper::UpdateLattice(
   request.anchored = s.HasWholeExtent();
   std::copy(s.WholeExtent, s.WholeExtent + 6, request.wholeExtent);
   std::copy(s.WholeOrigin, s.WholeOrigin + 3, request.wholeOrigin);
-  std::vector<vtkDataArray*> arrays;
+  std::vector<vtkDataArray*> arrays, second;
   for (vtkImageData* image : images)
   {
     vtkDataArray* a = SelectedScalars(s, image);
@@ -404,6 +439,12 @@ void vtkSpaceSkipMultiBlockVolumeMapper::UpdateLattice(
     key.insert(key.end(),
       { reinterpret_cast<unsigned long long>(image), image->GetMTime(),
         reinterpret_cast<unsigned long long>(a), a ? a->GetMTime() : 0ULL });
+    // The 2-D transfer function's y-axis array goes into padded copies too.
+    vtkDataArray* y = s.Transfer2DYAxisArray.empty()
+      ? nullptr
+      : image->GetPointData()->GetArray(s.Transfer2DYAxisArray.c_str());
+    second.push_back(y);
+    key.insert(key.end(), { reinterpret_cast<unsigned long long>(y), y ? y->GetMTime() : 0ULL });
   }
   if (key != this->PlanKey)
   {
@@ -412,7 +453,7 @@ void vtkSpaceSkipMultiBlockVolumeMapper::UpdateLattice(
     {
       request.blocks.push_back(ToLatticeBlock(images[i], arrays[i]));
     }
-    this->ApplyPlan(spaceskip::planLattice(request), arrays);
+    this->ApplyPlan(spaceskip::planLattice(request), arrays, second);
   }
   if (!this->OnLattice)
   {
@@ -425,9 +466,11 @@ void vtkSpaceSkipMultiBlockVolumeMapper::UpdateLattice(
 
 //------------------------------------------------------------------------------
 // Each drawing block as a piece of the whole: its arrays on the lattice, or a padded copy.
-void vtkSpaceSkipMultiBlockVolumeMapper::ApplyPlan(
-  const spaceskip::LatticePlan& plan, const std::vector<vtkDataArray*>& arrays)
+void vtkSpaceSkipMultiBlockVolumeMapper::ApplyPlan(const spaceskip::LatticePlan& plan,
+  const std::vector<vtkDataArray*>& arrays, const std::vector<vtkDataArray*>& second)
 {
+  const bool padSecond =
+    !second.empty() && std::all_of(second.begin(), second.end(), [](vtkDataArray* y) { return y; });
   this->OnLattice = plan.onLattice;
   this->OffLatticeWhy = plan.why;
   this->Lattice = vtkSmartPointer<vtkImageData>::New();
@@ -450,6 +493,10 @@ void vtkSpaceSkipMultiBlockVolumeMapper::ApplyPlan(
     {
       piece->SetExtent(const_cast<int*>(p.need));
       piece->GetPointData()->SetScalars(PaddedScalars(p, plan.pieces, arrays, arrays[i]));
+      if (padSecond)
+      {
+        piece->GetPointData()->AddArray(PaddedScalars(p, plan.pieces, second, second[i]));
+      }
     }
     else
     {

@@ -139,9 +139,13 @@ private:
   bool CollectImages(vtkRenderer* ren, std::vector<vtkImageData*>& images);
   // The table range every block uses; false (Problem set) when no block has the scalars.
   bool TableRange(const std::vector<vtkImageData*>& images, double range[2]);
+  // A second array as the 2-D function's y axis: the blocks' range of it, unless one was given.
+  void SecondAxisRange(const std::vector<vtkImageData*>& images);
   // Lays the blocks on one lattice when what it depends on changed (spaceskip::planLattice).
   void UpdateLattice(const std::vector<vtkImageData*>& images, vtkVolume* vol);
-  void ApplyPlan(const spaceskip::LatticePlan& plan, const std::vector<vtkDataArray*>& arrays);
+  // `second`: the blocks' 2-D y-axis arrays (empty, or with a null: not padded).
+  void ApplyPlan(const spaceskip::LatticePlan& plan, const std::vector<vtkDataArray*>& arrays,
+    const std::vector<vtkDataArray*>& second);
   // Each block's settings, input and depth for this frame.
   void ConfigureBlocks(const double range[2], vtkRenderer* ren, vtkVolume* vol);
   // Whether this frame's block images go to the piece exchange (MPI, one lattice).

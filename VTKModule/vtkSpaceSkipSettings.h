@@ -42,6 +42,7 @@ struct vtkSpaceSkipSettings
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   double WholeOrigin[3] = { 0, 0, 0 };
   double WholeScalarRange[2] = { 1, 0 };
+  double WholeSecondAxisRange[2] = { 1, 0 }; // empty: the input's own (all blocks')
   spaceskip::Tuning Tuning;
   bool LabelMap = false;        // label maps (issue 37)
   int LabelSampling = 1;
@@ -89,6 +90,7 @@ struct vtkSpaceSkipSettings
     m->GetWholeExtent(s.WholeExtent);
     m->GetWholeOrigin(s.WholeOrigin);
     m->GetWholeScalarRange(s.WholeScalarRange);
+    m->GetWholeSecondAxisRange(s.WholeSecondAxisRange);
     s.Tuning = m->GetTuning();
     s.LabelMap = m->GetLabelMap() != 0;
     s.LabelSampling = m->GetLabelSampling();
@@ -140,6 +142,7 @@ struct vtkSpaceSkipSettings
     to->SetVectorComponent(s.VectorComponent);
     to->SetTransfer2DYAxisArray(s.Transfer2DYAxisArray.empty() ? nullptr : s.Transfer2DYAxisArray.c_str());
     to->SetTransfer2DYAxisComponent(s.Transfer2DYAxisComponent);
+    to->SetWholeSecondAxisRange(s.WholeSecondAxisRange);
     to->SetBlendModeOverride(s.BlendModeOverride);
     to->SetBlendMode(s.BlendMode);
     to->SetAverageIPScalarRange(s.AverageIPScalarRange[0], s.AverageIPScalarRange[1]);

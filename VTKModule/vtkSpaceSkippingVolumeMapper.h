@@ -371,6 +371,18 @@ public:
 
   ///@{
   /**
+   * The range of the 2-D transfer function's y-axis array (Transfer2DYAxisArray, its component
+   * Transfer2DYAxisComponent) over the whole data this input is a piece of: the 2-D table's
+   * rows span it on every rank, as they span the whole array's range in a serial render (set by
+   * vtkSpaceSkipVolumeRepresentation under MPI). Empty (the default): the input's own range; for
+   * composite input, the range over all its blocks.
+   */
+  vtkSetVector2Macro(WholeSecondAxisRange, double);
+  vtkGetVector2Macro(WholeSecondAxisRange, double);
+  ///@}
+
+  ///@{
+  /**
    * The most device memory the voxels may take, in MiB (0, the default: the free device memory
    * less what the mapper's other structures need). A volume above it stays sparse: only the
    * bricks the transfer function, blend mode and shading make visible are kept on the device
@@ -590,6 +602,7 @@ protected:
   int WholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   double WholeOrigin[3] = { 0, 0, 0 };
   double WholeScalarRange[2] = { 1, 0 };
+  double WholeSecondAxisRange[2] = { 1, 0 };
   vtkTypeBool LabelMap = 0;
   int LabelSampling = BlendedLabel;
 

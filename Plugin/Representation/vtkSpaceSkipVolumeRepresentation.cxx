@@ -253,6 +253,16 @@ void vtkSpaceSkipVolumeRepresentation::UpdateMapperParameters()
   const bool secondArray = this->UseTransfer2D && !this->UseGradientForTransfer2D && !this->ColorArray2Name.empty();
   this->SpaceSkipMapper->SetTransfer2DYAxisArray(secondArray ? this->ColorArray2Name.c_str() : nullptr);
   this->SpaceSkipMapper->SetTransfer2DYAxisComponent(std::max(this->ColorArray2Component, 0));
+  // Under MPI its range over all ranks (RequestData gathers it): every rank's rows span it.
+  const int k2 = static_cast<int>(this->SecondWholeRanges.size() / 2) - 1; // its components
+  double yRange[2] = { 1, 0 };                                             // none: the piece's own
+  if (secondArray && k2 >= 1)
+  {
+    const int c = std::min(std::max(this->ColorArray2Component, 0), k2 - 1);
+    yRange[0] = this->SecondWholeRanges[2 * c];
+    yRange[1] = this->SecondWholeRanges[2 * c + 1];
+  }
+  this->SpaceSkipMapper->SetWholeSecondAxisRange(yRange);
   this->UpdateLabelMap();
   // Same rule as the base class for vtkSmartVolumeMapper: with independent components the
   // colour map's vector mode and component, else component 0.
@@ -405,6 +415,7 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
 
   // The colour array's range over all ranks (collective: every rank runs RequestData).
   this->WholeRanges.clear();
+  this->SecondWholeRanges.clear();
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   this->UpdateExchange(controller);
   vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
@@ -421,6 +432,16 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
     arrays.push_back(array);
   }
   this->WholeRanges = GatherWholeRanges(controller, arrays);
+  // Color Array 2 (the 2-D transfer function's y axis): its whole range too.
+  std::vector<vtkDataArray*> second;
+  if (vtkDataArray* array = input && !this->ColorArray2Name.empty()
+        ? input->GetPointData()->GetArray(this->ColorArray2Name.c_str())
+        : nullptr)
+  {
+    second.push_back(array);
+  }
+  this->SecondWholeRanges = this->ColorArray2Name.empty() ? std::vector<double>()
+                                                          : GatherWholeRanges(controller, second);
   return ok;
 }
 
@@ -560,12 +581,13 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
   // it) and the range of the drawn array (every rank's table spans it). Collective.
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   this->WholeRanges.clear();
+  this->SecondWholeRanges.clear();
   double wholeOrigin[3] = { 0, 0, 0 };
   int wholeExtent[6] = { 0, -1, 0, -1, 0, -1 };
   if (controller && controller->GetNumberOfProcesses() > 1)
   {
     std::vector<vtkImageData*> images;
-    std::vector<vtkDataArray*> arrays;
+    std::vector<vtkDataArray*> arrays, second;
     vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
     const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
       ? arrayInfo->Get(vtkDataObject::FIELD_NAME())
@@ -580,6 +602,12 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
         {
           arrays.push_back(a);
         }
+        if (vtkDataArray* a = this->ColorArray2Name.empty()
+              ? nullptr
+              : image->GetPointData()->GetArray(this->ColorArray2Name.c_str()))
+        {
+          second.push_back(a);
+        }
       }
     }
     if (!GatherLattice(controller, images, wholeOrigin, wholeExtent))
@@ -589,6 +617,10 @@ int vtkSpaceSkipVolumeRepresentation::RequestPartitionedData(
     if (name && name[0])
     {
       this->WholeRanges = GatherWholeRanges(controller, arrays);
+    }
+    if (!this->ColorArray2Name.empty())
+    {
+      this->SecondWholeRanges = GatherWholeRanges(controller, second);
     }
   }
   this->SpaceSkipMapper->SetWholeOrigin(wholeOrigin);

@@ -156,6 +156,8 @@ protected:
   /// Finite ranges of the colour array over all ranks (lo, hi per component, then the
   /// magnitude's); empty in a serial run.
   std::vector<double> WholeRanges;
+  // Color Array 2's range over all ranks, as WholeRanges (MPI; empty: none).
+  std::vector<double> SecondWholeRanges;
   ///@}
   /// vtkPartitionedDataSet input, which the base class renders only with
   /// vtkMultiBlockVolumeMapper: the same cache of partitions for our mapper (it accepts composite

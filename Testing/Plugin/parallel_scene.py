@@ -11,7 +11,10 @@ Usage: pvbatch parallel_scene.py OUT.png [builder] [scene]
            v * 12 + 24, read from a little-endian raw file by ParaView's Image Reader as a new
            user would: 'unsigned short', DataByteOrder, DataExtent), "vti=PATH" (the same 16-bit
            head from a .vti file, XML Image Data Reader). With raw16 and vti the view keeps
-           ParaView's default FXAA (on), as a new user's does.
+           ParaView's default FXAA (on), as a new user's does. "second" (the MNI scene with a
+           2-D transfer function whose y axis is a second array, the point's y coordinate:
+           Use Transfer 2D, Use Gradient For Transfer 2D off, Color Array 2; under MPI the
+           pieces split along y, so each piece holds another part of that array's range).
 Prints how the data was distributed (the ranks that hold a piece of the volume)."""
 import os
 import sys
@@ -74,6 +77,10 @@ else:
         reader.DataExtent = [0, 98, 0, 116, 0, 94]
         reader.DataSpacing = [2.0, 2.0, 2.0]
         reader.DataOrigin = [-98.0, -134.0, -72.0]
+    if scene == "second":
+        # A second point array, the point's y coordinate, for the 2-D function's y axis.
+        reader = Calculator(Input=reader, AttributeType="Point Data", ResultArrayName="second",
+                            Function="coordsY", ResultArrayType="Float")
     if scene == "rect":
         # The same head as a vtkRectilinearGrid of the same points, per rank's piece.
         image_reader = reader
@@ -98,6 +105,20 @@ else:
         opacity_points=hu([0.0, 0.0, 0.5, 0.0, 30.0, 0.0, 0.5, 0.0, 80.0, 0.03, 0.5, 0.0,
                            160.0, 0.12, 0.5, 0.0, 243.0, 0.3, 0.5, 0.0]))
     disp.ScalarOpacityUnitDistance = 10.0
+    if scene == "second":
+        # One box over values 30..243 and the middle 40 % of the second array's whole range
+        # (the data information's range: all ranks' pieces), which the cut between 2 ranks'
+        # pieces (along y) runs through.
+        ylo, yhi = reader.PointData["second"].GetRange()
+        tf2d = GetTransferFunction2D(ssptest.ARRAY)
+        tf2d.AutomaticRescaleRangeMode = "Never"
+        tf2d.Range = [0.0, 243.0, ylo, yhi]
+        tf2d.Boxes = [30.0, ylo + 0.3 * (yhi - ylo), 213.0, 0.4 * (yhi - ylo), 1.0, 0.85, 0.6, 0.08]
+        tf2d.SMProxy.InvokeCommand("Build")
+        disp.TransferFunction2D = tf2d
+        disp.UseTransfer2D = 1
+        disp.UseGradientForTransfer2D = 0
+        disp.ColorArray2Name = ["POINTS", "second"]
     if not stock:
         disp.Builder = builder
         disp.Backend = "CPU"

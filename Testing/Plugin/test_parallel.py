@@ -40,8 +40,14 @@ it composites across ranks. Measured 2026-11-27 on the 2-core machine, 2 ranks: 
 (FXAA left on), --imagereader Grid and --vti KdTreeCPU alike 60.18 dB, max 8/255, 0.946 % of
 the pixels off at all (0.612 % by more than 1/255): both fail; after it 98.01 dB, max 1/255,
 0.003 % of the pixels off at all (none by more than 1/255), both readers.
+With --second-array the head is drawn through a 2-D transfer function whose y axis is a second
+array, the point's y coordinate (Color Array 2), over a band of y that the cut between the
+pieces runs through: every rank normalises that array over the whole data's range (gathered by
+the representation), as the serial image does. Before that gather each rank used its own
+piece's range, and the box moved to another place on each piece (measured 2026-11-29, 2-core
+machine, 2 ranks, see docs/paraview.md).
 Usage: pvpython test_parallel.py MPIEXEC PVBATCH [--partitioned] [--8bit] [--rectilinear]
-       [--imagereader] [--vti] [builder [ranks...]]
+       [--imagereader] [--vti] [--second-array] [builder [ranks...]]
   builder "stock": ParaView's own Volume representation, reported only (no limit checked)."""
 import os
 import re
@@ -56,9 +62,10 @@ xretry_marks = ("bad X server connection",
                 "require remote rendering which, however, is not available")
 
 args = [a for a in sys.argv[1:]
-        if a not in ("--partitioned", "--8bit", "--rectilinear", "--imagereader", "--vti")]
+        if a not in ("--partitioned", "--8bit", "--rectilinear", "--imagereader", "--vti", "--second-array")]
 partitioned = "--partitioned" in sys.argv
 rectilinear = "--rectilinear" in sys.argv
+second_array = "--second-array" in sys.argv
 ct_reader = "raw16" if "--imagereader" in sys.argv else ("vti" if "--vti" in sys.argv else None)
 if "--8bit" in sys.argv:
     os.environ["SPACESKIP_FLOAT_COMPOSITING"] = "0"  # ParaView's 8-bit compositing (the fallback)
@@ -177,10 +184,11 @@ def write_ct16(kind):
 if ct_reader:
     mpi_scene = [write_ct16(ct_reader)]
 else:
-    mpi_scene = ["vtpd=" + write_partitioned()] if partitioned else (["rect"] if rectilinear else [])
-tag = "_" + ct_reader if ct_reader else ("_rect" if rectilinear else "")
+    mpi_scene = ["vtpd=" + write_partitioned()] if partitioned else (
+        ["rect"] if rectilinear else (["second"] if second_array else []))
+tag = "_" + ct_reader if ct_reader else ("_rect" if rectilinear else ("_second" if second_array else ""))
 serial = image("parallel_serial_%s%s.png" % (builder, tag))
-serial_scene = mpi_scene if ct_reader else (["rect"] if rectilinear else [])
+serial_scene = mpi_scene if ct_reader else (["rect"] if rectilinear else (["second"] if second_array else []))
 rc, _ = run([pvbatch, scene, serial, builder] + serial_scene, 150)
 ok.check(rc == 0 and os.path.exists(serial), "serial pvbatch rendered (rc %d)" % rc)
 a = ssptest.read_png(serial) if os.path.exists(serial) else None

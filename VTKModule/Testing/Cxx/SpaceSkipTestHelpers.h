@@ -8,6 +8,7 @@
 #include "vtkActor.h"
 #include "vtkCamera.h"
 #include "vtkColorTransferFunction.h"
+#include "vtkFloatArray.h"
 #include "vtkCommand.h"
 #include "vtkGPUVolumeRayCastMapper.h"
 #include "vtkImageData.h"
@@ -42,6 +43,31 @@
 
 namespace sstest
 {
+
+// A w x h RGBA float image as ParaView's vtkPVTransferFunction2D builds it: x over the scalar
+// range, y over the normalised gradient magnitude; a box of opacity `a` over normalised value
+// [x0, x1] and gradient magnitude [y0, y1], its colour varying along both axes.
+inline vtkSmartPointer<vtkImageData> MakeBox2D(int w, int h, double x0, double x1, double y0, double y1, double a)
+{
+  auto img = vtkSmartPointer<vtkImageData>::New();
+  img->SetDimensions(w, h, 1);
+  img->AllocateScalars(VTK_FLOAT, 4);
+  auto* s = vtkFloatArray::SafeDownCast(img->GetPointData()->GetScalars());
+  for (int y = 0; y < h; ++y)
+  {
+    for (int x = 0; x < w; ++x)
+    {
+      const double u = (x + 0.5) / w, g = (y + 0.5) / h;
+      const bool in = u >= x0 && u <= x1 && g >= y0 && g <= y1;
+      const vtkIdType i = vtkIdType(y) * w + x;
+      s->SetTypedComponent(i, 0, static_cast<float>(u));
+      s->SetTypedComponent(i, 1, static_cast<float>(1.0 - g));
+      s->SetTypedComponent(i, 2, 0.4f);
+      s->SetTypedComponent(i, 3, in ? static_cast<float>(a) : 0.f);
+    }
+  }
+  return img;
+}
 
 // The wavelet (float, range about [37, 277]) on n^3 points: smooth, with an opacity threshold
 // it leaves large empty regions in the corners.

@@ -6,10 +6,13 @@
 // vtkMultiBlockVolumeMapper on the same blocks; blocks off one lattice (another spacing) or
 // overlapping are drawn each on its own with one warning; a rectilinear block without
 // coordinates for its extent is skipped with one warning (rectilinear blocks that have them are
-// drawn: TestSpaceSkippingVolumeRectilinear); the statistics add up.
+// drawn: TestSpaceSkippingVolumeRectilinear); the statistics add up. A 2-D transfer function
+// whose y axis is a second array (Transfer2DYAxisArray) spans that array's range over all blocks,
+// as the single image's does.
 #include "SpaceSkipTestHelpers.h"
 
 #include "vtkExtractVOI.h"
+#include "vtkFloatArray.h"
 #include "vtkMultiBlockDataSet.h"
 #include "vtkMultiBlockVolumeMapper.h"
 #include "vtkPartitionedDataSet.h"
@@ -72,6 +75,18 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
   image->GetScalarRange(range);
   const double sampleDistance = 0.5;
   const std::string dir = sstest::TempDir(argc, argv);
+  {
+    // A second point array (the point's x index, -3..5) for the 2-D transfer function's y axis;
+    // the blocks cut below carry it.
+    vtkNew<vtkFloatArray> second;
+    second->SetName("second");
+    second->SetNumberOfTuples(image->GetNumberOfPoints());
+    for (vtkIdType n = 0; n < image->GetNumberOfPoints(); ++n)
+    {
+      second->SetValue(n, static_cast<float>(-3.0 + 8.0 * static_cast<double>(n % 64) / 63.0));
+    }
+    image->GetPointData()->AddArray(second);
+  }
 
   // Adjacent blocks share their face plane of points (as ParaView's extent splits do), so
   // every cell lies in one block.
@@ -293,6 +308,40 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
   }
 
   scene.Volume->SetMapper(blocks);
+
+  // A second array as the 2-D function's y axis (a box over the middle of its range): blocks
+  // that each hold part of its range (cut in x) draw the single image's rows, not their own.
+  auto oneD = sstest::RenderWith(scene.Window, scene.Volume, single);
+  scene.Property->SetTransferFunctionMode(vtkVolumeProperty::TF_2D);
+  scene.Property->SetTransferFunction2D(sstest::MakeBox2D(64, 32, 0.3, 0.95, 0.35, 0.65, 0.3));
+  single->SetTransfer2DYAxisArray("second");
+  blocks->SetTransfer2DYAxisArray("second");
+  auto wholeSecond = sstest::RenderWith(scene.Window, scene.Volume, single);
+  if (sstest::MaxDiff(oneD, wholeSecond) < 20)
+  {
+    std::cerr << "the 2-D function over the second array draws the 1-D image\n";
+    ok = false;
+  }
+  for (const Case& c : { cases[1], cases[3] })
+  {
+    blocks->SetInputDataObject(c.input);
+    auto ours = sstest::RenderWith(scene.Window, scene.Volume, blocks);
+    const std::string name = std::string(c.name) + "/second-array";
+    const double psnr = sstest::PrintComparison(name, wholeSecond, ours, "single image", "single");
+    std::cout << "\n";
+    const int maxDiff = sstest::MaxDiff(wholeSecond, ours);
+    if (!(psnr >= kMinPSNRSingle) || maxDiff > kMaxDiffSingle)
+    {
+      std::cerr << name << ": blocks differ from the single image (PSNR " << psnr << ", max diff "
+                << maxDiff << ")\n";
+      sstest::WritePNG(ours, dir + "/Blocks-" + c.name + "-second-array.png");
+      sstest::WritePNG(wholeSecond, dir + "/Blocks-single-second-array.png");
+      ok = false;
+    }
+  }
+  single->SetTransfer2DYAxisArray(nullptr);
+  blocks->SetTransfer2DYAxisArray(nullptr);
+  scene.Property->SetTransferFunctionMode(vtkVolumeProperty::TF_1D);
 
   // The mixed case warned once, not once per frame: the next frames of it add nothing.
   messages->Clear();

@@ -14,31 +14,6 @@ namespace
 {
 // Issue 34's target.
 constexpr double kMinPSNR = 40.0;
-
-// A w x h RGBA float image as ParaView's vtkPVTransferFunction2D builds it: x over the scalar
-// range, y over the normalised gradient magnitude; a box of opacity `a` over normalised value
-// [x0, x1] and gradient magnitude [y0, y1], its colour varying along both axes.
-vtkSmartPointer<vtkImageData> MakeBox2D(int w, int h, double x0, double x1, double y0, double y1, double a)
-{
-  auto img = vtkSmartPointer<vtkImageData>::New();
-  img->SetDimensions(w, h, 1);
-  img->AllocateScalars(VTK_FLOAT, 4);
-  auto* s = vtkFloatArray::SafeDownCast(img->GetPointData()->GetScalars());
-  for (int y = 0; y < h; ++y)
-  {
-    for (int x = 0; x < w; ++x)
-    {
-      const double u = (x + 0.5) / w, g = (y + 0.5) / h;
-      const bool in = u >= x0 && u <= x1 && g >= y0 && g <= y1;
-      const vtkIdType i = vtkIdType(y) * w + x;
-      s->SetTypedComponent(i, 0, static_cast<float>(u));
-      s->SetTypedComponent(i, 1, static_cast<float>(1.0 - g));
-      s->SetTypedComponent(i, 2, 0.4f);
-      s->SetTypedComponent(i, 3, in ? static_cast<float>(a) : 0.f);
-    }
-  }
-  return img;
-}
 }
 
 int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
@@ -71,7 +46,7 @@ int TestSpaceSkippingVolumeGradientTFVsGPU(int argc, char* argv[])
     img->GetPointData()->AddArray(second);
   }
 
-  auto box = MakeBox2D(64, 32, 0.3, 0.95, 0.08, 0.5, 0.15);
+  auto box = sstest::MakeBox2D(64, 32, 0.3, 0.95, 0.08, 0.5, 0.15);
   auto plain = [&](vtkVolumeProperty* p) { sstest::SetupProperty(p, lo, hi, 0.6); };
   auto twoD = [&](vtkVolumeProperty* p) {
     plain(p);
