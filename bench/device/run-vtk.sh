@@ -30,7 +30,8 @@
 #          volume-only scene skips) bench-modes (issue 12: MIP with value-range skipping vs Naive, and the cost of
 #          shading, window and CLI, N-body and Menger 1024^3: modes.log) bench-scatter (issue 34:
 #          volumetric scattering on vs off in one process, and vtkGPUVolumeRayCastMapper with it:
-#          scatter.log) bench-time-series (issue 38: playback of N-body time steps, ours against
+#          scatter.log) bench-time-series (issue 38: playback of time steps (TS_SHAPE: nbody, or rm
+#          for the mixing layer; TS_CASES), ours against
 #          vtkGPUVolumeRayCastMapper in one window, and the CLI's upload bound: time-series.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
 #          its CUDA tests: core.log) auto (the CLI's Builder Auto against fixed builders, dense and
 #          sparse 1024^3: cli-bench.log) cli-ab (CLI kernel fps, settings alternated per process:
@@ -370,11 +371,12 @@ if has bench-time-series; then
   for c in ${TS_CASES:-512:uint8 512:float32 1024:uint8 1024:float32}; do
     late && break
     tn=${c%%:*} tt=${c#*:}
-    echo "==== time series nbody $tn^3 $tt" >> "$work/bench.log"
-    ITEMS=${TS_ITEMS:-Auto} window_bench nbody "$tn" "${vg[@]}" --time-series "${TS_STEPS:-100}" \
+    ts=${TS_SHAPE:-nbody}
+    echo "==== time series $ts $tn^3 $tt" >> "$work/bench.log"
+    ITEMS=${TS_ITEMS:-Auto} window_bench "$ts" "$tn" "${vg[@]}" --time-series "${TS_STEPS:-100}" \
       --steps-held "${TS_HELD:-4}" --step-type "$tt" --vtk-gpu-steps "${TS_VTK_STEPS:-20}"
     if [ -x "$cli" ]; then
-      { echo "==== CLI time series nbody $tn^3 $tt"; timeout 300 "$cli" bench "gen:nbody:$tn" --backend cuda \
+      { echo "==== CLI time series $ts $tn^3 $tt"; timeout 300 "$cli" bench "gen:$ts:$tn" --backend cuda \
           --size 1024x1024 --time-series "${TS_STEPS:-100}" --steps-held "${TS_HELD:-4}" --step-type "$tt"; } \
         >> "$work/time-series-cli.log" 2>&1
     fi
