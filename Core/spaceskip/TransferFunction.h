@@ -75,6 +75,9 @@ struct TransferFunction {
 /// (every gradient magnitude), so a brick is empty only when no value it can take has opacity
 /// at any gradient; with gradient opacity the 1-D table (the factor only lowers opacity), all
 /// transparent when the factor is 0 everywhere. Lossless without any per-brick gradient range.
+/// With `components` 1 the result keeps the 2-D table itself too (table2D, width2D, height2D),
+/// for the backends' per-brick gradient bound (GradientBound.h: a brick's value range x the
+/// gradient magnitude its neighbourhood can reach), which narrows the column rule above.
 /// With `components` 2 (a 2-D table read at component 0 and component 1) the table runs over
 /// the rows instead, height2D + 1 entries over [alphaMin(), alphaMax()] (the range grid's
 /// component), entry j the largest opacity of rows j-1 and j over every column: a brick whose
