@@ -15,6 +15,8 @@ Usage: pvbatch parallel_scene.py OUT.png [builder] [scene]
            2-D transfer function whose y axis is a second array, the point's y coordinate:
            Use Transfer 2D, Use Gradient For Transfer 2D off, Color Array 2; under MPI the
            pieces split along y, so each piece holds another part of that array's range).
+           SPACESKIP_PARALLEL_SECOND=1 adds that array and function to any other scene (e.g.
+           "vtpd=PATH": the partitions each hold part of its range).
 Prints how the data was distributed (the ranks that hold a piece of the volume)."""
 import os
 import sys
@@ -24,6 +26,7 @@ import ssptest
 out = sys.argv[1]
 builder = sys.argv[2] if len(sys.argv) > 2 else "Grid"
 scene = sys.argv[3] if len(sys.argv) > 3 else "mni"
+second = scene == "second" or bool(os.environ.get("SPACESKIP_PARALLEL_SECOND"))
 
 
 def progress(what):
@@ -77,7 +80,7 @@ else:
         reader.DataExtent = [0, 98, 0, 116, 0, 94]
         reader.DataSpacing = [2.0, 2.0, 2.0]
         reader.DataOrigin = [-98.0, -134.0, -72.0]
-    if scene == "second":
+    if second:
         # A second point array, the point's y coordinate, for the 2-D function's y axis.
         reader = Calculator(Input=reader, AttributeType="Point Data", ResultArrayName="second",
                             Function="coordsY", ResultArrayType="Float")
@@ -105,7 +108,7 @@ else:
         opacity_points=hu([0.0, 0.0, 0.5, 0.0, 30.0, 0.0, 0.5, 0.0, 80.0, 0.03, 0.5, 0.0,
                            160.0, 0.12, 0.5, 0.0, 243.0, 0.3, 0.5, 0.0]))
     disp.ScalarOpacityUnitDistance = 10.0
-    if scene == "second":
+    if second:
         # One box over values 30..243 and the middle 40 % of the second array's whole range
         # (the data information's range: all ranks' pieces), which the cut between 2 ranks'
         # pieces (along y) runs through.
