@@ -11,12 +11,11 @@ Usage: pvbatch parallel_scene.py OUT.png [builder] [scene]
            v * 12 + 24, read from a little-endian raw file by ParaView's Image Reader as a new
            user would: 'unsigned short', DataByteOrder, DataExtent), "vti=PATH" (the same 16-bit
            head from a .vti file, XML Image Data Reader). With raw16 and vti the view keeps
-           ParaView's default FXAA (on), as a new user's does. "second" (the MNI scene with a
-           2-D transfer function whose y axis is a second array, the point's y coordinate:
-           Use Transfer 2D, Use Gradient For Transfer 2D off, Color Array 2; under MPI the
-           pieces split along y, so each piece holds another part of that array's range).
-           SPACESKIP_PARALLEL_SECOND=1 adds that array and function to any other scene (e.g.
-           "vtpd=PATH": the partitions each hold part of its range).
+           ParaView's default FXAA (on), as a new user's does.
+           With SPACESKIP_PARALLEL_SECOND=1 the MNI scenes are drawn through a 2-D transfer
+           function whose y axis is a second array, the point's y coordinate (Use Transfer 2D,
+           Use Gradient For Transfer 2D off, Color Array 2): under MPI each piece or partition
+           holds part of that array's range.
 Prints how the data was distributed (the ranks that hold a piece of the volume)."""
 import os
 import sys
@@ -26,7 +25,7 @@ import ssptest
 out = sys.argv[1]
 builder = sys.argv[2] if len(sys.argv) > 2 else "Grid"
 scene = sys.argv[3] if len(sys.argv) > 3 else "mni"
-second = scene == "second" or bool(os.environ.get("SPACESKIP_PARALLEL_SECOND"))
+second = bool(os.environ.get("SPACESKIP_PARALLEL_SECOND"))
 
 
 def progress(what):

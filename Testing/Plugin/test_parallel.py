@@ -67,9 +67,9 @@ args = [a for a in sys.argv[1:]
 partitioned = "--partitioned" in sys.argv
 rectilinear = "--rectilinear" in sys.argv
 second_array = "--second-array" in sys.argv
-if second_array and partitioned:
-    # The partitions get the second array too (parallel_scene.py); the serial image is the
-    # raw head's with it.
+if second_array:
+    # parallel_scene.py adds the array and the 2-D function to the scene, serially and on every
+    # rank (the serial image of --partitioned is the raw head's with it).
     os.environ["SPACESKIP_PARALLEL_SECOND"] = "1"
 ct_reader = "raw16" if "--imagereader" in sys.argv else ("vti" if "--vti" in sys.argv else None)
 if "--8bit" in sys.argv:
@@ -190,10 +190,10 @@ if ct_reader:
     mpi_scene = [write_ct16(ct_reader)]
 else:
     mpi_scene = ["vtpd=" + write_partitioned()] if partitioned else (
-        ["rect"] if rectilinear else (["second"] if second_array else []))
+        ["rect"] if rectilinear else [])
 tag = "_" + ct_reader if ct_reader else ("_rect" if rectilinear else ("_second" if second_array else ""))
 serial = image("parallel_serial_%s%s.png" % (builder, tag))
-serial_scene = mpi_scene if ct_reader else (["rect"] if rectilinear else (["second"] if second_array else []))
+serial_scene = mpi_scene if ct_reader else (["rect"] if rectilinear else [])
 rc, _ = run([pvbatch, scene, serial, builder] + serial_scene, 150)
 ok.check(rc == 0 and os.path.exists(serial), "serial pvbatch rendered (rc %d)" % rc)
 a = ssptest.read_png(serial) if os.path.exists(serial) else None

@@ -322,7 +322,7 @@ int TestSpaceSkippingVolumeBlocks(int argc, char* argv[])
     std::cerr << "the 2-D function over the second array draws the 1-D image\n";
     ok = false;
   }
-  for (const Case& c : { cases[1], cases[3] })
+  for (const Case& c : { Case{ "partitioned-4", four, 4 }, Case{ "gaps-4", gaps, 4 } })
   {
     blocks->SetInputDataObject(c.input);
     auto ours = sstest::RenderWith(scene.Window, scene.Volume, blocks);
