@@ -1,15 +1,17 @@
-"""Ours ('Space Skipping Volume', CPU backend) against ParaView's stock 'Volume' (vtkSmartVolumeMapper
--> the GPU ray caster, on Mesa llvmpipe here), side by side in one pvpython process, stock defaults
-(default colour map and opacity ramp, the camera of ParaView's first Render).
+"""Ours ('Space Skipping Volume', the CPU backend unless --backend says otherwise) against ParaView's
+stock 'Volume' (vtkSmartVolumeMapper -> the GPU ray caster: Mesa llvmpipe on a machine without a GPU,
+NVIDIA's GL on the GPU machine, bench/device/run-pv.sh), side by side in one pvpython process, stock
+defaults (default colour map and opacity ramp, the camera of ParaView's first Render).
 
 Two representations of one source in two views of the same size; frames alternate (ours, stock,
-ours, ...) with the camera turned by a few degrees each frame, and each Render() is timed. Prints
+ours, ...) with the camera turned by a few degrees each frame, and each Render() is timed up to the
+render window's WaitForCompletion (glFinish: the frame drawn, not only queued). Prints
 the median frame times, their ratio (stock / ours: > 1 means ours is faster) and the PSNR between
 the two views' first images.
 
 Usage (an X server is needed: `source scripts/xvfb.sh 97`):
   pvpython bench/cpu-vs-stock.py --plugin build/lib/paraview-5.11/plugins/SpaceSkip/SpaceSkip.so \
-      [--source wavelet|sparse] [--dims 256] [--view 1024] [--frames 5] [--builder Auto]
+      [--source wavelet|sparse] [--dims 256] [--view 1024] [--frames 5] [--builder Auto] [--backend CPU]
 """
 import argparse
 import math
@@ -23,6 +25,7 @@ parser.add_argument("--dims", type=int, default=256)
 parser.add_argument("--view", type=int, default=1024)
 parser.add_argument("--frames", type=int, default=5)
 parser.add_argument("--builder", default="", help="'' keeps the default (Auto)")
+parser.add_argument("--backend", default="CPU", help="ours: CPU, CUDA or Auto")
 parser.add_argument("--turn", type=float, default=4.0, help="degrees the camera turns each frame")
 args = parser.parse_args()
 
@@ -74,7 +77,7 @@ for name, rtype in (("ours", "Space Skipping Volume"), ("stock", "Volume")):
             info = src.GetDataInformation().GetPointDataInformation()
             rep.ColorArrayName = ["POINTS", info.GetArrayInformation(0).GetName()]
         if hasattr(rep, "Backend"):
-            rep.Backend = "CPU"
+            rep.Backend = args.backend
         if args.builder:
             rep.Builder = args.builder
     view.ResetCamera()
@@ -99,6 +102,7 @@ first = {}
 for name in ("ours", "stock"):  # first frames: uploads, builds, Auto's measuring
     t = time.perf_counter()
     simple.Render(views[name])
+    views[name].GetRenderWindow().WaitForCompletion()
     print("%s first frame %.3f s" % (name, time.perf_counter() - t), flush=True)
     first[name] = grab(views[name], name)
 for i in range(args.frames):
@@ -107,6 +111,7 @@ for i in range(args.frames):
         cam.Azimuth(args.turn)
         t = time.perf_counter()
         simple.Render(views[name])
+        views[name].GetRenderWindow().WaitForCompletion()
         times[name].append(time.perf_counter() - t)
 a, b = first["ours"], first["stock"]
 mse = ((a - b) ** 2).mean()

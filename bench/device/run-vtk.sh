@@ -81,32 +81,10 @@ log "bundle unpacked ($(cat "$B/vtk/COMMIT" 2>/dev/null | head -1))"
 } > "$work/env.txt"
 
 # --- X server: the bundled Xvfb, its GLX on the bundled Mesa swrast driver ---------------------
-# Xvfb runs xkbcomp from its compiled-in directory (/usr/bin).
-[ -x /usr/bin/xkbcomp ] || cp "$B/x/bin/xkbcomp" /usr/bin/xkbcomp
-dpy=${XDISPLAY:-77}
-export DISPLAY=:$dpy
-start_xvfb() {  # [extra Xvfb options]
-  LD_LIBRARY_PATH=$B/x/lib LIBGL_DRIVERS_PATH=$B/x/lib/dri \
-    "$B/x/bin/Xvfb" :$dpy -screen 0 1280x1024x24 -nolisten tcp -noreset -xkbdir "$B/x/share/xkb" "$@" \
-    >> "$work/xvfb.log" 2>&1 &
-  xpid=$!
-  for _ in $(seq 50); do [ -S /tmp/.X11-unix/X$dpy ] && break; sleep 0.2; done
-  log "Xvfb $* pid $xpid socket $(ls /tmp/.X11-unix/X$dpy 2>&1)"
-}
-stop_xvfb() {
-  kill $xpid 2>/dev/null
-  wait $xpid 2>/dev/null
-  rm -f /tmp/.X11-unix/X$dpy /tmp/.X$dpy-lock
-}
+. "$src/bench/device/x-gl.sh"
 start_xvfb
 
 # --- GL for the clients: NVIDIA first, Mesa (llvmpipe, bundled) as the fallback ---------------
-# NVIDIA's GLX vendor library: where the machine keeps it (its loader path is kept after ours).
-sys_ldpath=${LD_LIBRARY_PATH:-}
-nvglx=$( (ldconfig -p | awk '/libGLX_nvidia\.so\.0/ {print $NF}'; for d in ${sys_ldpath//:/ } \
-  /usr/local/nvidia/lib64 /usr/local/nvidia/lib /usr/lib/x86_64-linux-gnu /usr/lib64; do
-  ls "$d"/libGLX_nvidia.so.0 2>/dev/null; done) | head -1)
-nvdir=${nvglx:+$(dirname "$nvglx")}
 {
   echo "LD_LIBRARY_PATH at start: $sys_ldpath"
   echo "libGLX_nvidia: ${nvglx:-not found}"

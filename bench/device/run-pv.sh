@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# On a GPU machine without ParaView, X or GL loaders: ParaView's own engine (pvbatch, pvpython) with
+# the SpaceSkip plugin built with CUDA, from the parts of bench/device/bundle-pv.sh and the X part
+# of bundle-vtk.sh (all parked in BUNDLE beforehand, one device call per part). Starts the bundled
+# Xvfb, picks NVIDIA's GLX (REQUIRE_NVIDIA_GL: stop if only Mesa works), then runs the phases:
+#   probe        ParaView's version, GL_RENDERER, the backend ours used (pv-probe.py)
+#   tests        the plugin's pvpython tests (Testing/Plugin/test_*.py; PV_TESTS to choose), each
+#                with the environment ctest gives it: ours on CUDA, the stock Volume on NVIDIA's GL
+#   parallel     test_parallel.py: N pvbatch ranks (mpirun) against serial pvbatch, on this GPU
+#                (PARALLEL_ARGS, default "--imagereader Grid 2")
+#   bench-stock  bench/cpu-vs-stock.py --backend CUDA: ours vs the stock Volume in one process
+#                (STOCK_CASES "source:dims ...", default "sparse:512 wavelet:512"; STOCK_VIEW 1024)
+#   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, --raw)
+#
+#   bench/device/run-pv.sh OUTDIR [PHASE...]     (default: probe tests parallel bench-stock bench-ts)
+#   env: BUNDLE (default /tmp/bun), DEADLINE (epoch seconds: later phases are skipped)
+# OUTDIR receives env.txt, pv.log (everything printed) and logs.tgz (each test's output).
+set -uo pipefail
+out=${1:?usage: run-pv.sh OUTDIR [PHASE...]}
+shift
+phases=${*:-probe tests parallel bench-stock bench-ts}
+src=$(cd "$(dirname "$0")/../.." && pwd)
+bundle=${BUNDLE:-/tmp/bun}
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+work=$(mktemp -d)
+status=0
+has() { case " $phases " in *" $1 "*) return 0 ;; *) return 1 ;; esac; }
+log() { echo "[$(date -u +%H:%M:%S)] $*" | tee -a "$out/pv.log"; }
+late() { [ -n "${DEADLINE:-}" ] && [ "$(date +%s)" -ge "$DEADLINE" ]; }
+
+# --- unpack: the parts of pv.tar.xz, checked against the first part's checksum; the X part ------
+B=$work/bundle
+mkdir -p "$B"
+cat "$bundle"/pv.tar.xz.[0-9] > "$work/pv.tar.xz"
+(cd "$work" && sha256sum -c "$bundle/pv.tar.xz.sha256") >> "$out/pv.log" 2>&1 ||
+  { log "the parts in $bundle do not make pv.tar.xz (missing or stale part)"; exit 1; }
+xz -dc "$work/pv.tar.xz" | tar -C "$B" -xf - && rm "$work/pv.tar.xz"
+xz -dc "$bundle/x.tar.xz" | tar -C "$B" -xf - || { log "cannot unpack $bundle/x.tar.xz"; exit 1; }
+P=$B/pv
+log "bundle unpacked ($(head -1 "$P/COMMIT"))"
+{
+  echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
+  echo "host: $(hostname)  phases: $phases"
+  nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1
+  echo "bundle built from: $(cat "$P/COMMIT")"
+  echo "tree: $(cd "$src" && git rev-parse HEAD 2>/dev/null || echo 'no git (copied tree)')"
+  echo "cores: $(nproc)  os: $(. /etc/os-release 2>/dev/null; echo "$PRETTY_NAME")"
+} > "$out/env.txt"
+
+. "$src/bench/device/x-gl.sh"
+start_xvfb
+# Open MPI: the machine's own 4.x when it has one (its mpirun finds its own components), else the
+# carried Debian one.
+mpilib=
+if ldconfig -p | grep -q "libmpi\.so\.40 "; then
+  echo "Open MPI: the machine's ($(mpirun --version 2>&1 | head -1))" >> "$out/env.txt"
+else
+  mpilib=$P/lib-mpi
+  echo "Open MPI: no libmpi.so.40 here: the carried libraries (parallel phase skipped: no mpirun)" >> "$out/env.txt"
+fi
+export LD_LIBRARY_PATH=$P/lib${mpilib:+:$mpilib}:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
+export __GLX_VENDOR_LIBRARY_NAME=nvidia
+export PYTHONHOME=$P/python PYTHONPATH=$P/python/dist-packages:$src/Testing/Plugin
+export SPACESKIP_PLUGIN=$P/plugin/SpaceSkip.so SPACESKIP_DATA=$src/Data \
+  SPACESKIP_BASELINES=$src/Testing/Plugin/Baseline SPACESKIP_TEMP=$work/tmp
+mkdir -p "$SPACESKIP_TEMP" "$work/logs"
+pvbatch=$P/bin/pvbatch
+pvpython=$P/bin/pvpython
+
+timeout 120 "$pvbatch" --no-mpi "$src/bench/device/pv-probe.py" "$SPACESKIP_PLUGIN" > "$work/logs/probe.log" 2>&1
+cat "$work/logs/probe.log" >> "$out/pv.log"
+if ! grep -q "GL_RENDERER.*NVIDIA" "$work/logs/probe.log"; then
+  log "NVIDIA GL not used by pvbatch (see probe.log)"
+  if [ -n "${REQUIRE_NVIDIA_GL:-}" ]; then
+    stop_xvfb
+    tar -C "$work" -czf "$out/logs.tgz" logs xvfb.log 2>/dev/null
+    exit 3
+  fi
+fi
+{ grep -E "GL_RENDERER|ParaView|backend" "$work/logs/probe.log"; } >> "$out/env.txt"
+
+run() {  # NAME TIMEOUT COMMAND...: logged under logs/NAME.log, its last lines and status in pv.log
+  local name=$1 limit=$2 rc
+  shift 2
+  if late; then log "$name: skipped (DEADLINE)"; return; fi
+  log "$name: $*"
+  local t0=$SECONDS
+  (cd "$work" && timeout "$limit" "$@") > "$work/logs/$name.log" 2>&1
+  rc=$?
+  [ $rc = 0 ] || status=1
+  tail -n "${TAIL:-6}" "$work/logs/$name.log" | sed 's/^/    /' >> "$out/pv.log"
+  log "$name: rc $rc, $((SECONDS - t0)) s"
+}
+
+if has tests; then
+  for t in ${PV_TESTS:-plugin_load render properties tf_edits stock_cropping stock_components \
+      stock_slice_lights stock_transfer2d stock_scattering stock_rectilinear modes partitioned labelmap \
+      time_series hostile_properties}; do
+    run "test_$t" 600 "$pvpython" "$src/Testing/Plugin/test_$t.py"
+  done
+fi
+if has parallel && [ -z "$mpilib" ]; then
+  # shellcheck disable=SC2086
+  run parallel 600 "$pvpython" "$src/Testing/Plugin/test_parallel.py" \
+    "$(command -v mpirun)" "$pvbatch" ${PARALLEL_ARGS:---imagereader Grid 2}
+fi
+if has bench-stock; then
+  for c in ${STOCK_CASES:-sparse:512 wavelet:512}; do
+    TAIL=4 run "stock-${c/:/-}" 600 "$pvpython" "$src/bench/cpu-vs-stock.py" --plugin "$SPACESKIP_PLUGIN" \
+      --backend CUDA --source "${c%%:*}" --dims "${c##*:}" --view "${STOCK_VIEW:-1024}" --frames 20
+  done
+fi
+if has bench-ts; then
+  TAIL=4 run "time-series" 600 "$pvpython" "$src/bench/time-series-vs-stock.py" --plugin "$SPACESKIP_PLUGIN" \
+    --backend CUDA --dims "${TS_DIMS:-512}" --steps "${TS_STEPS:-10}" --raw --workdir "$work/ts"
+fi
+stop_xvfb
+tar -C "$work" -czf "$out/logs.tgz" logs xvfb.log 2>/dev/null
+log "done (status $status)"
+exit $status
