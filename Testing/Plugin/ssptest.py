@@ -3,6 +3,8 @@
 Environment (set by CTest, see CMakeLists.txt): SPACESKIP_PLUGIN (the plugin .so),
 SPACESKIP_DATA (Data/ folder), SPACESKIP_BASELINES (Baseline/ folder), SPACESKIP_TEMP (output
 folder for images). A missing baseline fails the test and leaves the image in SPACESKIP_TEMP.
+SPACESKIP_TEST_BACKEND (optional: CPU, CUDA or Auto) replaces the backend the tests ask for
+(CPU: the CI machine has no GPU; bench/device/run-pv.sh sets CUDA on the GPU machine).
 """
 import math
 import os
@@ -19,6 +21,28 @@ def env(name):
     if not value:
         raise RuntimeError("environment variable %s is not set (run through ctest)" % name)
     return value
+
+
+def launcher_env(extra=None):
+    """The environment for a child mpiexec, pvserver or paraview: without the job state Open MPI
+    put into this process when pvpython initialised MPI as a singleton (it would make the child
+    mpiexec think it runs inside a job), but with the user's own Open MPI/PMIx settings
+    (OMPI_MCA_*, PMIX_MCA_*, OPAL_PREFIX: e.g. OMPI_MCA_plm=isolated where no ssh exists)."""
+    job_state = ("OMPI_MCA_ess", "OMPI_MCA_orte_", "OMPI_MCA_pmix", "OMPI_MCA_initial_wdir")
+
+    def keep(k):
+        if k.startswith(job_state):
+            return False
+        if k.startswith("OMPI_"):
+            return k.startswith("OMPI_MCA_")
+        if k.startswith("PMIX_"):
+            return k.startswith("PMIX_MCA_")
+        if k.startswith("OPAL_"):
+            return k == "OPAL_PREFIX"
+        return not k.startswith(("PRTE_", "HYDRA_", "PMI_"))
+    env = {k: v for k, v in os.environ.items() if keep(k)}
+    env.update(extra or {})
+    return env
 
 
 def temp_path(name):
@@ -88,7 +112,7 @@ def show_space_skipping(source, view, builder="KdTreeCPU", backend="CPU"):
     set_transfer_functions()
     disp.ScalarOpacityUnitDistance = 4.0
     disp.Builder = builder
-    disp.Backend = backend
+    disp.Backend = os.environ.get("SPACESKIP_TEST_BACKEND") or backend
     return disp
 
 

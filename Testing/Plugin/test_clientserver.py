@@ -38,9 +38,8 @@ def free_port():
 
 def start_server(pvserver, port, mpiexec=None):
     mpi = [mpiexec, "--allow-run-as-root", "--oversubscribe", "-n", "2"] if mpiexec else []
-    # pvpython may have initialised MPI (as a singleton): its variables would confuse mpiexec.
-    env = {k: v for k, v in os.environ.items()
-           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "PRTE_", "HYDRA_", "PMI_"))}
+    # pvpython may have initialised MPI (as a singleton): its job state would confuse mpiexec.
+    env = ssptest.launcher_env()
     server = subprocess.Popen(
         ["timeout", "-s", "KILL", str(SERVER_SECONDS)] + mpi + [pvserver, "--server-port=%d" % port],
         env=env,

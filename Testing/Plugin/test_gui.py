@@ -18,10 +18,8 @@ for name in ("gui_done.txt", "gui_view.png", "gui_window.png", "gui_first.png", 
     if os.path.exists(os.path.join(out, name)):
         os.remove(os.path.join(out, name))
 
-env = dict(os.environ)
-env["PV_PLUGIN_PATH"] = plugin_dir
-env["SPACESKIP_GUI_SCENE"] = os.path.join(here, "gui_scene.py")
-env = {k: v for k, v in env.items() if not k.startswith(("OMPI_", "PMIX_", "OPAL_"))}
+env = ssptest.launcher_env({"PV_PLUGIN_PATH": plugin_dir,
+                            "SPACESKIP_GUI_SCENE": os.path.join(here, "gui_scene.py")})
 log = open(os.path.join(out, "gui_paraview.log"), "w")
 proc = subprocess.Popen([paraview, "--dr", "--script=" + env["SPACESKIP_GUI_SCENE"]],
                         env=env, stdout=log, stderr=subprocess.STDOUT)

@@ -96,10 +96,9 @@ ok = ssptest.Checker()
 def run(cmd, timeout):
     print("$ " + " ".join(cmd))
     # timeout: a Python exception on one rank leaves the others waiting forever.
-    # pvpython itself may have initialised MPI (as a singleton): its OMPI_/PMIX_ variables
-    # would make the child mpiexec think it runs inside a job.
-    env = {k: v for k, v in os.environ.items()
-           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "PRTE_", "HYDRA_", "PMI_"))}
+    # pvpython itself may have initialised MPI (as a singleton): ssptest.launcher_env drops its
+    # job state, which would make the child mpiexec think it runs inside a job.
+    env = ssptest.launcher_env()
     try:
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                            timeout=timeout, env=env)

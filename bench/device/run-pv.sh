@@ -5,7 +5,8 @@
 # Xvfb, picks NVIDIA's GLX (REQUIRE_NVIDIA_GL: stop if only Mesa works), then runs the phases:
 #   probe        ParaView's version, GL_RENDERER, the backend ours used (pv-probe.py)
 #   tests        the plugin's pvpython tests (Testing/Plugin/test_*.py; PV_TESTS to choose), each
-#                with the environment ctest gives it: ours on CUDA, the stock Volume on NVIDIA's GL
+#                with the environment ctest gives it, ours on CUDA (TEST_BACKEND), the stock Volume
+#                on NVIDIA's GL
 #   parallel     test_parallel.py: N pvbatch ranks (mpirun) against serial pvbatch, on this GPU
 #                (PARALLEL_ARGS, default "--imagereader Grid 2")
 #   bench-stock  bench/cpu-vs-stock.py --backend CUDA: ours vs the stock Volume in one process
@@ -54,7 +55,7 @@ start_xvfb
 # carried Debian one.
 mpilib=
 if ldconfig -p | grep -q "libmpi\.so\.40 "; then
-  echo "Open MPI: the machine's ($(mpirun --version 2>&1 | head -1))" >> "$out/env.txt"
+  echo "Open MPI: the machine's ($(mpirun --version 2>&1 | head -1)); $(env | grep -E '^(OMPI_MCA|PMIX_MCA)' | tr '\n' ' ')" >> "$out/env.txt"
 else
   mpilib=$P/lib-mpi
   echo "Open MPI: no libmpi.so.40 here: the carried libraries (parallel phase skipped: no mpirun)" >> "$out/env.txt"
@@ -62,6 +63,8 @@ fi
 export LD_LIBRARY_PATH=$P/lib${mpilib:+:$mpilib}:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
 export __GLX_VENDOR_LIBRARY_NAME=nvidia
 export PYTHONHOME=$P/python PYTHONPATH=$P/python/dist-packages:$src/Testing/Plugin
+# The plugin's tests ask for the CPU backend (CI has no GPU): here CUDA (TEST_BACKEND) instead.
+export SPACESKIP_TEST_BACKEND=${TEST_BACKEND:-CUDA}
 export SPACESKIP_PLUGIN=$P/plugin/SpaceSkip.so SPACESKIP_DATA=$src/Data \
   SPACESKIP_BASELINES=$src/Testing/Plugin/Baseline SPACESKIP_TEMP=$work/tmp
 mkdir -p "$SPACESKIP_TEMP" "$work/logs"
