@@ -4,9 +4,12 @@ GPU), the same steps in the same view, one pvpython process.
 
 The steps: N^3 uint8 .vti files of balls that drift apart and a ball that grows, step by step, in a
 background of exact zeros (sparse, as a simulation's early steps), listed in a .pvd. The animation
-scene steps AnimationTime over them; each Render() is timed (the reader's load of the step, the
-representation's update and the frame). Rounds alternate ours, stock, ours, stock; the median
-step time of each and their ratio (stock / ours: > 1 means ours is faster) are printed.
+scene steps AnimationTime over them; each step is timed in two parts: the switch (AnimationTime
+set: ParaView loads the step and gathers its data information, the same for every representation;
+in ParaView 5.11 the array's range is computed there, with VTK's SMP backend: set
+VTK_SMP_BACKEND_IN_USE=STDThread for threads) and the frame (Render() up to WaitForCompletion: the
+representation's upload and drawing). Rounds alternate ours, stock and Outline (the floor of any
+representation); the medians and the ratios stock / ours (> 1 means ours is faster) are printed.
 
 Usage (an X server is needed: `source scripts/xvfb.sh 97`):
   pvpython bench/time-series-vs-stock.py --plugin build/lib/paraview-5.11/plugins/SpaceSkip/SpaceSkip.so \
@@ -78,7 +81,9 @@ with open(pvd, "w") as f:
         name = "step_%s_%d.vti" % (tag, k)
         path = os.path.join(args.workdir, name)
         if not os.path.exists(path):
+            t0 = time.perf_counter()
             write_step(path, k)
+            print("  wrote %s in %.2f s" % (name, time.perf_counter() - t0), flush=True)
         f.write('<DataSet timestep="%d" file="%s"/>\n' % (k, name))
     f.write('</Collection>\n</VTKFile>\n')
 
@@ -109,13 +114,17 @@ def set_rep(name):
 
 
 def play():
+    """Each step: (the switch, the frame) in ms. The switch (AnimationTime set) is where ParaView
+    loads the step and gathers its data information for every representation alike; the frame
+    (Render() up to WaitForCompletion) is where the representation uploads and draws it."""
     ms = []
     for t in times:
-        scene.AnimationTime = t
         t0 = time.perf_counter()
+        scene.AnimationTime = t
+        t1 = time.perf_counter()
         simple.Render(view)
         view.GetRenderWindow().WaitForCompletion()  # the frame drawn, not only queued
-        ms.append(1e3 * (time.perf_counter() - t0))
+        ms.append((1e3 * (t1 - t0), 1e3 * (time.perf_counter() - t1)))
     return ms
 
 
@@ -124,17 +133,28 @@ def play():
 results = {"Space Skipping Volume": [], "Volume": [], "Outline": []}
 for r in range(args.rounds):
     for name in results:
+        t0 = time.perf_counter()
         set_rep(name)
+        t1 = time.perf_counter()
         results[name] += play()
-ours = statistics.median(results["Space Skipping Volume"])
-stock = statistics.median(results["Volume"])
-floor = statistics.median(results["Outline"])
-print("time series %d^3 uint8, %d steps (.pvd of %s .vti), %dx%d view, %d rounds:" %
-      (N, K, "raw" if args.raw else "zlib-compressed", args.view, args.view, args.rounds))
-print("  a step (AnimationTime set -> Render() returned), median: ours %.1f ms (%.2f steps/s), stock Volume %.1f ms "
-      "(%.2f steps/s): %.2fx" % (ours, 1e3 / ours, stock, 1e3 / stock, stock / ours))
-print("  the floor (Outline: the step's load, the pipeline and a frame): %.1f ms; ours %.1f ms above it, "
-      "the stock Volume %.1f ms" % (floor, ours - floor, stock - floor))
+        print("  round %d, %s: first frame %.2f s, %d steps %.2f s" %
+              (r, name, t1 - t0, K, time.perf_counter() - t1), flush=True)
+def medians(name):
+    switch = statistics.median(m[0] for m in results[name])
+    frame = statistics.median(m[1] for m in results[name])
+    step = statistics.median(m[0] + m[1] for m in results[name])
+    return switch, frame, step
+
+
+ours, stock, floor = medians("Space Skipping Volume"), medians("Volume"), medians("Outline")
+print("time series %d^3 uint8, %d steps (.pvd of %s .vti), %dx%d view, %d rounds, VTK_SMP_BACKEND_IN_USE=%s:" %
+      (N, K, "raw" if args.raw else "zlib-compressed", args.view, args.view, args.rounds,
+       os.environ.get("VTK_SMP_BACKEND_IN_USE", "(unset)")))
+for label, m in (("ours", ours), ("stock Volume", stock), ("Outline (the floor)", floor)):
+    print("  %-20s a step %.1f ms (%.2f steps/s): the switch %.1f ms + the frame %.1f ms (medians)" %
+          (label, m[2], 1e3 / m[2], m[0], m[1]))
+print("  stock / ours: a step %.2fx, the frame %.2fx; ours' frame above the floor's %.1f ms" %
+      (stock[2] / ours[2], stock[1] / ours[1], ours[1] - floor[1]))
 disp.SetRepresentationType("Space Skipping Volume")
 disp.UpdatePropertyInformation()
 print("  ours: backend %s, builder %s; %s" % (disp.GetPropertyValue("BackendUsed"), disp.GetPropertyValue("BuilderUsed"),

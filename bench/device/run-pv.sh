@@ -11,7 +11,8 @@
 #                (PARALLEL_ARGS, default "--imagereader Grid 2")
 #   bench-stock  bench/cpu-vs-stock.py --backend CUDA: ours vs the stock Volume in one process
 #                (STOCK_CASES "source:dims ...", default "sparse:512 wavelet:512"; STOCK_VIEW 1024)
-#   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, --raw)
+#   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
+#                --raw; TS_WORKDIR keeps the written steps for a later run)
 #
 #   bench/device/run-pv.sh OUTDIR [PHASE...]     (default: probe tests parallel bench-stock bench-ts)
 #   env: BUNDLE (default /tmp/bun), DEADLINE (epoch seconds: later phases are skipped)
@@ -116,7 +117,8 @@ if has bench-stock; then
 fi
 if has bench-ts; then
   TAIL=4 run "time-series" 600 "$pvpython" "$src/bench/time-series-vs-stock.py" --plugin "$SPACESKIP_PLUGIN" \
-    --backend CUDA --dims "${TS_DIMS:-512}" --steps "${TS_STEPS:-10}" --raw --workdir "$work/ts"
+    --backend CUDA --dims "${TS_DIMS:-512}" --steps "${TS_STEPS:-10}" --rounds "${TS_ROUNDS:-2}" --raw \
+    --workdir "${TS_WORKDIR:-$work/ts}"
 fi
 stop_xvfb
 tar -C "$work" -czf "$out/logs.tgz" logs xvfb.log 2>/dev/null
