@@ -11,6 +11,11 @@
 #                (PARALLEL_ARGS, default "--imagereader Grid 2")
 #   bench-stock  bench/cpu-vs-stock.py --backend CUDA: ours vs the stock Volume in one process
 #                (STOCK_CASES "source:dims ...", default "sparse:512 wavelet:512"; STOCK_VIEW 1024)
+#   bench-pvbatch  bench/pvbatch-orbit.py: pvbatch on 1 rank and mpirun -n N pvbatch (PVB_RANKS,
+#                default "1 2"; each rank picks the GPU of its node-local rank) on a generated
+#                volume (PVB_SHAPE nbody, PVB_N 2048: spaceskip generate, kept in PVB_DIR, default
+#                /tmp/pvb), PVB_FRAMES 60 at 1024^2, each N-rank first frame against the 1-rank one;
+#                PVB_STOCK=1: ParaView's Volume too (PVB_BACKEND CUDA, PVB_VIEW 1024)
 #   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
 #                --raw; TS_WORKDIR keeps the written steps for a later run)
 #
@@ -20,7 +25,7 @@
 set -uo pipefail
 out=${1:?usage: run-pv.sh OUTDIR [PHASE...]}
 shift
-phases=${*:-probe tests parallel bench-stock bench-ts}
+phases=${*:-probe tests parallel bench-stock bench-ts}  # bench-pvbatch on request
 src=$(cd "$(dirname "$0")/../.." && pwd)
 bundle=${BUNDLE:-/tmp/bun}
 mkdir -p "$out"
@@ -72,7 +77,8 @@ mkdir -p "$SPACESKIP_TEMP" "$work/logs"
 pvbatch=$P/bin/pvbatch
 pvpython=$P/bin/pvpython
 
-timeout 120 "$pvbatch" --no-mpi "$src/bench/device/pv-probe.py" "$SPACESKIP_PLUGIN" > "$work/logs/probe.log" 2>&1
+probe() { timeout 120 "$pvbatch" --no-mpi "$src/bench/device/pv-probe.py" "$SPACESKIP_PLUGIN" > "$work/logs/probe.log" 2>&1; }
+probe
 cat "$work/logs/probe.log" >> "$out/pv.log"
 if ! grep -q "GL_RENDERER.*NVIDIA" "$work/logs/probe.log"; then
   log "NVIDIA GL not used by pvbatch (see probe.log)"
@@ -81,6 +87,12 @@ if ! grep -q "GL_RENDERER.*NVIDIA" "$work/logs/probe.log"; then
     tar -C "$work" -czf "$out/logs.tgz" logs xvfb.log 2>/dev/null
     exit 3
   fi
+  # The bundled Mesa (llvmpipe) instead, and say so.
+  unset __GLX_VENDOR_LIBRARY_NAME
+  export LIBGL_DRIVERS_PATH=$B/x/lib/dri
+  probe
+  cat "$work/logs/probe.log" >> "$out/pv.log"
+  echo "FALLBACK: Mesa (NVIDIA's GLX did not work)" >> "$out/env.txt"
 fi
 { grep -E "GL_RENDERER|ParaView|backend" "$work/logs/probe.log"; } >> "$out/env.txt"
 
@@ -114,6 +126,25 @@ if has bench-stock; then
     TAIL=4 run "stock-${c/:/-}" 600 "$pvpython" "$src/bench/cpu-vs-stock.py" --plugin "$SPACESKIP_PLUGIN" \
       --backend CUDA --source "${c%%:*}" --dims "${c##*:}" --view "${STOCK_VIEW:-1024}" --frames 20
   done
+fi
+if has bench-pvbatch; then
+  n=${PVB_N:-2048}
+  shape=${PVB_SHAPE:-nbody}
+  mkdir -p "${PVB_DIR:-/tmp/pvb}"
+  raw=${PVB_DIR:-/tmp/pvb}/${shape}_${n}x${n}x${n}_uint8.raw
+  [ -f "$raw" ] || run "generate-$shape-$n" 600 "$P/bin/spaceskip" generate "$shape" --dims "$n" "$n" "$n" -o "$raw"
+  for stock in "" ${PVB_STOCK:+--stock}; do
+    for r in ${PVB_RANKS:-1 2}; do
+      tag=pvbatch-$r${stock:+-stock}
+      launch=("$pvbatch")
+      [ "$r" = 1 ] || launch=(mpirun --allow-run-as-root --oversubscribe --bind-to none -n "$r" "$pvbatch")
+      ref=()
+      [ "$r" = 1 ] || ref=(--reference "$work/logs/pvbatch-1${stock:+-stock}.png")
+      TAIL=3 run "$tag" 600 "${launch[@]}" "$src/bench/pvbatch-orbit.py" --plugin "$SPACESKIP_PLUGIN" \
+        --raw "$raw" --frames "${PVB_FRAMES:-60}" --backend "${PVB_BACKEND:-CUDA}" --view "${PVB_VIEW:-1024}" $stock --png "$work/logs/$tag.png" "${ref[@]}"
+    done
+  done
+  grep -h "^PVBATCH_ORBIT" "$work"/logs/pvbatch-*.log >> "$out/pv.log"
 fi
 if has bench-ts; then
   TAIL=4 run "time-series" 600 "$pvpython" "$src/bench/time-series-vs-stock.py" --plugin "$SPACESKIP_PLUGIN" \
