@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Packs, on the development machine (Debian 12 + ParaView 5.11), ParaView's own engine for a GPU
 # machine that has no ParaView, X server or GL loader: pvbatch and pvpython, the SpaceSkip plugin
-# built with CUDA, the spaceskip CLI (to generate volumes there), the closure of shared libraries they load (ldd, minus glibc and the C++ runtime,
+# built with CUDA, the spaceskip CLI (to generate volumes there: GEN_CLI), the closure of shared libraries they load (ldd, minus glibc and the C++ runtime,
 # whose GPU-machine copies are newer), Python 3.11's standard library and the Python packages the
 # plugin's tests and benchmarks import (paraview, vtkmodules, numpy).
 #
@@ -38,8 +38,11 @@ cp -L /usr/bin/pvbatch3.11 "$pv/bin/pvbatch"
 cp -L /usr/bin/pvpython3.11 "$pv/bin/pvpython"
 cp -L "$plugin"/*.so "$pv/plugin/"
 cp -L "$build/lib/libvtkSpaceSkip.so" "$pv/lib/"
-# The CLI: run-pv.sh's bench-pvbatch generates its volumes with it (spaceskip generate).
-[ -x "$build/Core/spaceskip" ] && cp "$build/Core/spaceskip" "$pv/bin/"
+# The CLI: run-pv.sh's bench-pvbatch generates its volumes with it (spaceskip generate, on the
+# CPU). GEN_CLI, default a CPU-only build's (build-cpu: 4 MB against the CUDA build's 42 MB of xz).
+cli=${GEN_CLI:-$src/build-cpu/Core/spaceskip}
+[ -x "$cli" ] || cli=$build/Core/spaceskip
+[ -x "$cli" ] && cp "$cli" "$pv/bin/spaceskip"
 
 # Python: the standard library without its tests and GUI toolkits, and the packages used.
 tar -C /usr/lib -cf - --exclude=__pycache__ --exclude=python3.11/test --exclude=python3.11/idlelib \
