@@ -16,7 +16,8 @@ ok.check(0.05 < lit < 0.9, "the volume covers %.1f%% of the image" % (100 * lit)
 s = ssptest.stats(disp)
 print("statistics:", s)
 backend = (os.environ.get("SPACESKIP_TEST_BACKEND") or "CPU").lower()  # as ssptest asks for it
-ok.check(s["BuilderUsed"] == "Grid" and s["BackendUsed"] == backend and s["BuildCount"] >= 1,
+ok.check(s["BuilderUsed"] == "Grid" and s["BackendUsed"] in ((backend,) if backend != "auto" else ("cpu", "cuda"))
+         and s["BuildCount"] >= 1,
          "the Grid was built and the %s backend drew" % backend)
 ok.check(0.0 < s["Occupancy"] < 1.0, "part of the volume is empty (occupancy %.3f)"
          % s["Occupancy"])
