@@ -64,7 +64,7 @@ if ldconfig -p | grep -q "libmpi\.so\.40 "; then
   echo "Open MPI: the machine's ($(mpirun --version 2>&1 | head -1)); $(env | grep -E '^(OMPI_MCA|PMIX_MCA)' | tr '\n' ' ')" >> "$out/env.txt"
 else
   mpilib=$P/lib-mpi
-  echo "Open MPI: no libmpi.so.40 here: the carried libraries (parallel phase skipped: no mpirun)" >> "$out/env.txt"
+  echo "Open MPI: no libmpi.so.40 here: the carried libraries (no mpirun: the parallel phase and several pvbatch ranks skipped)" >> "$out/env.txt"
 fi
 export LD_LIBRARY_PATH=$P/lib${mpilib:+:$mpilib}:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
 export __GLX_VENDOR_LIBRARY_NAME=nvidia
@@ -135,6 +135,8 @@ if has bench-pvbatch; then
   [ -f "$raw" ] || run "generate-$shape-$n" 600 "$P/bin/spaceskip" generate "$shape" --dims "$n" "$n" "$n" -o "$raw"
   for stock in "" ${PVB_STOCK:+--stock}; do
     for r in ${PVB_RANKS:-1 2}; do
+      # Several ranks need the machine's mpirun (as the parallel phase does).
+      [ "$r" = 1 ] || [ -z "$mpilib" ] || { log "pvbatch-$r: skipped (no mpirun here)"; continue; }
       tag=pvbatch-$r${stock:+-stock}
       launch=("$pvbatch")
       [ "$r" = 1 ] || launch=(mpirun --allow-run-as-root --oversubscribe --bind-to none -n "$r" "$pvbatch")
