@@ -89,8 +89,9 @@ void CameraInIndexSpace(vtkRenderer* ren, vtkVolume* vol, vtkImageData* lattice,
 
 //------------------------------------------------------------------------------
 void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const double dir[3],
-  bool parallel, int width, int height, spaceskip::Image& out)
+  bool parallel, int width, int height, spaceskip::Image& out, double stopAt)
 {
+  const float stop = static_cast<float>(std::min(stopAt, 2.0));
   std::vector<spaceskip::PieceBox> boxes;
   std::vector<const PieceImage*> parts;
   for (const PieceImage& p : pieces)
@@ -116,6 +117,10 @@ void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const dou
       spaceskip::vec4f* dst = out.rgba.data() + size_t(p.Y + y) * size_t(width) + size_t(p.X);
       for (int x = 0; x < p.Width; ++x, src += 4, ++dst)
       {
+        if (dst->w >= stop)
+        {
+          continue;
+        }
         const float t = 1.f - dst->w;
         dst->x += t * src[0];
         dst->y += t * src[1];

@@ -47,9 +47,11 @@ void CameraInIndexSpace(vtkRenderer* ren, vtkVolume* vol, vtkImageData* lattice,
 
 /// `pieces` blended front to back in the order the rays meet their boxes
 /// (spaceskip::visibilityOrder), in float, into `out` (`width` x `height`). Pieces without cells
-/// or outside the viewport are left out.
+/// or outside the viewport are left out. A pixel whose opacity has reached `stopAt` (the early
+/// ray termination threshold; above 1: never) takes nothing from the pieces behind: the single
+/// image's ray stopped in front of them.
 void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const double dir[3],
-  bool parallel, int width, int height, spaceskip::Image& out);
+  bool parallel, int width, int height, spaceskip::Image& out, double stopAt = 2.0);
 }
 
 #endif

@@ -43,8 +43,12 @@ namespace
 constexpr int kTableSize = 1024;
 // Entries of the gradient-opacity table: vtkOpenGLVolumeGradientOpacityTable's texture width.
 constexpr int kGradientTableSize = 1024;
-// Opacity at which a ray stops when EarlyRayTermination is on (vtkGPUVolumeRayCastMapper's 0.99).
-constexpr double kErtThreshold = 0.99;
+// Opacity at which a ray stops when EarlyRayTermination is on: 1 - 1/255, the threshold of
+// vtkGPUVolumeRayCastMapper's shaders (g_opacityThreshold). What a stopped ray leaves out is below
+// one 8-bit step, so the image stays within 1/255 of the unterminated one, and pieces drawn apart
+// (MPI ranks, blocks) composite to the single image within 1/255; at 0.99 a piece behind a
+// terminated one still added up to 1 % (2/255 between 2 ranks and 1 on the N-body ramp).
+constexpr double kErtThreshold = 1.0 - 1.0 / 255.0;
 
 static_assert(static_cast<int>(spaceskip::BlendMode::Isosurface) == vtkVolumeMapper::ISOSURFACE_BLEND &&
     static_cast<int>(spaceskip::BlendMode::MaximumIntensity) == vtkVolumeMapper::MAXIMUM_INTENSITY_BLEND,
@@ -84,6 +88,12 @@ vtkImageData* vtkSpaceSkipPropertyTranslator::Usable2D(vtkVolumeProperty* prop)
   const bool ok = a && a->GetNumberOfComponents() == 4 && dims[0] >= 1 && dims[1] >= 1 && dims[2] == 1 &&
     int64_t(dims[0]) * dims[1] <= (int64_t(1) << 24) && a->GetNumberOfTuples() == vtkIdType(dims[0]) * dims[1];
   return ok ? img : nullptr;
+}
+
+//------------------------------------------------------------------------------
+double vtkSpaceSkipPropertyTranslator::EarlyTerminationOpacity(const vtkSpaceSkipSettings& s)
+{
+  return s.EarlyRayTermination ? kErtThreshold : 2.0;
 }
 
 //------------------------------------------------------------------------------
@@ -299,7 +309,7 @@ void vtkSpaceSkipPropertyTranslator::UpdateParameters(spaceskip::Engine& engine,
   engine.setBuildParams(bp);
   spaceskip::RenderParams rp = engine.renderParams();
   rp.sampleDistance = s.SampleDistance;
-  rp.ertThreshold = s.EarlyRayTermination ? kErtThreshold : 2.0;
+  rp.ertThreshold = EarlyTerminationOpacity(s);
   rp.jitter = s.UseJittering;
   // vtkVolumeProperty's InterpolationType: nearest samples the nearest voxel (the skipping is the
   // same: that voxel is one of a trilinear sample's corners).

@@ -71,6 +71,10 @@ public:
   /// vtkPVTransferFunction2D); else nullptr.
   static vtkImageData* Usable2D(vtkVolumeProperty* prop);
 
+  /// The accumulated opacity at which `settings` stop a ray (early ray termination: 1 - 1/255,
+  /// vtkGPUVolumeRayCastMapper's threshold); above 1 when rays never stop early.
+  static double EarlyTerminationOpacity(const vtkSpaceSkipSettings& settings);
+
   /**
    * Gives the engine the build parameters and the render parameters of `settings` (its
    * effective blend mode, iso values, shading and lights, cropping, clipping planes, jitter, early ray

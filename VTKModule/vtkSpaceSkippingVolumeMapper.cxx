@@ -20,6 +20,7 @@
 #include "vtkSpaceSkipInputConverter.h"
 #include "vtkSpaceSkipMultiBlockVolumeMapper.h"
 #include "vtkSpaceSkipPieceCompositing.h"
+#include "vtkSpaceSkipPropertyTranslator.h"
 #include "vtkSpaceSkipSettings.h"
 #include "vtkVolume.h"
 #include "vtkVolumeProperty.h"
@@ -664,8 +665,15 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   {
     // Every piece front to back in the order the rays meet them, blended in float: one
     // rounding to 8 bits, as the serial image.
+    // A pixel whose ray stopped early in front pieces takes nothing from those behind it, as
+    // the single image's ray (composite and isosurface blending accumulate opacity).
     std::move(mine.begin(), mine.end(), std::back_inserter(others));
-    pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged);
+    const vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(this);
+    const int mode = s.EffectiveBlendMode();
+    const double stopAt = mode == vtkVolumeMapper::COMPOSITE_BLEND || mode == vtkVolumeMapper::ISOSURFACE_BLEND
+      ? vtkSpaceSkipPropertyTranslator::EarlyTerminationOpacity(s)
+      : 2.0;
+    pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged, stopAt);
     drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
   }
   if (!drawn)

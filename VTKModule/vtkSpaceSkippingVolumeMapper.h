@@ -210,7 +210,8 @@ public:
 
   ///@{
   /**
-   * Stop a ray once its opacity reaches 0.99 (default on).
+   * Stop a ray once its opacity reaches 1 - 1/255, as vtkGPUVolumeRayCastMapper does (default
+   * on): the light it leaves out is below one 8-bit step.
    */
   vtkSetMacro(EarlyRayTermination, vtkTypeBool);
   vtkGetMacro(EarlyRayTermination, vtkTypeBool);

@@ -58,6 +58,7 @@ out.GetCellData().ShallowCopy(inp.GetCellData())
 
 ssptest.load_plugin()
 stock = builder == "stock" or bool(os.environ.get("SPACESKIP_STOCK_VOLUME"))
+opaque = bool(os.environ.get("SPACESKIP_PARALLEL_OPAQUE"))
 if scene == "shell":
     reader, view, disp = ssptest.make_scene(builder="Grid" if stock else builder, backend="CPU")
 else:
@@ -104,9 +105,13 @@ else:
     ssptest.set_transfer_functions(
         lut_points=hu([0.0, 0.05, 0.05, 0.2, 70.0, 0.85, 0.45, 0.2, 140.0, 0.95, 0.9, 0.75,
                        243.0, 1.0, 1.0, 1.0]),
-        opacity_points=hu([0.0, 0.0, 0.5, 0.0, 30.0, 0.0, 0.5, 0.0, 80.0, 0.03, 0.5, 0.0,
+        # Opaque: tissue from value 60 up saturates most rays within a few voxels, in the front
+        # piece where the pieces overlap along the ray (early ray termination decides there).
+        opacity_points=hu([0.0, 0.0, 0.5, 0.0, 30.0, 0.0, 0.5, 0.0, 60.0, 0.4, 0.5, 0.0,
+                           243.0, 1.0, 0.5, 0.0] if opaque else
+                          [0.0, 0.0, 0.5, 0.0, 30.0, 0.0, 0.5, 0.0, 80.0, 0.03, 0.5, 0.0,
                            160.0, 0.12, 0.5, 0.0, 243.0, 0.3, 0.5, 0.0]))
-    disp.ScalarOpacityUnitDistance = 10.0
+    disp.ScalarOpacityUnitDistance = 2.0 if opaque else 10.0
     if second:
         # One box over values 30..243 and the middle 40 % of the second array's whole range
         # (the data information's range: all ranks' pieces), which the cut between 2 ranks'
@@ -140,9 +145,11 @@ if stock:
     # ParaView's own volume mapper on the same scene.
     disp.SetRepresentationType("Volume")
 else:
-    # Early ray termination stops a ray at opacity 0.99 inside one piece; the pieces behind it
-    # still add their (at most 1 %) share: off for the exact comparison (docs/paraview.md, Parallel (MPI)).
-    disp.EarlyRayTermination = 1 if os.environ.get("SPACESKIP_PARALLEL_ERT") else 0
+    # Early ray termination: a ray stops at opacity 1 - 1/255 inside its piece; where it stops
+    # in a piece behind the front one, that piece drew on past the serial ray's stop (less than
+    # 1/255 more, on some pixels). Off here for the exact comparisons, whose checks count the
+    # pixels off at all; on (the default) in the opaque scene, which checks that bound.
+    disp.EarlyRayTermination = 1 if opaque else 0
     # Float compositing of the ranks' pieces (on by default); "0": ParaView's 8-bit compositing.
     disp.FloatCompositing = int(os.environ.get("SPACESKIP_FLOAT_COMPOSITING", "1"))
 # Under MPI the rendering of scene "rect" rebinds the name `disp` in this script's namespace to

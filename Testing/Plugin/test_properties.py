@@ -244,9 +244,10 @@ ert_off = shot("prop_ert_off.png")
 t_off = frame_seconds()
 p = ssptest.psnr(ert_on, ert_off)
 diff = abs(ert_on - ert_off).max()
-# Rays stop at opacity 0.99: what lies behind changes a pixel by at most ~1% (3/255), but it
-# does change some pixels; identical images would mean ERT is ignored.
-ok.check(0 < diff <= 3, "ERT on/off: images differ by at most 3/255 (max %d, PSNR %.2f dB)"
+# Rays stop at opacity 1 - 1/255 (vtkGPUVolumeRayCastMapper's threshold): what lies behind
+# changes a pixel by less than one 8-bit step, but it does change some pixels (measured
+# 2026-11-29: max 1, 92.21 dB); identical images would mean ERT is ignored.
+ok.check(0 < diff <= 1, "ERT on/off: images differ by at most 1/255 (max %d, PSNR %.2f dB)"
          % (diff, p))
 print("frame time (Naive, opaque): %.3f s with ERT vs %.3f s without" % (t_on, t_off))
 ok.done()

@@ -17,7 +17,8 @@
 #                /tmp/pvb), PVB_FRAMES 60 at 1024^2, each N-rank first frame against the 1-rank one;
 #                PVB_STOCK=1: ParaView's Volume too (PVB_BACKEND CUDA, PVB_VIEW 1024)
 #   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
-#                --raw; TS_WORKDIR keeps the written steps for a later run)
+#                --raw; TS_WORKDIR keeps the written steps for a later run; TS_ARGS more options,
+#                e.g. "--cache 4000" for ParaView's animation cache)
 #
 #   bench/device/run-pv.sh OUTDIR [PHASE...]     (default: probe tests parallel bench-stock bench-ts)
 #   env: BUNDLE (default /tmp/bun), DEADLINE (epoch seconds: later phases are skipped)
@@ -151,7 +152,7 @@ fi
 if has bench-ts; then
   TAIL=4 run "time-series" 600 "$pvpython" "$src/bench/time-series-vs-stock.py" --plugin "$SPACESKIP_PLUGIN" \
     --backend CUDA --dims "${TS_DIMS:-512}" --steps "${TS_STEPS:-10}" --rounds "${TS_ROUNDS:-2}" --raw \
-    --workdir "${TS_WORKDIR:-$work/ts}"
+    --workdir "${TS_WORKDIR:-$work/ts}" ${TS_ARGS:-}
 fi
 stop_xvfb
 tar -C "$work" -czf "$out/logs.tgz" logs xvfb.log 2>/dev/null
