@@ -128,7 +128,9 @@ else:
         disp.ColorArray2Name = ["POINTS", "second"]
     if not stock:
         disp.Builder = builder
-        disp.Backend = "CPU"
+        # The CPU backend, or SPACESKIP_TEST_BACKEND's (as ssptest.make_scene): on a GPU machine
+        # each rank draws on CUDA.
+        disp.Backend = os.environ.get("SPACESKIP_TEST_BACKEND") or "CPU"
     view.CameraFocalPoint = [0.0, -18.0, 22.0]
     view.CameraPosition = [260.0, -330.0, 210.0]
     view.CameraViewUp = [0.0, 0.0, 1.0]

@@ -216,7 +216,8 @@ env_args = []
 # What the ranks' scene script reads (parallel_scene.py); the piece bias is a Tuning field the
 # plugin sets, not an environment variable.
 for name in ("DISPLAY", "PYTHONPATH", "SPACESKIP_PLUGIN", "SPACESKIP_DATA", "SPACESKIP_TEMP", "SPACESKIP_BASELINES",
-             "SPACESKIP_PARALLEL_OPAQUE", "SPACESKIP_FLOAT_COMPOSITING", "SPACESKIP_PARALLEL_SECOND"):
+             "SPACESKIP_PARALLEL_OPAQUE", "SPACESKIP_FLOAT_COMPOSITING", "SPACESKIP_PARALLEL_SECOND",
+             "SPACESKIP_TEST_BACKEND"):
     if name in os.environ:
         env_args += ["-x", name]
 for n in ranks:
