@@ -76,7 +76,8 @@ log "bundle unpacked ($(cat "$B/vtk/COMMIT" 2>/dev/null | head -1))"
   echo "host: $(hostname)  phases: $phases  frames: $frames"
   nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>&1
   echo "bundle built from: $(cat "$B/vtk/COMMIT" 2>/dev/null)"
-  echo "tree: $(cd "$src" && git rev-parse HEAD 2>/dev/null || echo 'no git (copied tree)')"
+  # The device copy carries the working tree's files; its git HEAD can be an older commit.
+  echo "git HEAD of the copied tree (may predate its files): $(cd "$src" && git rev-parse HEAD 2>/dev/null || echo none)"
   echo "cores: $(nproc)  os: $(. /etc/os-release 2>/dev/null; echo "$PRETTY_NAME")"
 } > "$work/env.txt"
 
