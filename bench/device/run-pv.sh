@@ -21,7 +21,8 @@
 #                e.g. "--cache 4000" for ParaView's animation cache)
 #
 #   bench/device/run-pv.sh OUTDIR [PHASE...]     (default: probe tests parallel bench-stock bench-ts)
-#   env: BUNDLE (default /tmp/bun), DEADLINE (epoch seconds: later phases are skipped)
+#   env: BUNDLE (default /tmp/bun), DEADLINE (epoch seconds: later phases are skipped),
+#        PLUGIN_LIBS (a folder of libraries to load before the bundle's)
 # OUTDIR receives env.txt, pv.log (everything printed) and logs.tgz (each test's output).
 set -uo pipefail
 out=${1:?usage: run-pv.sh OUTDIR [PHASE...]}
@@ -68,7 +69,9 @@ else
   mpilib=$P/lib-mpi
   echo "Open MPI: no libmpi.so.40 here: the carried libraries (no mpirun: the parallel phase and several pvbatch ranks skipped)" >> "$out/env.txt"
 fi
-export LD_LIBRARY_PATH=$P/lib${mpilib:+:$mpilib}:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
+# PLUGIN_LIBS: a folder of libraries loaded before the bundle's (e.g. a newer libvtkSpaceSkip.so:
+# an A/B of a VTK-module change without repacking the bundle).
+export LD_LIBRARY_PATH=${PLUGIN_LIBS:+$PLUGIN_LIBS:}$P/lib${mpilib:+:$mpilib}:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
 export __GLX_VENDOR_LIBRARY_NAME=nvidia
 export PYTHONHOME=$P/python PYTHONPATH=$P/python/dist-packages:$src/Testing/Plugin
 # The plugin's tests ask for the CPU backend (CI has no GPU): here CUDA (TEST_BACKEND) instead.
