@@ -683,6 +683,27 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
 }
 
 //------------------------------------------------------------------------------
+bool vtkSpaceSkippingVolumeMapper::GetOwnedExtent(vtkImageData* image, int extent[6])
+{
+  if (!image)
+  {
+    return false;
+  }
+  image->GetExtent(extent);
+  int cells[6];
+  const int found = vtkSpaceSkipInputConverter::UnmarkedCells(image, cells);
+  if (found == 1)
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      extent[2 * a] = cells[2 * a];
+      extent[2 * a + 1] = std::max(cells[2 * a + 1], cells[2 * a]);
+    }
+  }
+  return found != 0;
+}
+
+//------------------------------------------------------------------------------
 int vtkSpaceSkippingVolumeMapper::FillInputPortInformation(int port, vtkInformation* info)
 {
   this->Superclass::FillInputPortInformation(port, info);

@@ -370,6 +370,13 @@ public:
   vtkGetVector2Macro(WholeScalarRange, double);
   ///@}
 
+  /**
+   * The point extent of the cells of `image` that its vtkGhostType cell array does not mark as
+   * duplicates of another piece's (the cells this mapper draws of a piece): its own extent when
+   * none is marked. False (`extent` its own extent) when every cell is marked.
+   */
+  static bool GetOwnedExtent(vtkImageData* image, int extent[6]);
+
   ///@{
   /**
    * The range of the 2-D transfer function's y-axis array (Transfer2DYAxisArray, its component

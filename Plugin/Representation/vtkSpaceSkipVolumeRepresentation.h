@@ -24,6 +24,7 @@
 #include <string> // for std::string
 #include <vector> // for std::vector
 
+class vtkImageData;
 class vtkMultiProcessController;
 class vtkSpaceSkipMPIExchange;
 class vtkSpaceSkippingVolumeMapper;
@@ -163,6 +164,10 @@ protected:
   /// vtkMultiBlockVolumeMapper: the same cache of partitions for our mapper (it accepts composite
   /// input), with the outline and data size of the whole.
   int RequestPartitionedData(vtkInformation*, vtkInformationVector**, vtkInformationVector*);
+  /// An image piece with ghost layers (under MPI): the base class's RequestData without its crop
+  /// of the ghost cells (the mapper draws the piece's own cells; the crop copied every tuple).
+  int RequestPieceWithGhosts(vtkImageData* input, vtkInformation*, vtkInformationVector**,
+    vtkInformationVector*);
 
   int LabelMapMode = LabelMapAuto;
   std::vector<int> HiddenLabels; ///< HideLabel's ids
