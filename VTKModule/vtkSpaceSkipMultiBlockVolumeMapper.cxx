@@ -549,9 +549,7 @@ bool vtkSpaceSkipMultiBlockVolumeMapper::CarriesOpacity() const
 {
   // Composite and isosurface blending accumulate opacity along the ray; the other modes'
   // blocks are blended over one another (not exact across block faces).
-  const int mode = this->Settings.EffectiveBlendMode();
-  return this->OnLattice && !this->ExchangesPieces() &&
-    (mode == vtkVolumeMapper::COMPOSITE_BLEND || mode == vtkVolumeMapper::ISOSURFACE_BLEND);
+  return this->OnLattice && !this->ExchangesPieces() && this->Settings.AccumulatesOpacity();
 }
 
 //------------------------------------------------------------------------------

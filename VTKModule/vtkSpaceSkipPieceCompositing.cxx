@@ -112,7 +112,7 @@ void CameraInIndexSpace(vtkRenderer* ren, vtkVolume* vol, vtkImageData* lattice,
 void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const double dir[3],
   bool parallel, int width, int height, spaceskip::Image& out, double stopAt)
 {
-  const float stop = static_cast<float>(std::min(stopAt, 2.0));
+  const float stop = static_cast<float>(stopAt);
   std::vector<spaceskip::PieceBox> boxes;
   std::vector<const PieceImage*> parts;
   for (const PieceImage& p : pieces)

@@ -7,6 +7,7 @@
 
 #include "vtkAbstractMapper.h" // For VTK_SCALAR_MODE_USE_POINT_DATA, VTK_GET_ARRAY_BY_ID
 #include "vtkType.h"           // For vtkIdType
+#include "vtkVolumeMapper.h"   // For the blend modes
 
 #include "spaceskip/Tuning.h" // For Tuning
 #include "vtkSpaceSkipPropertyTranslator.h" // For vtkSpaceSkipLabelEdits
@@ -168,6 +169,14 @@ struct vtkSpaceSkipSettings
   int EffectiveBlendMode() const
   {
     return this->BlendModeOverride >= 0 ? this->BlendModeOverride : this->BlendMode;
+  }
+  /// Whether the effective blend mode accumulates opacity along the ray (composite and
+  /// isosurface): pieces drawn apart then compose front to back, a ray's stop included. The
+  /// other modes' pieces are blended over one another.
+  bool AccumulatesOpacity() const
+  {
+    const int mode = this->EffectiveBlendMode();
+    return mode == vtkVolumeMapper::COMPOSITE_BLEND || mode == vtkVolumeMapper::ISOSURFACE_BLEND;
   }
   /// Whether WholeExtent names an image (the input is a piece of it).
   bool HasWholeExtent() const

@@ -669,10 +669,8 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     // the single image's ray (composite and isosurface blending accumulate opacity).
     std::move(mine.begin(), mine.end(), std::back_inserter(others));
     const vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(this);
-    const int mode = s.EffectiveBlendMode();
-    const double stopAt = mode == vtkVolumeMapper::COMPOSITE_BLEND || mode == vtkVolumeMapper::ISOSURFACE_BLEND
-      ? vtkSpaceSkipPropertyTranslator::EarlyTerminationOpacity(s)
-      : 2.0;
+    const double stopAt =
+      s.AccumulatesOpacity() ? vtkSpaceSkipPropertyTranslator::EarlyTerminationOpacity(s) : 2.0;
     pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged, stopAt);
     drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
   }

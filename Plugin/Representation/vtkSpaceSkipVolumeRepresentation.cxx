@@ -553,7 +553,6 @@ int vtkSpaceSkipVolumeRepresentation::RequestPieceWithGhosts(vtkImageData* input
   // pvbatch run of a 512^3 volume on the 2-core machine). The bounds of the cells without ghosts,
   // which the base class took from the cropped piece, still go to the ordered compositing and the
   // outline.
-  vtkMath::UninitializeBounds(this->DataBounds);
   auto cache = vtkSmartPointer<vtkImageData>::New();
   cache->ShallowCopy(input);
   int own[6];

@@ -48,7 +48,7 @@ piece's range, and the box moved to another place on each piece (measured 2026-1
 machine, 2 ranks: 13.18 dB, max 255/255; after it 0/255). With --partitioned too, the ranks'
 partitions (the .vtpd) carry the array, through the representation's composite path.
 With --opaque the head's opacity function saturates most rays within a few voxels of the skin,
-so early ray termination (on, the default, in every case here) decides where a ray stops: a
+so early ray termination (on here, its default; off in the other cases) decides where a ray stops: a
 piece behind a stopped ray added what it held, which serially is never drawn: at the former
 threshold, opacity 0.99, up to 1 % of a colour (measured 2026-11-29, 2-core machine, Grid: 2 / 3
 ranks 51.03 / 49.94 dB, max 3/255, 13.7 % / 18.0 % of the pixels off by more than 1/255; N-body
