@@ -106,7 +106,7 @@ struct vtkSpaceSkipSettings
     s.CroppingRegionFlags = m->GetCroppingRegionFlags();
     std::copy_n(m->GetCroppingRegionPlanes(), 6, s.CroppingRegionPlanes);
     s.ClippingPlanes = m->GetClippingPlanes();
-    if (s.EffectiveBlendMode() == 3 /* vtkVolumeMapper::SLICE_BLEND */)
+    if (s.EffectiveBlendMode() == vtkVolumeMapper::SLICE_BLEND)
     {
       std::copy_n(m->GetBounds(), 6, s.Bounds);
     }
