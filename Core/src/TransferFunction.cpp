@@ -31,7 +31,11 @@ TransferFunction TransferFunction::fromPoints(std::vector<TFPoint> pts, double l
     else {
       const TFPoint& a = *(it - 1);
       const TFPoint& b = *it;
-      double f = b.value > a.value ? (0.5 * v - 0.5 * a.value) / (0.5 * b.value - 0.5 * a.value) : 0.0;
+      // Halved differences cannot overflow; between denormals they can round to 0 (0.5 * 4.9e-324
+      // is 0: 0/0 gave NaN table entries, found by fuzz_render), where the plain differences are exact.
+      double num = 0.5 * v - 0.5 * a.value, den = 0.5 * b.value - 0.5 * a.value;
+      if (!(den > 0)) num = v - a.value, den = b.value - a.value;
+      const double f = den > 0 ? std::clamp(num / den, 0.0, 1.0) : 0.0;
       auto mix = [f](float x, float y) { return float(x + (y - x) * f); };
       p = TFPoint{v, mix(a.r, b.r), mix(a.g, b.g), mix(a.b, b.b), mix(a.a, b.a)};
     }

@@ -467,3 +467,27 @@ TEST(Extremes, ValuesNearDoubleMinimumDrawFiniteInEveryBlendMode) {
     }
   }
 }
+
+// Found by fuzz_render in CI: a double volume of denormal values (0 and 4.94e-323, ten times the
+// smallest denormal) with jittered rays drew NaN colour in MinIP, average and additive blending.
+// The seed is Testing/Fuzz/corpus/render/nan_image_denormal_values_jitter_average.
+TEST(Extremes, DenormalValuesDrawFiniteWithJitter) {
+  for (double value : {4.94e-323, 4.94e-324 * 3, 1e-310}) {
+    Volume v = filled(vec3l{1, 1, 4}, VoxelType::Float64, 0.0);
+    reinterpret_cast<double*>(v.mutableData())[0] = value;
+    for (const char* preset : {"band", "ramp"}) {
+      auto tf = TransferFunction::preset(preset, 0.0, value);
+      for (BlendMode m : {BlendMode::Composite, BlendMode::MaximumIntensity, BlendMode::MinimumIntensity,
+                          BlendMode::Additive, BlendMode::AverageIntensity}) {
+        RenderParams rp;
+        rp.blend = m;
+        rp.jitter = true;
+        for (BuilderKind k : {BuilderKind::Naive, BuilderKind::Grid}) {
+          Image img = test::renderWith(v, tf, test::builder(k), 30, 20, false, 16, BackendKind::CPU, rp);
+          EXPECT_FALSE(hasNonFinite(img)) << "value " << value << " " << preset << " blend " << int(m)
+                                          << " builder " << int(k);
+        }
+      }
+    }
+  }
+}

@@ -103,15 +103,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const double far = std::max({std::fabs(v.origin[0]), std::fabs(v.origin[1]), std::fabs(v.origin[2])});
     if (spMax > 1e15 * spMin && !(far <= 1e30 * extent)) return 0;
   }
-  // Open finding of this harness (issue 41): a double volume of ONE value near DBL_MIN (one voxel
-  // of 2.644e-308, the engine's value exponent 1021) draws a NaN image in MinIP (seed
-  // nan_image_double_value_2.6e-308_minip; a range of such values draws finite since the
-  // normalising scale is bounded: Extremes.ValuesNearDoubleMinimumDrawFiniteInEveryBlendMode).
-  // Such constant volumes are skipped until that is fixed.
-  {
-    double vlo, vhi;
-    if (v.scalarRange(vlo, vhi) && vlo == vhi && std::fabs(vlo) < 1e-300) return 0;
-  }
   static const char* const presets[] = {"ramp", "grayscale", "coolwarm", "band", "spike", "opaque", "zero"};
   RenderParams rp;
   rp.blend = BlendMode(s[2] % 7);
