@@ -318,15 +318,17 @@ void vtkSpaceSkipInputConverter::Reset()
 }
 
 //------------------------------------------------------------------------------
-int vtkSpaceSkipInputConverter::UnmarkedCells(vtkImageData* image, int cells[6])
+namespace
 {
-  vtkUnsignedCharArray* g = image->GetCellData()->GetGhostArray();
+// The cells of a structured data set of extent `ext` that its ghost-cell array leaves unmarked,
+// [lo, hi) per axis (vtkSpaceSkipInputConverter::UnmarkedCells; `cells` set only when 1).
+int UnmarkedCellsOf(vtkDataSet* data, const int ext[6], int cells[6])
+{
+  vtkUnsignedCharArray* g = data->GetCellData()->GetGhostArray();
   if (!g || g->GetNumberOfTuples() == 0)
   {
     return 2;
   }
-  // The first and the last cell that is not a duplicate bound the owned cells, as ParaView's
-  // volume representation does.
   const vtkIdType n = g->GetNumberOfTuples();
   const unsigned char* v = g->GetPointer(0);
   const unsigned char dup = vtkDataSetAttributes::DUPLICATECELL;
@@ -347,8 +349,7 @@ int vtkSpaceSkipInputConverter::UnmarkedCells(vtkImageData* image, int cells[6])
   {
     return 2;
   }
-  int ext[6], ijk[3], ijk1[3];
-  image->GetExtent(ext);
+  int ijk[3], ijk1[3];
   vtkStructuredData::ComputeCellStructuredCoordsForExtent(first, ext, ijk);
   vtkStructuredData::ComputeCellStructuredCoordsForExtent(last, ext, ijk1);
   for (int a = 0; a < 3; ++a)
@@ -357,6 +358,13 @@ int vtkSpaceSkipInputConverter::UnmarkedCells(vtkImageData* image, int cells[6])
     cells[2 * a + 1] = ijk1[a] + 1;
   }
   return 1;
+}
+
+} // namespace
+
+int vtkSpaceSkipInputConverter::UnmarkedCells(vtkImageData* image, int cells[6])
+{
+  return UnmarkedCellsOf(image, image->GetExtent(), cells);
 }
 
 //------------------------------------------------------------------------------
@@ -501,13 +509,14 @@ void ResampleTrilinear(vtkRectilinearGrid* grid, vtkImageData* image)
   grid->GetDimensions(gdims);
   const double* origin = image->GetOrigin();
   const double* spacing = image->GetSpacing();
+  const int* ext = image->GetExtent();
   vtkDataArray* coords[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
     grid->GetZCoordinates() };
   std::vector<vtkIdType> cell[3];
   std::vector<double> weight[3];
   for (int a = 0; a < 3; ++a)
   {
-    AxisWeights(coords[a], dims[a], origin[a], spacing[a], cell[a], weight[a]);
+    AxisWeights(coords[a], dims[a], origin[a] + ext[2 * a] * spacing[a], spacing[a], cell[a], weight[a]);
   }
   // The upper neighbour's offset per axis (0 on an axis of one point).
   const vtkIdType up[3] = { gdims[0] > 1 ? 1 : 0,
@@ -567,12 +576,89 @@ void ResampleTrilinear(vtkRectilinearGrid* grid, vtkImageData* image)
     }
   }
 }
+
+// The resampling lattice of a grid spanning [first, last] per axis with `count` points and
+// `smallest` its smallest step: the smallest step per axis, coarsened alike on every axis (never
+// below the grid's own point count) until the lattice holds at most `cap` points. The serial
+// grid and the pieces of one (from the whole grid's figures) get the same lattice.
+void ResampleLattice(const double first[3], const double last[3], const double smallest[3],
+  const vtkIdType count[3], double cap, int n[3], double spacing[3])
+{
+  double dims[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    dims[a] = count[a] > 1 ? std::ceil((last[a] - first[a]) / smallest[a] - 1e-9) + 1 : 1;
+  }
+  for (int pass = 0; pass < 8 && dims[0] * dims[1] * dims[2] > cap; ++pass)
+  {
+    const double f = std::cbrt(dims[0] * dims[1] * dims[2] / cap);
+    for (int a = 0; a < 3; ++a)
+    {
+      dims[a] = std::max(static_cast<double>(count[a]), std::floor((dims[a] - 1) / f) + 1);
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+  {
+    n[a] = static_cast<int>(dims[a]);
+    spacing[a] = n[a] > 1 ? (last[a] - first[a]) / (n[a] - 1) : 1.0;
+  }
+}
+
+// Marks the cells of `image` outside the lattice cells [owned[2a], owned[2a+1]) per axis as
+// duplicates (a ghost-cell array), so that UnmarkedCells finds `owned`.
+void MarkOwnedCells(vtkImageData* image, const int owned[6])
+{
+  const int* ext = image->GetExtent();
+  int cells[3], lo[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    lo[a] = ext[2 * a];
+    cells[a] = std::max(ext[2 * a + 1] - ext[2 * a], 1);
+  }
+  vtkNew<vtkUnsignedCharArray> ghosts;
+  ghosts->SetName(vtkDataSetAttributes::GhostArrayName());
+  ghosts->SetNumberOfTuples(static_cast<vtkIdType>(cells[0]) * cells[1] * cells[2]);
+  unsigned char* g = ghosts->GetPointer(0);
+  for (int k = 0; k < cells[2]; ++k)
+  {
+    for (int j = 0; j < cells[1]; ++j)
+    {
+      for (int i = 0; i < cells[0]; ++i)
+      {
+        const int c[3] = { lo[0] + i, lo[1] + j, lo[2] + k };
+        bool mine = true;
+        for (int a = 0; a < 3; ++a)
+        {
+          mine = mine && c[a] >= owned[2 * a] && c[a] < owned[2 * a + 1];
+        }
+        *g++ = mine ? 0 : vtkDataSetAttributes::DUPLICATECELL;
+      }
+    }
+  }
+  image->GetCellData()->AddArray(ghosts);
+}
 } // namespace
 
 //------------------------------------------------------------------------------
-vtkImageData* vtkSpaceSkipRectilinearImage::From(
-  vtkRectilinearGrid* grid, const WarnFunction& warn, std::string& problem)
+bool vtkSpaceSkipRectilinearImage::WholeGrid::Valid() const
 {
+  for (int a = 0; a < 3; ++a)
+  {
+    // An axis of one point has no step.
+    if (!(this->Bounds[2 * a] <= this->Bounds[2 * a + 1]) || this->Extent[2 * a] > this->Extent[2 * a + 1] ||
+      (!(this->SmallestStep[a] > 0) && this->Extent[2 * a] < this->Extent[2 * a + 1]))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
+  const WarnFunction& warn, std::string& problem, const WholeGrid* wholeGrid)
+{
+  const WholeGrid whole = wholeGrid && wholeGrid->Valid() ? *wholeGrid : WholeGrid();
   vtkDataArray* coords[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
     grid->GetZCoordinates() };
   vtkMTimeType mtime = grid->GetMTime();
@@ -580,13 +666,19 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(
   {
     mtime = std::max(mtime, c ? c->GetMTime() : 0);
   }
-  if (this->Key == grid && this->MTime == mtime)
+  auto sameWhole = [&](const WholeGrid& w) {
+    return std::equal(w.Bounds, w.Bounds + 6, whole.Bounds) &&
+      std::equal(w.SmallestStep, w.SmallestStep + 3, whole.SmallestStep) &&
+      std::equal(w.Extent, w.Extent + 6, whole.Extent);
+  };
+  if (this->Key == grid && this->MTime == mtime && sameWhole(this->KeyWhole))
   {
     problem = this->Problem;
     return this->Image;
   }
   this->Key = grid;
   this->MTime = mtime;
+  this->KeyWhole = whole;
   this->Image = nullptr;
   this->Path = 0;
   this->Problem.clear();
@@ -656,51 +748,101 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(
     problem = this->Problem;
     return nullptr;
   }
-  // The smallest step per axis over the grid's bounds, coarsened alike on every axis (never
-  // below the grid's own point count) until the lattice holds at most kMaxResampleFactor times
-  // the grid's points.
-  double smallest[3];
-  double dims[3];
-  const double cap = kMaxResampleFactor * static_cast<double>(grid->GetNumberOfPoints());
+  // The smallest step per axis over the grid's bounds (the whole grid's, for a piece of one),
+  // coarsened until the lattice holds at most kMaxResampleFactor times the grid's points.
+  const bool piece = whole.Valid();
+  double first[3], last[3], smallest[3];
+  vtkIdType count[3];
   for (int a = 0; a < 3; ++a)
   {
-    smallest[a] = std::abs(axes[a].Mean);
-    for (vtkIdType i = 1; i < axes[a].Count; ++i)
+    first[a] = piece ? whole.Bounds[2 * a] : axes[a].First;
+    last[a] = piece ? whole.Bounds[2 * a + 1] : axes[a].Last;
+    count[a] = piece ? whole.Extent[2 * a + 1] - whole.Extent[2 * a] + 1 : axes[a].Count;
+    smallest[a] = piece ? whole.SmallestStep[a] : std::abs(axes[a].Mean);
+    for (vtkIdType i = 1; !piece && i < axes[a].Count; ++i)
     {
       smallest[a] =
         std::min(smallest[a], coords[a]->GetComponent(i, 0) - coords[a]->GetComponent(i - 1, 0));
     }
-    dims[a] = axes[a].Count > 1 ? std::ceil((axes[a].Last - axes[a].First) / smallest[a] - 1e-9) + 1 : 1;
   }
-  for (int pass = 0; pass < 8 && dims[0] * dims[1] * dims[2] > cap; ++pass)
+  int n[3];
+  double spacing[3];
+  ResampleLattice(first, last, smallest, count,
+    kMaxResampleFactor * static_cast<double>(count[0]) * count[1] * count[2], n, spacing);
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetOrigin(first);
+  image->SetSpacing(spacing);
+  std::string seams;
+  if (!piece)
   {
-    const double f = std::cbrt(dims[0] * dims[1] * dims[2] / cap);
+    image->SetExtent(0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1);
+  }
+  else
+  {
+    // The lattice points the piece's coordinates span, and the lattice cells it owns: from the
+    // first lattice point at or after the world position of its first owned grid point to the
+    // one at or after its last (the same bits of the shared coordinate on both neighbours: no
+    // cell is owned twice or not at all).
+    int cells[6];
     for (int a = 0; a < 3; ++a)
     {
-      dims[a] = std::max(static_cast<double>(axes[a].Count), std::floor((dims[a] - 1) / f) + 1);
+      cells[2 * a] = ext[2 * a];
+      cells[2 * a + 1] = std::max(ext[2 * a + 1] - 1, ext[2 * a]) + 1;
+    }
+    const bool ownsNothing = UnmarkedCellsOf(grid, ext, cells) == 0; // all ghost
+    int pext[6], owned[6];
+    for (int a = 0; a < 3; ++a)
+    {
+      auto at = [&](double x, double round) {
+        const double u = (x - first[a]) / spacing[a];
+        return std::clamp(static_cast<int>(round > 0 ? std::ceil(u - 1e-9) : std::floor(u + 1e-9)), 0, n[a] - 1);
+      };
+      auto coordinate = [&](int p) { return coords[a]->GetComponent(p - ext[2 * a], 0); };
+      pext[2 * a] = at(axes[a].First, 1);
+      pext[2 * a + 1] = at(axes[a].Last, -1);
+      owned[2 * a] = cells[2 * a] <= whole.Extent[2 * a] ? 0 : at(coordinate(cells[2 * a]), 1);
+      owned[2 * a + 1] = cells[2 * a + 1] >= whole.Extent[2 * a + 1]
+        ? std::max(n[a] - 1, 1)
+        : at(coordinate(std::min(cells[2 * a + 1], ext[2 * a + 1])), 1);
+      if (owned[2 * a] < pext[2 * a] || std::min(owned[2 * a + 1], n[a] - 1) > pext[2 * a + 1])
+      {
+        seams += kAxis[a];
+      }
+      // The owned points must be in the image (beyond the piece's coordinates, its edge values).
+      pext[2 * a] = std::min(pext[2 * a], owned[2 * a]);
+      pext[2 * a + 1] = std::max(pext[2 * a + 1], std::min(owned[2 * a + 1], n[a] - 1));
+    }
+    if (ownsNothing)
+    {
+      owned[1] = owned[0];
+    }
+    image->SetExtent(pext);
+    MarkOwnedCells(image, owned);
+    for (int a = 0; a < 3; ++a)
+    {
+      this->LatticeWhole[2 * a] = 0;
+      this->LatticeWhole[2 * a + 1] = n[a] - 1;
     }
   }
-  int n[3] = { static_cast<int>(dims[0]), static_cast<int>(dims[1]), static_cast<int>(dims[2]) };
-  auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetExtent(0, n[0] - 1, 0, n[1] - 1, 0, n[2] - 1);
-  double spacing[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    spacing[a] = n[a] > 1 ? (axes[a].Last - axes[a].First) / (n[a] - 1) : 1.0;
-  }
-  image->SetOrigin(axes[0].First, axes[1].First, axes[2].First);
-  image->SetSpacing(spacing);
   ResampleTrilinear(grid, image);
   this->Image = image;
-  this->Path = 2;
+  this->Path = piece ? 3 : 2;
   char dev[32];
   std::snprintf(dev, sizeof(dev), "%.3g", deviation);
   warn(name + " (" + std::to_string(axes[0].Count) + " x " + std::to_string(axes[1].Count) +
-    " x " + std::to_string(axes[2].Count) + " points) has non-uniform coordinates (largest " +
-    "relative step deviation " + dev + ", on " + kAxis[worst] + "): drawn resampled by " +
-    "trilinear interpolation on a uniform " + std::to_string(n[0]) + " x " + std::to_string(n[1]) +
-    " x " + std::to_string(n[2]) + " lattice (the smallest step per axis, at most " +
-    std::to_string(static_cast<int>(kMaxResampleFactor)) + "x the grid's points); sampling " +
-    "through the coordinate arrays is not done yet");
+    " x " + std::to_string(axes[2].Count) + " points" + (piece ? ", a piece of a larger grid" : "") +
+    ") has non-uniform coordinates (largest relative step deviation " + dev + ", on " +
+    kAxis[worst] + "): drawn resampled by trilinear interpolation on a uniform " +
+    std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]) +
+    " lattice (the smallest step per axis, at most " +
+    std::to_string(static_cast<int>(kMaxResampleFactor)) + "x the " + (piece ? "whole " : "") +
+    "grid's points); sampling through the coordinate arrays is not done yet");
+  if (!seams.empty())
+  {
+    warn(name + ": the piece's ghost layer does not reach the lattice points next to the cells it "
+      "owns (along " + seams + "; a step at the piece's boundary is smaller than the lattice's): "
+      "those points take the piece's edge values, so the image may differ from the serial one at "
+      "that seam");
+  }
   return this->Image;
 }

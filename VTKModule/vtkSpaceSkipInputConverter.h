@@ -131,6 +131,10 @@ private:
  *   coarsened so that the lattice holds at most kMaxResampleFactor times the grid's points.
  * - Coordinates that are not strictly monotonic, or non-uniform descending ones: `problem`,
  *   nothing drawn.
+ * A piece of a larger grid (MPI: `whole` given, the same on every process) is resampled on the
+ * whole grid's lattice (the lattice the serial grid gets), at the lattice points its own
+ * coordinates span, with a ghost-cell array that marks every lattice cell outside the cells
+ * it owns: the pieces are then pieces of one image, composited as image pieces are.
  */
 class vtkSpaceSkipRectilinearImage
 {
@@ -139,12 +143,28 @@ public:
   /// The resampled lattice of a non-uniform grid holds at most this many times its points.
   static constexpr double kMaxResampleFactor = 4.0;
 
-  /// The image to draw for `grid` (nullptr, with `problem` set, when nothing can be drawn).
-  vtkImageData* From(vtkRectilinearGrid* grid, const WarnFunction& warn, std::string& problem);
+  /// The whole grid a piece belongs to: its bounds, its smallest coordinate step per axis and
+  /// its point extent (all processes' pieces together).
+  struct WholeGrid
+  {
+    double Bounds[6] = { 1, -1, 1, -1, 1, -1 };
+    double SmallestStep[3] = { 0, 0, 0 };
+    int Extent[6] = { 0, -1, 0, -1, 0, -1 };
+    /// Every field known (bounds ascending, steps positive, a non-empty extent).
+    bool Valid() const;
+  };
 
-  /// How the last image was made: 0 none, 1 the uniform grid's arrays, 2 resampled (its
-  /// extent is not the grid's: a WholeExtent of the grid's pieces does not apply to it).
+  /// The image to draw for `grid` (nullptr, with `problem` set, when nothing can be drawn);
+  /// with `whole`, `grid` is a piece of that grid.
+  vtkImageData* From(vtkRectilinearGrid* grid, const WarnFunction& warn, std::string& problem,
+    const WholeGrid* whole = nullptr);
+
+  /// How the last image was made: 0 none, 1 the uniform grid's arrays, 2 resampled on a lattice
+  /// of the grid's own (its extent is not the grid's: a WholeExtent of the grid's pieces does not
+  /// apply to it), 3 resampled on the whole grid's lattice (GetLatticeWholeExtent()).
   int GetPath() const { return this->Path; }
+  /// Path 3: the whole grid's lattice's extent (the piece's image lies on it).
+  const int* GetLatticeWholeExtent() const { return this->LatticeWhole; }
   /// The last image made (null when none).
   vtkImageData* GetImage() const { return this->Image; }
   /// Lets go of the last image (the input is no longer a grid); the next From makes one again.
@@ -154,7 +174,9 @@ private:
   vtkSmartPointer<vtkImageData> Image;
   const void* Key = nullptr;
   vtkMTimeType MTime = 0;
+  WholeGrid KeyWhole;
   int Path = 0;
+  int LatticeWhole[6] = { 0, -1, 0, -1, 0, -1 };
   std::string Problem;
 };
 

@@ -132,6 +132,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   // Float compositing across processes (SetPieceExchange), and the image it hands back.
   std::shared_ptr<vtkSpaceSkipPieceExchange> Exchange;
   double WholeBounds[6] = { 1, -1, 1, -1, 1, -1 };
+  double WholeGridSteps[3] = { 0, 0, 0 };
   // GetInput() of a process with an empty piece (see there), and the array name it carries.
   vtkSmartPointer<vtkImageData> EmptyPiece;
   std::string EmptyPieceArray;
@@ -244,9 +245,11 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(vtkRenderer* ren, v
   vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(self);
   if (resampled)
   {
-    // A resampled grid is not on the lattice of the grid's WholeExtent: drawn whole.
+    // A resampled grid is not on the lattice of the grid's WholeExtent: a piece of one is on
+    // the whole grid's resampling lattice, else it is drawn whole.
     const int none[6] = { 0, -1, 0, -1, 0, -1 };
-    std::copy(none, none + 6, s.WholeExtent);
+    const int* lattice = this->Rectilinear.GetPath() == 3 ? this->Rectilinear.GetLatticeWholeExtent() : none;
+    std::copy(lattice, lattice + 6, s.WholeExtent);
   }
   s.Backend = Overrides().Backend >= 0 ? Overrides().Backend : s.Backend;
   int cellFlag = 0;
@@ -479,6 +482,14 @@ void vtkSpaceSkippingVolumeMapper::SetWholeBounds(const double bounds[6])
     this->Modified();
   }
 }
+void vtkSpaceSkippingVolumeMapper::SetWholeGridSteps(const double steps[3])
+{
+  if (!std::equal(steps, steps + 3, this->Internals->WholeGridSteps))
+  {
+    std::copy(steps, steps + 3, this->Internals->WholeGridSteps);
+    this->Modified();
+  }
+}
 const std::shared_ptr<vtkSpaceSkippingVolumeMapper::PieceExchange>&
 vtkSpaceSkippingVolumeMapper::GetPieceExchange() const
 {
@@ -563,14 +574,19 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
   {
     // The grid as an image (its own arrays when uniform, else resampled), made again only
     // when the grid changed.
+    // A piece of a larger grid (MPI): resampled on the whole grid's lattice.
+    vtkSpaceSkipRectilinearImage::WholeGrid whole;
+    std::copy_n(d.WholeBounds, 6, whole.Bounds);
+    std::copy_n(d.WholeGridSteps, 3, whole.SmallestStep);
+    std::copy_n(this->WholeExtent, 6, whole.Extent);
     std::string problem;
-    image = d.Rectilinear.From(grid, d.Warn, problem);
+    image = d.Rectilinear.From(grid, d.Warn, problem, &whole);
     if (!image)
     {
       d.Fail(problem);
       return;
     }
-    resampled = d.Rectilinear.GetPath() == 2;
+    resampled = d.Rectilinear.GetPath() >= 2;
   }
   else if (d.Rectilinear.GetImage())
   {
@@ -620,18 +636,23 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     if (!input && vtkRectilinearGrid::SafeDownCast(this->GetInputDataObject(0, 0)))
     {
       // A uniform grid's piece is the image of its points, on the grid's index lattice; a
-      // resampled one is on a lattice of its own, which the exchange cannot place.
-      input = d.Rectilinear.GetPath() == 1 ? d.Rectilinear.GetImage() : nullptr;
-      if (d.Rectilinear.GetPath() == 2)
+      // non-uniform one is resampled on the whole grid's lattice (path 3) where the whole grid's
+      // steps are known, else on a lattice of its own, which the exchange cannot place.
+      const int path = d.Rectilinear.GetPath();
+      input = path == 1 || path == 3 ? d.Rectilinear.GetImage() : nullptr;
+      if (path == 2)
       {
         this->WarnOnce("a vtkRectilinearGrid piece with non-uniform coordinates is not drawn "
-                       "when pieces are composited across processes (resample the grid to an "
-                       "image first)");
+                       "when pieces are composited across processes unless the whole grid's "
+                       "steps are known (SetWholeGridSteps; ParaView's representation gathers "
+                       "them)");
       }
     }
     if (image && input && ren->GetActiveCamera())
     {
-      const int* whole = this->WholeExtent;
+      const int* whole = vtkImageData::SafeDownCast(this->GetInput()) || d.Rectilinear.GetPath() != 3
+        ? this->WholeExtent
+        : d.Rectilinear.GetLatticeWholeExtent();
       const int shift[3] = { whole[0], whole[2], whole[4] };
       mine.push_back(pc::CropPiece(image, w, h, d.Image.LastPiece(), input, whole));
       pc::CameraInIndexSpace(ren, vol, input, shift, eye, dir, parallel);

@@ -559,6 +559,12 @@ public:
   /// volume reports them (GetBounds()), so that no renderer culls a piece that is out of view
   /// or empty while the others wait for it. Uninitialized (the default): the input's own.
   void SetWholeBounds(const double bounds[6]);
+  /// The smallest coordinate step per axis of the whole vtkRectilinearGrid the input is a piece
+  /// of (all processes' pieces; with WholeBounds and WholeExtent, the same on every process): a
+  /// non-uniform piece is then resampled on the lattice the whole grid gets serially, so that
+  /// the pieces composite as the pieces of one image. 0 (the default): unknown, and a
+  /// non-uniform piece under a PieceExchange is not drawn.
+  void SetWholeGridSteps(const double steps[3]);
   const std::shared_ptr<PieceExchange>& GetPieceExchange() const;
 #endif
 

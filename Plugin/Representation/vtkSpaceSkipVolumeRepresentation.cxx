@@ -24,6 +24,7 @@
 #include "vtkPVRenderView.h"
 #include "vtkPVView.h"
 #include "vtkPartitionedDataSet.h"
+#include "vtkRectilinearGrid.h"
 #include "vtkScalarsToColors.h"
 #include "vtkSpaceSkipMPIExchange.h"
 #include "vtkSpaceSkippingVolumeMapper.h"
@@ -193,6 +194,28 @@ bool IsLabelArray(vtkDataArray* a)
   const int t = a->GetDataType();
   return t == VTK_UNSIGNED_CHAR || t == VTK_CHAR || t == VTK_SIGNED_CHAR ||
     t == VTK_UNSIGNED_SHORT || t == VTK_SHORT;
+}
+
+// The smallest coordinate step per axis of all ranks' pieces of a vtkRectilinearGrid (collective;
+// 0 on an axis where no rank has two points, or no rank has a grid).
+void GatherSmallestSteps(vtkMultiProcessController* controller, vtkRectilinearGrid* grid, double steps[3])
+{
+  double local[3] = { VTK_DOUBLE_MAX, VTK_DOUBLE_MAX, VTK_DOUBLE_MAX };
+  vtkDataArray* coords[3] = { grid ? grid->GetXCoordinates() : nullptr,
+    grid ? grid->GetYCoordinates() : nullptr, grid ? grid->GetZCoordinates() : nullptr };
+  for (int a = 0; a < 3; ++a)
+  {
+    for (vtkIdType i = 1; coords[a] && i < coords[a]->GetNumberOfTuples(); ++i)
+    {
+      const double step = std::abs(coords[a]->GetComponent(i, 0) - coords[a]->GetComponent(i - 1, 0));
+      local[a] = step > 0 ? std::min(local[a], step) : local[a];
+    }
+  }
+  controller->AllReduce(local, steps, 3, vtkCommunicator::MIN_OP);
+  for (int a = 0; a < 3; ++a)
+  {
+    steps[a] = steps[a] == VTK_DOUBLE_MAX ? 0.0 : steps[a];
+  }
 }
 
 // The bounds of all ranks' data (collective; uninitialized when no rank has data).
@@ -411,6 +434,16 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
   this->SecondWholeRanges.clear();
   vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
   this->UpdateExchange(controller);
+  if (controller && controller->GetNumberOfProcesses() > 1)
+  {
+    // A rectilinear grid's pieces: its smallest step per axis over all ranks, so that the mapper
+    // resamples a non-uniform piece on the lattice the serial grid gets (collective).
+    double steps[3];
+    GatherSmallestSteps(controller,
+      inputVector[0]->GetNumberOfInformationObjects() == 1 ? vtkRectilinearGrid::GetData(inputVector[0], 0) : nullptr,
+      steps);
+    this->SpaceSkipMapper->SetWholeGridSteps(steps);
+  }
   vtkInformation* arrayInfo = this->GetInputArrayInformation(0);
   const char* name = arrayInfo && arrayInfo->Has(vtkDataObject::FIELD_NAME())
     ? arrayInfo->Get(vtkDataObject::FIELD_NAME())

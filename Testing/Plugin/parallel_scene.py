@@ -7,7 +7,7 @@ Usage: pvbatch parallel_scene.py OUT.png [builder] [scene]
            planes where the pieces meet), "shell" (the plugin tests' 64^3 reference scene) or
            "vtpd=PATH" (the MNI scene read from a partitioned data set file: its partitions go
            to the ranks as they are), "rect" (the MNI scene, each piece as the
-           vtkRectilinearGrid of its points), "raw16=PATH" (the MNI head as 16-bit CT-like values,
+           vtkRectilinearGrid of its points), "rectnu" (the same with non-uniform coordinates), "raw16=PATH" (the MNI head as 16-bit CT-like values,
            v * 12 + 24, read from a little-endian raw file by ParaView's Image Reader as a new
            user would: 'unsigned short', DataByteOrder, DataExtent), "vti=PATH" (the same 16-bit
            head from a .vti file, XML Image Data Reader). With raw16 and vti the view keeps
@@ -47,10 +47,11 @@ out = self.GetOutput()
 ext = inp.GetExtent()
 out.SetExtent(ext)
 setters = [out.SetXCoordinates, out.SetYCoordinates, out.SetZCoordinates]
+import math
 for a in range(3):
     c = vtkDoubleArray()
     for i in range(ext[2 * a], ext[2 * a + 1] + 1):
-        c.InsertNextValue(inp.GetOrigin()[a] + i * inp.GetSpacing()[a])
+        c.InsertNextValue(inp.GetOrigin()[a] + (i + WARP * math.sin(0.37 * i)) * inp.GetSpacing()[a])
     setters[a](c)
 out.GetPointData().ShallowCopy(inp.GetPointData())
 out.GetCellData().ShallowCopy(inp.GetCellData())
@@ -84,13 +85,16 @@ else:
         # A second point array, the point's y coordinate, for the 2-D function's y axis.
         reader = Calculator(Input=reader, AttributeType="Point Data", ResultArrayName="second",
                             Function="coordsY", ResultArrayType="Float")
-    if scene == "rect":
-        # The same head as a vtkRectilinearGrid of the same points, per rank's piece.
+    if scene in ("rect", "rectnu"):
+        # The same head as a vtkRectilinearGrid of the same points, per rank's piece; "rectnu"
+        # moves point i of each axis by 1.5 sin(0.37 i) of a step (steps 0.45..1.55 of the
+        # image's: non-uniform, resampled by the mapper on the whole grid's lattice, which the
+        # 4x cap on its points coarsens to 156 x 185 x 152).
         image_reader = reader
         reader = ProgrammableFilter(Input=image_reader)
         reader.OutputDataSetType = "vtkRectilinearGrid"
         reader.RequestInformationScript = RECT_INFO
-        reader.Script = RECT_SCRIPT
+        reader.Script = "WARP = %g\n" % (1.5 if scene == "rectnu" else 0.0) + RECT_SCRIPT
     view = ssptest.make_view((360, 360))
     disp = Show(reader, view)
     disp.SetRepresentationType("Space Skipping Volume")
