@@ -804,7 +804,8 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
       owned[2 * a + 1] = cells[2 * a + 1] >= whole.Extent[2 * a + 1]
         ? std::max(n[a] - 1, 1)
         : at(coordinate(std::min(cells[2 * a + 1], ext[2 * a + 1])), 1);
-      if (owned[2 * a] < pext[2 * a] || std::min(owned[2 * a + 1], n[a] - 1) > pext[2 * a + 1])
+      // Shading's central differences read one lattice point beyond the owned ones.
+      if (std::max(owned[2 * a] - 1, 0) < pext[2 * a] || std::min(owned[2 * a + 1] + 1, n[a] - 1) > pext[2 * a + 1])
       {
         seams += kAxis[a];
       }
@@ -839,10 +840,10 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
     "grid's points); sampling through the coordinate arrays is not done yet");
   if (!seams.empty())
   {
-    warn(name + ": the piece's ghost layer does not reach the lattice points next to the cells it "
-      "owns (along " + seams + "; a step at the piece's boundary is smaller than the lattice's): "
-      "those points take the piece's edge values, so the image may differ from the serial one at "
-      "that seam");
+    warn(name + ": the piece's ghost layers do not reach the lattice points next to the cells it "
+      "owns (along " + seams + "; steps at the piece's boundary are smaller than the lattice's): "
+      "those points take the piece's edge values, so the image (its shading first) may differ "
+      "from the serial one at that seam");
   }
   return this->Image;
 }

@@ -394,7 +394,10 @@ int vtkSpaceSkipVolumeRepresentation::RequestUpdateExtent(
     return 0;
   }
   // Pieces share their face points, so a trilinear sample in a piece's own cells reads its own
-  // voxels; shading's central differences read one voxel further: one ghost layer.
+  // voxels; shading's central differences read one voxel further: one ghost layer. A
+  // rectilinear grid's piece, if non-uniform, is resampled on the whole grid's lattice, whose
+  // points next to the owned cells (and one further, for shading) can lie more than one grid
+  // step beyond them: three layers (vtkSpaceSkipRectilinearImage warns where even that is short).
   using SDDP = vtkStreamingDemandDrivenPipeline;
   for (int i = 0; i < inputVector[0]->GetNumberOfInformationObjects(); ++i)
   {
@@ -407,7 +410,8 @@ int vtkSpaceSkipVolumeRepresentation::RequestUpdateExtent(
       const int levels = info->Has(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
         ? info->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
         : 0;
-      info->Set(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS(), std::max(levels, 1));
+      const bool grid = vtkRectilinearGrid::SafeDownCast(info->Get(vtkDataObject::DATA_OBJECT())) != nullptr;
+      info->Set(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS(), std::max(levels, grid ? 3 : 1));
     }
   }
   return 1;

@@ -130,6 +130,10 @@ else:
         disp.UseTransfer2D = 1
         disp.UseGradientForTransfer2D = 0
         disp.ColorArray2Name = ["POINTS", "second"]
+    if scene == "rectnu":
+        # Shaded: the central differences read one lattice point beyond a piece's own, which
+        # three ghost layers of the grid hold here (the representation asks a grid for three).
+        disp.Shade = 1
     if not stock:
         disp.Builder = builder
         # The CPU backend, or SPACESKIP_TEST_BACKEND's (as ssptest.make_scene): on a GPU machine

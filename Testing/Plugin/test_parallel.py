@@ -61,9 +61,11 @@ resamples the serial grid on a uniform lattice (the smallest step per axis, coar
 4x the grid's points: 156 x 185 x 152), and each rank's piece on that same lattice (the
 representation gathers the whole grid's smallest steps; the lattice cells a piece owns start at
 the first lattice point at or after its first owned grid point), so the pieces are pieces of one
-image and the same limits apply. Before, such a piece was not drawn under MPI (measured
-2026-11-29, 2-core machine, 2 / 3 ranks: 7.55 dB, max 244/255; after it 96.25 / 96.25 dB, max
-1/255; with 0.25 sin(0.37 i), an uncoarsened lattice, 93.24 / 95.00 dB).
+image and the same limits apply. The scene is shaded: the gradients read one lattice point
+beyond a piece's own cells, up to two lattice steps past its boundary, which the representation's
+three ghost layers for grids hold here (with one, shaded: 64.85 / 65.85 dB, max 3/255). Before,
+such a piece was not drawn under MPI (measured 2026-11-29, 2-core machine, 2 / 3 ranks, unshaded:
+7.55 dB, max 244/255; after it 96.25 / 96.25 dB, max 1/255; shaded 99.26 / 98.01 dB, max 1/255).
 Usage: pvpython test_parallel.py MPIEXEC PVBATCH [--partitioned] [--8bit] [--rectilinear]
        [--rectilinear-nonuniform]
        [--imagereader] [--vti] [--second-array] [--opaque] [builder [ranks...]]
