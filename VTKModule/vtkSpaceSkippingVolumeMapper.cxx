@@ -14,6 +14,7 @@
 #include "vtkOpenGLCamera.h"
 #include "vtkOpenGLRenderWindow.h"
 #include "vtkRectilinearGrid.h"
+#include "vtkRenderWindow.h"
 #include "vtkRenderer.h"
 #include "vtkSpaceSkipCompositor.h"
 #include "vtkSpaceSkipImageRenderer.h"
@@ -165,6 +166,16 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
     }
   }
 
+  // Interactive sampling (InteractiveAdjustSampleDistances): the last two frames' sample
+  // distances and seconds (newest first), which predict the time of the next interactive frame.
+  struct FrameTime
+  {
+    double Distance = 0, Seconds = 0;
+  };
+  FrameTime Frames[2];
+  double FrameSampleDistance(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, double still, bool piece);
+  void FrameDrawn(double seconds, double distance, vtkImageData* image);
+
   void RenderImage(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam,
     vtkImageData* input, bool resampled);
   void RenderComposite(vtkRenderer* ren, vtkVolume* vol, vtkDataObject* input);
@@ -197,6 +208,8 @@ struct vtkSpaceSkippingVolumeMapper::vtkBlock : public vtkSpaceSkipMultiBlockVol
   vtkNew<vtkSpaceSkippingVolumeMapper> Mapper;
   vtkInternals& D = *this->Mapper->Internals;
 
+  // The composite mapper's owner picks the blocks' sample distance (one for all of them).
+  vtkBlock() { this->Mapper->InteractiveAdjustSampleDistancesOff(); }
   void SetInput(vtkImageData* image) override
   {
     if (this->Mapper->GetInputDataObject(0, 0) != image)
@@ -235,6 +248,76 @@ struct vtkSpaceSkippingVolumeMapper::vtkBlock : public vtkSpaceSkipMultiBlockVol
 };
 
 //------------------------------------------------------------------------------
+namespace
+{
+double SmallestSpacing(vtkImageData* image)
+{
+  double smallest = 0;
+  for (int a = 0; image && a < 3; ++a)
+  {
+    const double h = std::abs(image->GetSpacing()[a]);
+    smallest = std::isfinite(h) && h > 0 && (smallest == 0 || h < smallest) ? h : smallest;
+  }
+  return smallest;
+}
+}
+
+// The sample distance of this frame: `still` (SampleDistance; 0: the engine's half smallest
+// spacing) in still renders, and in interactive ones whose frame at `still` would be fast (a
+// quarter of the volume's allocated render time or less: ParaView allocates 1/5 s among its
+// renderers, e.g. on a GPU). Otherwise at least one smallest spacing (where
+// vtkGPUVolumeRayCastMapper steps while dragged) and, if that does not fit the allocated time,
+// farther, up to 8 smallest spacings. A frame's time is modelled as fixed + work / distance,
+// fitted to the last two frames where their distances differ (else all work): the distance that
+// fits the allocated time, or where the fixed part alone nearly fills it, the one at which
+// sampling takes a quarter of the fixed part (farther would gain under 20 %). A piece of a larger
+// image keeps `still` (no process's own timing may give it another distance than the others').
+double vtkSpaceSkippingVolumeMapper::vtkInternals::FrameSampleDistance(
+  vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, double still, bool piece)
+{
+  vtkSpaceSkippingVolumeMapper* self = this->Self;
+  vtkRenderWindow* w = ren ? ren->GetRenderWindow() : nullptr;
+  const double rate = w ? w->GetDesiredUpdateRate() : 0.0;
+  const double smallest = SmallestSpacing(image);
+  self->LastRenderInteractive =
+    self->InteractiveAdjustSampleDistances && rate >= self->InteractiveUpdateRate && smallest > 0;
+  const FrameTime& a = this->Frames[0];
+  const FrameTime& b = this->Frames[1];
+  if (!self->LastRenderInteractive || piece || !(a.Seconds > 0 && a.Distance > 0))
+  {
+    return still;
+  }
+  const double base = still > 0 ? still : 0.5 * smallest;
+  const double allocated = vol->GetAllocatedRenderTime();
+  const double budget = allocated > 0 ? allocated : 1.0 / rate;
+  double work = a.Seconds * a.Distance, fixed = 0;
+  if (!std::isfinite(work) || !(work / base > 0.25 * budget))
+  {
+    return still;
+  }
+  if (b.Seconds > 0 && b.Distance > 0 && std::abs(a.Distance - b.Distance) > 0.1 * a.Distance)
+  {
+    const double wk = (a.Seconds - b.Seconds) / (1.0 / a.Distance - 1.0 / b.Distance);
+    const double fx = a.Seconds - wk / a.Distance;
+    if (std::isfinite(wk) && std::isfinite(fx) && wk > 0 && fx >= 0)
+    {
+      work = wk;
+      fixed = fx;
+    }
+  }
+  const double d = budget > 1.25 * fixed ? work / (budget - fixed) : work / (0.25 * fixed);
+  return std::clamp(d, std::max(base, smallest), std::max(base, 8.0 * smallest));
+}
+
+void vtkSpaceSkippingVolumeMapper::vtkInternals::FrameDrawn(double seconds, double distance, vtkImageData* image)
+{
+  this->Frames[1] = this->Frames[0];
+  this->Frames[0].Seconds = seconds;
+  this->Frames[0].Distance = distance > 0 ? distance : 0.5 * SmallestSpacing(image);
+  this->Self->LastRequestedSampleDistance = distance;
+}
+
+//------------------------------------------------------------------------------
 // One image through vtkSpaceSkipImageRenderer; SPACESKIP_BACKEND overrides the backend.
 void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(vtkRenderer* ren, vtkVolume* vol,
   vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam, vtkImageData* input, bool resampled)
@@ -252,6 +335,10 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(vtkRenderer* ren, v
     std::copy(lattice, lattice + 6, s.WholeExtent);
   }
   s.Backend = Overrides().Backend >= 0 ? Overrides().Backend : s.Backend;
+  // A piece of a larger image (ParaView sets WholeExtent serially too: the image's own).
+  const bool piece = this->Exchange != nullptr ||
+    (s.HasWholeExtent() && input && !std::equal(s.WholeExtent, s.WholeExtent + 6, input->GetExtent()));
+  s.SampleDistance = this->FrameSampleDistance(ren, vol, input, s.SampleDistance, piece);
   int cellFlag = 0;
   vtkDataArray* scalars = input ? vtkAbstractMapper::GetScalars(input, self->ScalarMode,
                                     self->ArrayAccessMode, self->ArrayId, self->ArrayName, cellFlag)
@@ -259,6 +346,7 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(vtkRenderer* ren, v
   if (this->Image.Render(ren, vol, renWin, cam, input, scalars, cellFlag, s, this->Mode))
   {
     this->Image.SetMapperSeconds(SecondsSince(t0));
+    this->FrameDrawn(SecondsSince(t0), s.SampleDistance, input);
     this->LastProblem.clear();
   }
 }
@@ -272,11 +360,16 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderComposite(
   {
     this->Composite->SetInputDataObject(input);
   }
-  this->Composite->SetSettings(vtkSpaceSkipSettings::From(this->Self));
+  const auto t0 = std::chrono::steady_clock::now();
+  vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(this->Self);
+  vtkImageData* first = vtkSpaceSkipMultiBlockVolumeMapper::FirstImage(input);
+  s.SampleDistance = this->FrameSampleDistance(ren, vol, first, s.SampleDistance, this->Exchange != nullptr);
+  this->Composite->SetSettings(s);
   this->Composite->Render(ren, vol);
   const std::string& problem = this->Composite->GetLastProblem();
   if (problem.empty())
   {
+    this->FrameDrawn(SecondsSince(t0), s.SampleDistance, first);
     this->LastProblem.clear();
   }
   else
@@ -868,6 +961,8 @@ void vtkSpaceSkippingVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BinCount: " << this->BinCount << "\n";
   os << indent << "MacroCellSize: " << this->MacroCellSize << "\n";
   os << indent << "SampleDistance: " << this->SampleDistance << "\n";
+  os << indent << "InteractiveAdjustSampleDistances: " << this->InteractiveAdjustSampleDistances << "\n";
+  os << indent << "InteractiveUpdateRate: " << this->InteractiveUpdateRate << "\n";
   os << indent << "Backend: "
      << (this->Backend == Auto ? "Auto" : (this->Backend == CPU ? "CPU" : "CUDA")) << "\n";
   os << indent << "FilterMode: " << this->GetFilterModeAsString() << "\n";

@@ -172,6 +172,31 @@ public:
 
   ///@{
   /**
+   * Interactive renders (the render window's DesiredUpdateRate at or above
+   * InteractiveUpdateRate, as vtkSmartVolumeMapper decides: VTK's interactors raise it while the
+   * user drags, ParaView's view sets 5 for its interactive renders and 0.002 for still ones)
+   * whose frame at SampleDistance would take more than a quarter of the volume's allocated render
+   * time (ParaView allocates 1/5 s among its renderers) step at least one smallest spacing (as
+   * vtkGPUVolumeRayCastMapper does while dragged) and, if that does not fit the allocated time,
+   * farther, at most 8 smallest spacings, as far as a model of the last two frames' times (a
+   * fixed part plus sampling work that goes as 1 / distance) says fits it or gains at least
+   * 20 %; faster frames (e.g. on a GPU) keep SampleDistance. Still renders use SampleDistance, so the picture the user stops at
+   * is the exact one. On by default (as vtkSmartVolumeMapper's
+   * InteractiveAdjustSampleDistances); a piece of a larger image (MPI) keeps SampleDistance, the
+   * same on every process.
+   */
+  vtkSetMacro(InteractiveAdjustSampleDistances, vtkTypeBool);
+  vtkGetMacro(InteractiveAdjustSampleDistances, vtkTypeBool);
+  vtkBooleanMacro(InteractiveAdjustSampleDistances, vtkTypeBool);
+  vtkSetClampMacro(InteractiveUpdateRate, double, 1.0e-10, 1.0e10);
+  vtkGetMacro(InteractiveUpdateRate, double);
+  /// Whether the last render was interactive, and the sample distance it asked the engine for.
+  vtkGetMacro(LastRenderInteractive, bool);
+  vtkGetMacro(LastRequestedSampleDistance, double);
+  ///@}
+
+  ///@{
+  /**
    * Auto (default): CUDA when a usable device exists, else CPU. The environment variable
    * SPACESKIP_BACKEND (cpu, cuda or auto; read once per process, said once as a warning)
    * overrides this property for every mapper of the process (to run the tests on a given
@@ -598,6 +623,10 @@ protected:
   int BinCount = 4;
   int MacroCellSize = 8;
   double SampleDistance = 0.0;
+  vtkTypeBool InteractiveAdjustSampleDistances = 1;
+  double InteractiveUpdateRate = 1.0;
+  bool LastRenderInteractive = false;
+  double LastRequestedSampleDistance = 0.0;
   int Backend = Auto;
   int FilterMode = ExactFilter;
   vtkTypeBool EarlyRayTermination = 1;

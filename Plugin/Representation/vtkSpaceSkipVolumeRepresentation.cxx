@@ -751,6 +751,7 @@ vtkSpaceSkipForwardGet(FrameCount, int)
 
 vtkSpaceSkipForwardBool(EarlyRayTermination)
 vtkSpaceSkipForwardBool(UseJittering)
+vtkSpaceSkipForwardBool(InteractiveAdjustSampleDistances)
 void vtkSpaceSkipVolumeRepresentation::SetGlobalIlluminationReach(float reach)
 {
   this->Superclass::SetGlobalIlluminationReach(reach);

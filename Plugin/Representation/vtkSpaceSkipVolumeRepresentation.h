@@ -57,6 +57,8 @@ public:
   void SetEarlyRayTermination(int on);
   int GetEarlyRayTermination();
   void SetUseJittering(int on);
+  void SetInteractiveAdjustSampleDistances(int on);
+  int GetInteractiveAdjustSampleDistances();
   ///@{
   /// The stock Volume's Global Illumination Reach and Volumetric Scattering Blending (shared
   /// properties; the base class hands them to VTK's mappers only): to our mapper as well. The
