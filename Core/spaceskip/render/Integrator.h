@@ -213,9 +213,12 @@ struct IntervalMarcher {
     n = len > 0.f ? n * (1.f / len) : vec3f{0, 0, 0};
     if (f->useLights) return shadeLights(rgb, n, p);
     const float nl = -dot(n, lightW);  // VTK: the gradient points inwards, hence -l
-    const vec3f r = normalize(n * (2.f * nl) + lightW);
-    const float vr = ss_max(-dot(r, viewW), 0.f);
-    const float spec = vr > 0.f ? f->specular * powf(vr, f->specularPower) : 0.f;
+    float spec = 0.f;
+    if (f->specular != 0.f) {  // ParaView's default Specular is 0: no reflection, no powf
+      const vec3f r = normalize(n * (2.f * nl) + lightW);
+      const float vr = ss_max(-dot(r, viewW), 0.f);
+      spec = vr > 0.f ? f->specular * powf(vr, f->specularPower) : 0.f;
+    }
     const float k = f->ambient + f->diffuse * fabsf(nl);
     return vec3f{k * rgb.x + spec, k * rgb.y + spec, k * rgb.z + spec};
   }
@@ -255,12 +258,15 @@ struct IntervalMarcher {
       if (nl < 0.f && f->twoSided) nl = -nl;
       if (nl > 0.f) {
         dif = dif + L.diffuse * ss_max(0.f, att * nl);
+        if (f->specular == 0.f) continue;  // ParaView's default: the specular sum is not used
         const vec3f r = normalize(n * (2.f * nl) - ld);
         float rv = dot(v, r);
         if (L.positional && rv < 0.f && f->twoSided) rv = -rv;
         if (rv > 0.f) spe = spe + L.specular * (att * powf(rv, f->specularPower));
       }
     }
+    // Without specular reflection spe stays 0 (0 * spe was 0 already, or NaN where a
+    // positional light's attenuation was infinite).
     const vec3f a = f->lightAmbient;
     return vec3f{f->ambient * a.x + f->diffuse * dif.x * rgb.x + f->specular * spe.x,
                  f->ambient * a.y + f->diffuse * dif.y * rgb.y + f->specular * spe.y,
