@@ -14,16 +14,18 @@
 namespace spaceskip {
 namespace march_detail {
 
-/// One ray's share of a packet, set up as renderPixel sets it up for a plain frame: the ray
-/// (index space), the lattice anchor t0 and the drawn part [a, b) of the ray.
+/// One ray's share of a packet, set up as renderPixel sets it up: the ray (index space), the
+/// lattice anchor t0, the drawn part [a, b) of the ray and, in shaded frames, the light's
+/// direction for the headlight model (rayLighting).
 struct LaneSetup {
   enum Kind { Empty, Packet, Scalar } kind;
   Ray r;
   vec3f inv;
   float t0, a, b;
+  vec3f light;
 };
 
-/// renderPixel<Sampler, -1, true> up to its march. Scalar: a pixel the packet leaves to
+/// renderPixel up to its march. Scalar: a pixel the packet leaves to
 /// renderPixel (its first sample lies past the box's exit, or sample indices too large for
 /// exact float lanes).
 inline LaneSetup setupLane(const FrameView& f, int px, int py) {
@@ -54,6 +56,10 @@ inline LaneSetup setupLane(const FrameView& f, int px, int py) {
   s.t0 = t0;
   s.a = a;
   s.b = b;
+  if (f.shade && !f.useLights) {
+    vec3f view;
+    rayLighting(f, p, s.light, view);
+  }
   return s;
 }
 
@@ -144,7 +150,23 @@ inline void initIter(HybridIter& it, const FrameView& f, const LaneSetup& s) {
 
 template <class T>
 vec4f scalarPixel(const FrameView& f, const T* v, int64_t nx, int64_t ny, int64_t nz, int px, int py) {
-  return renderPixel<ArraySampler<T>, -1, true>(f, ArraySampler<T>{v, nx, ny, nz}, px, py);
+  const ArraySampler<T> s{v, nx, ny, nz};
+  return f.shade ? renderPixel<ArraySampler<T>, -1, false>(f, s, px, py)
+                 : renderPixel<ArraySampler<T>, -1, true>(f, s, px, py);
+}
+
+/// Shaded composite frames the packets take: the gradient (Phong) shading without specular
+/// reflection (ParaView's and VTK's default Specular 0: no powf, whose SIMD rounding would
+/// differ from the C library's) and with directional lights only; no scattering, clipping,
+/// cropping, 2-D transfer function or gradient opacity.
+inline bool shadedPacketFrame(const FrameView& f) {
+  if (!(f.blend == BlendMode::Composite && f.shade && f.cut.numClipPlanes == 0 && !f.cut.cropping &&
+        f.gtf.mode == 0 && !f.scatter.on && f.specular == 0.f))
+    return false;
+  if (f.useLights)
+    for (int i = 0; i < f.numLights; ++i)
+      if (f.lights[i].positional) return false;
+  return true;
 }
 
 }  // namespace march_detail
@@ -262,7 +284,7 @@ constexpr size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
 template <class Iter>
 struct PacketLanes {
   HWY_ALIGN float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes], dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes],
-      t0[kMaxLanes];
+      t0[kMaxLanes], lx[kMaxLanes], ly[kMaxLanes], lz[kMaxLanes];
   HWY_ALIGN int32_t kc[kMaxLanes], ke[kMaxLanes];
   int64_t outAt[kMaxLanes];
   march_detail::LaneRuns<Iter> runs[kMaxLanes];
@@ -279,7 +301,7 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
   for (size_t l = 0; l < N; ++l) {
     const int x = bx + int(l) % bw, y = by + int(l) / bw;
     P.kc[l] = P.ke[l] = 0;
-    P.ox[l] = P.oy[l] = P.oz[l] = P.dx[l] = P.dy[l] = P.dz[l] = P.t0[l] = 0.f;
+    P.ox[l] = P.oy[l] = P.oz[l] = P.dx[l] = P.dy[l] = P.dz[l] = P.t0[l] = P.lx[l] = P.ly[l] = P.lz[l] = 0.f;
     P.outAt[l] = -1;
     if (x >= x1 || y >= y1) continue;
     const int64_t at = int64_t(y) * f.width + x;
@@ -300,6 +322,9 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
     P.dy[l] = s.r.dir.y;
     P.dz[l] = s.r.dir.z;
     P.t0[l] = s.t0;
+    P.lx[l] = s.light.x;
+    P.ly[l] = s.light.y;
+    P.lz[l] = s.light.z;
     P.runs[l] = march_detail::LaneRuns<Iter>{};
     P.runs[l].wa = s.a;
     P.runs[l].wb = s.b;
@@ -371,11 +396,77 @@ HWY_INLINE VF Sample(const T* vox, int64_t nx, int64_t ny, int64_t nz, VF x, VF 
   return hn::Add(c0, hn::Mul(hn::Sub(c1, c0), fz));
 }
 
+/// The lanes' ray position, light (headlight model) and volume: what shading a sample needs.
+template <class T>
+struct LaneShading {
+  const T* vox;
+  int64_t nx, ny, nz;
+  VF x, y, z;     ///< the samples' positions (index space)
+  VF lx, ly, lz;  ///< towards the light (rayLighting), world space
+};
+
+/// IntervalMarcher::shadeColor of colours (r, g, b) for the frames shadedPacketFrame accepts:
+/// the central differences one voxel apart, then shadeGradient with the headlight model or
+/// shadeLights over the directional lights, clamped to [0, 1]; each lane with the scalar
+/// integrator's float operations in its order.
+template <class T>
+HWY_INLINE void ShadeLanes(const FrameView& f, const LaneShading<T>& S, VF& r, VF& g, VF& b) {
+  const DF df;
+  const VF one = hn::Set(df, 1.f), zero = hn::Zero(df);
+  // p + vec3f{1, 0, 0} adds 0.f to the other coordinates (which turns -0 into +0); p - {1, 0, 0}
+  // subtracts it (which changes nothing).
+  const VF xp = hn::Add(S.x, zero), yp = hn::Add(S.y, zero), zp = hn::Add(S.z, zero);
+  const VF gx = hn::Sub(Sample(S.vox, S.nx, S.ny, S.nz, hn::Add(S.x, one), yp, zp),
+                        Sample(S.vox, S.nx, S.ny, S.nz, hn::Sub(S.x, one), S.y, S.z));
+  const VF gy = hn::Sub(Sample(S.vox, S.nx, S.ny, S.nz, xp, hn::Add(S.y, one), zp),
+                        Sample(S.vox, S.nx, S.ny, S.nz, S.x, hn::Sub(S.y, one), S.z));
+  const VF gz = hn::Sub(Sample(S.vox, S.nx, S.ny, S.nz, xp, yp, hn::Add(S.z, one)),
+                        Sample(S.vox, S.nx, S.ny, S.nz, S.x, S.y, hn::Sub(S.z, one)));
+  // shadeGradient: the gradient to world space, normalised (zero where its length is not > 0).
+  const float* M = f.worldToIndex;
+  auto row = [&](float a, float b2, float c) {
+    return hn::Add(hn::Add(hn::Mul(hn::Set(df, a), gx), hn::Mul(hn::Set(df, b2), gy)), hn::Mul(hn::Set(df, c), gz));
+  };
+  VF n0 = row(M[0], M[4], M[8]), n1 = row(M[1], M[5], M[9]), n2 = row(M[2], M[6], M[10]);
+  const VF len = hn::Sqrt(hn::Add(hn::Add(hn::Mul(n0, n0), hn::Mul(n1, n1)), hn::Mul(n2, n2)));
+  const MF pos = hn::Gt(len, zero);
+  const VF inv = hn::Div(one, len);
+  n0 = hn::IfThenElseZero(pos, hn::Mul(n0, inv));
+  n1 = hn::IfThenElseZero(pos, hn::Mul(n1, inv));
+  n2 = hn::IfThenElseZero(pos, hn::Mul(n2, inv));
+  if (!f.useLights) {  // the headlight model: ambient + diffuse |n.l|, no specular term
+    const VF nl = hn::Add(hn::Add(hn::Mul(n0, S.lx), hn::Mul(n1, S.ly)), hn::Mul(n2, S.lz));
+    const VF k = hn::Add(hn::Set(df, f.ambient), hn::Mul(hn::Set(df, f.diffuse), hn::Abs(nl)));
+    r = Clamp(hn::Add(hn::Mul(k, r), zero), zero, one);
+    g = Clamp(hn::Add(hn::Mul(k, g), zero), zero, one);
+    b = Clamp(hn::Add(hn::Mul(k, b), zero), zero, one);
+    return;
+  }
+  // shadeLights over directional lights (attenuation 1), without the specular sum.
+  VF d0 = zero, d1 = zero, d2 = zero;
+  for (int i = 0; i < f.numLights; ++i) {
+    const LightView& L = f.lights[i];
+    VF nl = hn::Add(hn::Add(hn::Mul(n0, hn::Set(df, L.dir.x)), hn::Mul(n1, hn::Set(df, L.dir.y))),
+                    hn::Mul(n2, hn::Set(df, L.dir.z)));
+    if (f.twoSided) nl = hn::IfThenElse(hn::Lt(nl, zero), hn::Neg(nl), nl);
+    const MF lit = hn::Gt(nl, zero);
+    d0 = hn::IfThenElse(lit, hn::Add(d0, hn::Mul(hn::Set(df, L.diffuse.x), nl)), d0);
+    d1 = hn::IfThenElse(lit, hn::Add(d1, hn::Mul(hn::Set(df, L.diffuse.y), nl)), d1);
+    d2 = hn::IfThenElse(lit, hn::Add(d2, hn::Mul(hn::Set(df, L.diffuse.z), nl)), d2);
+  }
+  const vec3f a = f.lightAmbient;
+  const VF kd = hn::Set(df, f.diffuse);
+  r = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.x), hn::Mul(hn::Mul(kd, d0), r)), zero), zero, one);
+  g = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.y), hn::Mul(hn::Mul(kd, d1), g)), zero), zero, one);
+  b = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.z), hn::Mul(hn::Mul(kd, d2), b)), zero), zero, one);
+}
+
 /// lookup() of samples v and IntervalMarcher::composite into (ax, ay, az, aw) for the live
-/// lanes: NaN is transparent; opacity first, colour only where a lane composites; a lane that
-/// composites and reaches the threshold stops.
-HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF live, VF& ax, VF& ay, VF& az,
-                                VF& aw, MF& stopped) {
+/// lanes: NaN is transparent; opacity first, colour only where a lane composites (shaded when
+/// `S` is given); a lane that composites and reaches the threshold stops.
+template <class T>
+HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF live, const LaneShading<T>* S,
+                                VF& ax, VF& ay, VF& az, VF& aw, MF& stopped) {
   const DF df;
   const DI di;
   const VF onef = hn::Set(df, 1.f), ert = hn::Set(df, f.ertThreshold);
@@ -397,9 +488,10 @@ HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF
   GatherPairs(pairs, q, r0, r1);
   GatherPairs(pairs + pairStride, q, g0, g1);
   GatherPairs(pairs + 2 * pairStride, q, b0, b1);
-  const VF cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
-  const VF cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
-  const VF cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
+  VF cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
+  VF cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
+  VF cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
+  if (S) ShadeLanes(f, *S, cx, cy, cz);
   // IntervalMarcher::composite, front-to-back "over".
   const VF w = hn::Mul(hn::Sub(onef, aw), cw);
   ax = hn::IfThenElse(comp, hn::Add(ax, hn::Mul(w, cx)), ax);
@@ -422,6 +514,9 @@ HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox
   const VF vox_ = hn::Load(df, P.ox), voy = hn::Load(df, P.oy), voz = hn::Load(df, P.oz);
   const VF vdx = hn::Load(df, P.dx), vdy = hn::Load(df, P.dy), vdz = hn::Load(df, P.dz);
   const VF vt0 = hn::Load(df, P.t0);
+  LaneShading<T> S{vox, nx, ny, nz, hn::Zero(df), hn::Zero(df), hn::Zero(df),
+                   hn::Load(df, P.lx), hn::Load(df, P.ly), hn::Load(df, P.lz)};
+  const LaneShading<T>* shade = f.shade ? &S : nullptr;
   VI k = hn::Load(di, P.kc), kEnd = hn::Load(di, P.ke);
   VF ax = hn::Zero(df), ay = hn::Zero(df), az = hn::Zero(df), aw = hn::Zero(df);
   MF stopped = hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd)));  // no samples, or terminated
@@ -432,9 +527,11 @@ HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox
     if (hn::AllFalse(df, live)) break;
     // IntervalMarcher::take(k): t = t0 + float(k) * dt, p = org + dir * t.
     const VF t = hn::Add(vt0, hn::Mul(hn::ConvertTo(df, k), dtv));
-    const VF v = Sample(vox, nx, ny, nz, hn::Add(vox_, hn::Mul(vdx, t)), hn::Add(voy, hn::Mul(vdy, t)),
-                        hn::Add(voz, hn::Mul(vdz, t)));
-    LookupComposite(f, pairs, v, live, ax, ay, az, aw, stopped);
+    S.x = hn::Add(vox_, hn::Mul(vdx, t));
+    S.y = hn::Add(voy, hn::Mul(vdy, t));
+    S.z = hn::Add(voz, hn::Mul(vdz, t));
+    const VF v = Sample(vox, nx, ny, nz, S.x, S.y, S.z);
+    LookupComposite(f, pairs, v, live, shade, ax, ay, az, aw, stopped);
     k = hn::Add(k, one);
   }
   HWY_ALIGN float rx[kMaxLanes], ry[kMaxLanes], rz[kMaxLanes], rw[kMaxLanes];
@@ -508,7 +605,7 @@ HWY_EXPORT(TargetName);
 
 bool packetMarchable(const FrameView& f, VoxelType type, int components, int64_t nx, int64_t ny, int64_t nz) {
 #ifdef SPACESKIP_HAVE_HWY
-  if (!isPlainFrame(f) || f.lattice.active || f.alphaIn || f.sampleCount || f.grid.vmin) return false;
+  if (!(isPlainFrame(f) || march_detail::shadedPacketFrame(f)) || f.lattice.active || f.alphaIn || f.sampleCount || f.grid.vmin) return false;
   if (f.sampling != 0) return false;  // nearest and label sampling (render/LabelSampler.h)
   if (components != 1 || type == VoxelType::Float64) return false;
   // 32-bit gathers: float32 by index, the others by byte offset (voxel index * size + 1).

@@ -15,7 +15,9 @@
 namespace spaceskip {
 
 /// Whether marchPacketTile renders frame `f` over a volume of this type and shape: plain
-/// composite frames (isPlainFrame) with any traversal (each lane walks its own ray's runs with
+/// composite frames (isPlainFrame) and shaded composite ones without specular reflection and
+/// with directional lights only (ParaView's defaults: Specular 0, the light kit or the
+/// headlight) and without scattering, clipping, cropping or 2-D functions, with any traversal (each lane walks its own ray's runs with
 /// the shared iterators, Traversal.h, as IntervalMarcher::marchRuns does), serial (no piece),
 /// no incoming opacity, no sample counts; one component of 8- or 16-bit integers or float32,
 /// every axis at least 2 voxels, fewer than 2^31 voxel bytes (32-bit gather offsets). Else the
@@ -27,7 +29,7 @@ bool packetMarchable(const FrameView& f, VoxelType type, int components, int64_t
 void packetPairTable(const TransferFunctionView& tf, std::vector<float>& pairs);
 
 /// Renders pixels [x0, x1) x [y0, y1) of a frame packetMarchable accepted into `px` (row-major,
-/// f.width wide), each pixel as renderPixel<ArraySampler<T>, -1, true> does. `pairs`:
+/// f.width wide), each pixel as renderPixel<ArraySampler<T>> does. `pairs`:
 /// packetPairTable(f.tf).
 void marchPacketTile(const FrameView& f, const float* pairs, VoxelType type, const void* voxels, int64_t nx,
                      int64_t ny, int64_t nz, int x0, int y0, int x1, int y1, vec4f* px);

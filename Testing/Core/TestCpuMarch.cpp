@@ -4,7 +4,8 @@
 // are compared frame against frame: every voxel type, parallel and perspective views, jitter,
 // the first sample one step in (as the VTK mapper asks), early ray termination, NaN and Inf
 // voxels, a frame whose edges are not multiples of a packet and a camera inside the volume;
-// and every skipping structure, each lane walking its own ray's runs.
+// and every skipping structure, each lane walking its own ray's runs; shaded frames (ParaView's
+// defaults: no specular reflection, the headlight or the light kit's directional lights) too.
 #include "TestUtil.h"
 
 #include "src/CpuMarch.h"
@@ -151,6 +152,91 @@ TEST(CpuMarch, EverySkippingStructureWalksTheSameRunsAsTheScalarIntegrator) {
         ASSERT_GT(coverage(s), 0.0) << what << " renders nothing";
         expectSameBits(a, s, what);
       }
+  }
+}
+
+TEST(CpuMarch, PacketsTakeShadedFramesWithoutSpecularAndDirectionalLights) {
+  if (std::strcmp(packetTarget(), "none") == 0) GTEST_SKIP() << "built without Highway: no packets";
+  FrameView f{};
+  f.blend = BlendMode::Composite;
+  f.tf.size = 256;
+  f.dt = 0.5f;
+  f.shade = 1;
+  f.specular = 0.f;
+  EXPECT_TRUE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "headlight, Specular 0";
+  f.useLights = 1;
+  f.numLights = 2;
+  EXPECT_TRUE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "directional lights, Specular 0";
+  f.lights[1].positional = 1;
+  EXPECT_FALSE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "a positional light: the scalar integrator";
+  f.lights[1].positional = 0;
+  f.specular = 0.2f;
+  EXPECT_FALSE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "specular reflection: the scalar integrator";
+  f.specular = 0.f;
+  f.scatter.on = 1;
+  EXPECT_FALSE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "scattering: the scalar integrator";
+}
+
+TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
+  // The headlight (parallel and perspective views, a set light direction) and a light kit of
+  // directional lights (one-sided and two-sided), on an anisotropic grid (the gradient goes to
+  // world space through the inverse transpose), every voxel type, skipping structures, jitter,
+  // early ray termination and NaN/Inf voxels.
+  Volume base = generateVolume("noise", vec3l{33, 27, 30});
+  base.spacing[0] = 0.7;
+  base.spacing[2] = 1.6;
+  std::vector<Light> kit(3);
+  kit[0].position[0] = 1, kit[0].position[1] = 2, kit[0].position[2] = 3;
+  kit[0].diffuse[0] = 0.9, kit[0].diffuse[1] = 0.8, kit[0].diffuse[2] = 0.7;
+  kit[0].ambient[0] = kit[0].ambient[1] = kit[0].ambient[2] = 0.1;
+  kit[1].position[0] = -2, kit[1].position[1] = 0.5, kit[1].position[2] = -1;
+  kit[1].diffuse[0] = 0.3, kit[1].diffuse[1] = 0.35, kit[1].diffuse[2] = 0.4;
+  kit[2].position[0] = 0, kit[2].position[1] = -1, kit[2].position[2] = 0.2;
+  const VoxelType types[] = {VoxelType::UInt8, VoxelType::Int16, VoxelType::UInt16, VoxelType::Float32};
+  const BuilderKind builders[] = {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid,
+                                  BuilderKind::KdTreeCPU};
+  int variant = 0;
+  for (VoxelType t : types) {
+    Volume v = t == VoxelType::UInt8 ? base : convert(base, t);
+    v.spacing[0] = 0.7;
+    v.spacing[2] = 1.6;
+    if (t == VoxelType::Float32) {
+      float* d = reinterpret_cast<float*>(v.mutableData());
+      d[500] = std::numeric_limits<float>::quiet_NaN();
+      d[4000] = std::numeric_limits<float>::infinity();
+    }
+    double lo = 0, hi = 1;
+    ASSERT_TRUE(v.scalarRange(lo, hi));
+    if (t == VoxelType::Float32) lo = -11.0, hi = 83.0;  // the finite values' range
+    for (const char* preset : {"ramp", "spike"})
+      for (BuilderKind b : builders)
+        for (int lights = 0; lights < 4; ++lights, ++variant) {
+          const TransferFunction tf = TransferFunction::preset(preset, lo, hi);
+          RenderParams rp;
+          rp.shade = true;
+          rp.ambient = 0.15;
+          rp.diffuse = 0.8;
+          rp.specular = 0.0;  // ParaView's default
+          rp.jitter = variant % 3 == 0;
+          rp.jitterSeed = 11;
+          rp.firstSampleOffset = variant % 2 ? 1.0 : 0.0;
+          rp.ertThreshold = variant % 5 == 0 ? 0.9 : 2.0;
+          if (lights == 1) rp.lightDirection[0] = 0.3, rp.lightDirection[1] = -0.5, rp.lightDirection[2] = 0.8;
+          if (lights >= 2) {
+            rp.useLights = true;
+            rp.lights = kit;
+            rp.twoSidedLighting = lights == 3;
+          }
+          const bool persp = lights != 1;
+          const std::string what = std::string("type ") + std::to_string(int(t)) + " tf " + preset + " " +
+                                   builderName(b) + " lights " + std::to_string(lights);
+          const BuildParams bp = test::builder(b, LeafCriterion::Deep, 0, 4, 8);
+          const double az = 25.0 + 17.0 * (variant % 7), el = 30.0 - 9.0 * (variant % 5);
+          const Image a = render(v, tf, rp, false, az, el, persp, 45, 38, 1.0, bp);
+          const Image s = render(v, tf, rp, true, az, el, persp, 45, 38, 1.0, bp);
+          ASSERT_GT(coverage(s), 0.0) << what << " renders nothing";
+          expectSameBits(a, s, what);
+        }
   }
 }
 

@@ -563,6 +563,17 @@ SS_FUNC bool segmentableFrame(const FrameView& f) {
   return isPlainFrame(f) && !(f.ertThreshold <= 1.f) && !f.alphaIn && !f.sampleCount && !f.lattice.active;
 }
 
+/// A shaded ray's light and view directions in world space (IntervalMarcher::lightW, viewW) for
+/// the headlight model: VTK's headlight is at the eye, seen from the ray's entry point; a set
+/// light direction is the same for every ray. The scalar integrator and the SIMD packets
+/// (Core/src/CpuMarch.cpp) both set their rays up here.
+SS_FUNC void rayLighting(const FrameView& f, const PrimaryRay& p, vec3f& lightW, vec3f& viewW) {
+  const vec3f toEye = normalize(f.eyeW - (p.nearW + p.dirW * p.tEnter));
+  const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
+  lightW = head ? toEye : normalize(f.lightDir);
+  viewW = toEye;
+}
+
 /// Premultiplied RGBA of pixel (px, py); row 0 is the bottom row (OpenGL convention).
 /// `Traversal` >= 0 fixes the traversal at compile time (the CUDA kernels, one per traversal);
 /// -1 reads f.traversal.
@@ -591,12 +602,7 @@ SS_FUNC vec4f renderPixel(const FrameView& f, const Sampler& s, int px, int py, 
 
   IntervalMarcher<Sampler, Plain> m{&f, &s, rl, tEnter, 0, vec4f{0, 0, 0, aIn}, 0u, vec3f{0, 0, 0}, vec3f{0, 0, 0},
                              0.f, 0u, -1};
-  if (!Plain && f.shade) {  // VTK's headlight: the light is at the eye, seen from the ray's entry point
-    const vec3f toEye = normalize(f.eyeW - (nearW + dirW * tEnter));
-    const bool head = f.lightDir.x == 0.f && f.lightDir.y == 0.f && f.lightDir.z == 0.f;
-    m.lightW = head ? toEye : normalize(f.lightDir);
-    m.viewW = toEye;
-  }
+  if (!Plain && f.shade) rayLighting(f, p, m.lightW, m.viewW);
   m.orgW = nearW;
   m.dirW = dirW;
   if (!Plain && f.scatter.on) {  // VTK's g_lengthStep: the primary step in texture units
