@@ -15,14 +15,15 @@ namespace spaceskip {
 namespace march_detail {
 
 /// One ray's share of a packet, set up as renderPixel sets it up: the ray (index space), the
-/// lattice anchor t0, the drawn part [a, b) of the ray and, in shaded frames, the light's
-/// direction for the headlight model (rayLighting).
+/// lattice anchor t0, the drawn part [a, b) of the ray and, in shaded frames, the light and
+/// view directions of the headlight model (rayLighting) and the ray in world space (the light
+/// list's view vector, IntervalMarcher::worldAt).
 struct LaneSetup {
   enum Kind { Empty, Packet, Scalar } kind;
   Ray r;
   vec3f inv;
   float t0, a, b;
-  vec3f light;
+  vec3f light, view, orgW, dirW;
 };
 
 /// renderPixel up to its march. Scalar: a pixel the packet leaves to
@@ -56,9 +57,10 @@ inline LaneSetup setupLane(const FrameView& f, int px, int py) {
   s.t0 = t0;
   s.a = a;
   s.b = b;
-  if (f.shade && !f.useLights) {
-    vec3f view;
-    rayLighting(f, p, s.light, view);
+  if (f.shade) {
+    rayLighting(f, p, s.light, s.view);
+    s.orgW = p.nearW;
+    s.dirW = p.dirW;
   }
   return s;
 }
@@ -155,13 +157,12 @@ vec4f scalarPixel(const FrameView& f, const T* v, int64_t nx, int64_t ny, int64_
                  : renderPixel<ArraySampler<T>, -1, true>(f, s, px, py);
 }
 
-/// Shaded composite frames the packets take: the gradient (Phong) shading without specular
-/// reflection (ParaView's and VTK's default Specular 0: no powf, whose SIMD rounding would
-/// differ from the C library's) and with directional lights only; no scattering, clipping,
-/// cropping, 2-D transfer function or gradient opacity.
+/// Shaded composite frames the packets take: the gradient (Phong) shading with the headlight
+/// model or directional lights (ParaView's light kit); no positional lights, scattering,
+/// clipping, cropping, 2-D transfer function or gradient opacity.
 inline bool shadedPacketFrame(const FrameView& f) {
   if (!(f.blend == BlendMode::Composite && f.shade && f.cut.numClipPlanes == 0 && !f.cut.cropping &&
-        f.gtf.mode == 0 && !f.scatter.on && f.specular == 0.f))
+        f.gtf.mode == 0 && !f.scatter.on))
     return false;
   if (f.useLights)
     for (int i = 0; i < f.numLights; ++i)
@@ -284,7 +285,10 @@ constexpr size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
 template <class Iter>
 struct PacketLanes {
   HWY_ALIGN float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes], dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes],
-      t0[kMaxLanes], lx[kMaxLanes], ly[kMaxLanes], lz[kMaxLanes];
+      t0[kMaxLanes];
+  // Shaded frames: the headlight model's light and view directions, the ray in world space.
+  HWY_ALIGN float lx[kMaxLanes], ly[kMaxLanes], lz[kMaxLanes], vx[kMaxLanes], vy[kMaxLanes], vz[kMaxLanes],
+      wox[kMaxLanes], woy[kMaxLanes], woz[kMaxLanes], wdx[kMaxLanes], wdy[kMaxLanes], wdz[kMaxLanes];
   HWY_ALIGN int32_t kc[kMaxLanes], ke[kMaxLanes];
   int64_t outAt[kMaxLanes];
   march_detail::LaneRuns<Iter> runs[kMaxLanes];
@@ -301,7 +305,9 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
   for (size_t l = 0; l < N; ++l) {
     const int x = bx + int(l) % bw, y = by + int(l) / bw;
     P.kc[l] = P.ke[l] = 0;
-    P.ox[l] = P.oy[l] = P.oz[l] = P.dx[l] = P.dy[l] = P.dz[l] = P.t0[l] = P.lx[l] = P.ly[l] = P.lz[l] = 0.f;
+    P.ox[l] = P.oy[l] = P.oz[l] = P.dx[l] = P.dy[l] = P.dz[l] = P.t0[l] = 0.f;
+    P.lx[l] = P.ly[l] = P.lz[l] = P.vx[l] = P.vy[l] = P.vz[l] = 0.f;
+    P.wox[l] = P.woy[l] = P.woz[l] = P.wdx[l] = P.wdy[l] = P.wdz[l] = 0.f;
     P.outAt[l] = -1;
     if (x >= x1 || y >= y1) continue;
     const int64_t at = int64_t(y) * f.width + x;
@@ -325,6 +331,15 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
     P.lx[l] = s.light.x;
     P.ly[l] = s.light.y;
     P.lz[l] = s.light.z;
+    P.vx[l] = s.view.x;
+    P.vy[l] = s.view.y;
+    P.vz[l] = s.view.z;
+    P.wox[l] = s.orgW.x;
+    P.woy[l] = s.orgW.y;
+    P.woz[l] = s.orgW.z;
+    P.wdx[l] = s.dirW.x;
+    P.wdy[l] = s.dirW.y;
+    P.wdz[l] = s.dirW.z;
     P.runs[l] = march_detail::LaneRuns<Iter>{};
     P.runs[l].wa = s.a;
     P.runs[l].wb = s.b;
@@ -396,14 +411,43 @@ HWY_INLINE VF Sample(const T* vox, int64_t nx, int64_t ny, int64_t nz, VF x, VF 
   return hn::Add(c0, hn::Mul(hn::Sub(c1, c0), fz));
 }
 
-/// The lanes' ray position, light (headlight model) and volume: what shading a sample needs.
+/// The lanes' ray position, light and view (headlight model), rays and volume: what shading a
+/// sample needs.
 template <class T>
 struct LaneShading {
   const T* vox;
   int64_t nx, ny, nz;
   VF x, y, z;     ///< the samples' positions (index space)
   VF lx, ly, lz;  ///< towards the light (rayLighting), world space
+  VF vx, vy, vz;  ///< towards the eye (rayLighting), world space
+  VF ox, oy, oz, dx, dy, dz;      ///< the ray, index space
+  VF wox, woy, woz, wdx, wdy, wdz;  ///< the ray, world space (primaryRay's nearW, dirW)
 };
+
+HWY_INLINE VF Dot(VF ax, VF ay, VF az, VF bx, VF by, VF bz) {
+  return hn::Add(hn::Add(hn::Mul(ax, bx), hn::Mul(ay, by)), hn::Mul(az, bz));
+}
+
+/// normalize() lane by lane: a / |a| where |a| > 0, else a unchanged.
+HWY_INLINE void Normalize(VF& x, VF& y, VF& z) {
+  const DF df;
+  const VF l = hn::Sqrt(Dot(x, y, z, x, y, z));
+  const MF pos = hn::Gt(l, hn::Zero(df));
+  const VF inv = hn::Div(hn::Set(df, 1.f), l);
+  x = hn::IfThenElse(pos, hn::Mul(x, inv), x);
+  y = hn::IfThenElse(pos, hn::Mul(y, inv), y);
+  z = hn::IfThenElse(pos, hn::Mul(z, inv), z);
+}
+
+/// powf(x, power) where x > 0, else 0: the C library's powf lane by lane (a vector power
+/// would round differently from the scalar integrator's).
+HWY_INLINE VF PowLanes(VF x, float power) {
+  const DF df;
+  HWY_ALIGN float a[kMaxLanes];
+  hn::Store(x, df, a);
+  for (size_t l = 0; l < hn::Lanes(df); ++l) a[l] = a[l] > 0.f ? powf(a[l], power) : 0.f;
+  return hn::Load(df, a);
+}
 
 /// IntervalMarcher::shadeColor of colours (r, g, b) for the frames shadedPacketFrame accepts:
 /// the central differences one voxel apart, then shadeGradient with the headlight model or
@@ -434,31 +478,62 @@ HWY_INLINE void ShadeLanes(const FrameView& f, const LaneShading<T>& S, VF& r, V
   n0 = hn::IfThenElseZero(pos, hn::Mul(n0, inv));
   n1 = hn::IfThenElseZero(pos, hn::Mul(n1, inv));
   n2 = hn::IfThenElseZero(pos, hn::Mul(n2, inv));
-  if (!f.useLights) {  // the headlight model: ambient + diffuse |n.l|, no specular term
-    const VF nl = hn::Add(hn::Add(hn::Mul(n0, S.lx), hn::Mul(n1, S.ly)), hn::Mul(n2, S.lz));
+  const bool specular = f.specular != 0.f;  // ParaView's default Specular 0: no reflection, no powf
+  if (!f.useLights) {  // the headlight model: ambient + diffuse |n.l| + the reflection's specular
+    const VF nl = hn::Neg(Dot(n0, n1, n2, S.lx, S.ly, S.lz));
+    VF spec = zero;
+    if (specular) {
+      const VF t2 = hn::Mul(hn::Set(df, 2.f), nl);
+      VF rx = hn::Add(hn::Mul(n0, t2), S.lx), ry = hn::Add(hn::Mul(n1, t2), S.ly), rz = hn::Add(hn::Mul(n2, t2), S.lz);
+      Normalize(rx, ry, rz);
+      const VF vr = hn::Neg(Dot(rx, ry, rz, S.vx, S.vy, S.vz));
+      spec = hn::Mul(hn::Set(df, f.specular), PowLanes(vr, f.specularPower));
+    }
     const VF k = hn::Add(hn::Set(df, f.ambient), hn::Mul(hn::Set(df, f.diffuse), hn::Abs(nl)));
-    r = Clamp(hn::Add(hn::Mul(k, r), zero), zero, one);
-    g = Clamp(hn::Add(hn::Mul(k, g), zero), zero, one);
-    b = Clamp(hn::Add(hn::Mul(k, b), zero), zero, one);
+    r = Clamp(hn::Add(hn::Mul(k, r), spec), zero, one);
+    g = Clamp(hn::Add(hn::Mul(k, g), spec), zero, one);
+    b = Clamp(hn::Add(hn::Mul(k, b), spec), zero, one);
     return;
   }
-  // shadeLights over directional lights (attenuation 1), without the specular sum.
-  VF d0 = zero, d1 = zero, d2 = zero;
+  // shadeLights over directional lights (attenuation 1).
+  VF vx = zero, vy = zero, vz = zero;  // eye -> sample, world space (IntervalMarcher::worldAt)
+  if (specular) {
+    const VF ex = hn::Sub(S.x, S.ox), ey = hn::Sub(S.y, S.oy), ez = hn::Sub(S.z, S.oz);
+    const VF t = hn::Div(Dot(ex, ey, ez, S.dx, S.dy, S.dz), Dot(S.dx, S.dy, S.dz, S.dx, S.dy, S.dz));
+    vx = hn::Sub(hn::Add(S.wox, hn::Mul(S.wdx, t)), hn::Set(df, f.eyeW.x));
+    vy = hn::Sub(hn::Add(S.woy, hn::Mul(S.wdy, t)), hn::Set(df, f.eyeW.y));
+    vz = hn::Sub(hn::Add(S.woz, hn::Mul(S.wdz, t)), hn::Set(df, f.eyeW.z));
+    Normalize(vx, vy, vz);
+  }
+  VF d0 = zero, d1 = zero, d2 = zero, s0 = zero, s1 = zero, s2 = zero;
   for (int i = 0; i < f.numLights; ++i) {
     const LightView& L = f.lights[i];
-    VF nl = hn::Add(hn::Add(hn::Mul(n0, hn::Set(df, L.dir.x)), hn::Mul(n1, hn::Set(df, L.dir.y))),
-                    hn::Mul(n2, hn::Set(df, L.dir.z)));
+    const VF ldx = hn::Set(df, L.dir.x), ldy = hn::Set(df, L.dir.y), ldz = hn::Set(df, L.dir.z);
+    VF nl = Dot(n0, n1, n2, ldx, ldy, ldz);
     if (f.twoSided) nl = hn::IfThenElse(hn::Lt(nl, zero), hn::Neg(nl), nl);
     const MF lit = hn::Gt(nl, zero);
     d0 = hn::IfThenElse(lit, hn::Add(d0, hn::Mul(hn::Set(df, L.diffuse.x), nl)), d0);
     d1 = hn::IfThenElse(lit, hn::Add(d1, hn::Mul(hn::Set(df, L.diffuse.y), nl)), d1);
     d2 = hn::IfThenElse(lit, hn::Add(d2, hn::Mul(hn::Set(df, L.diffuse.z), nl)), d2);
+    if (!specular || hn::AllFalse(df, lit)) continue;
+    const VF t2 = hn::Mul(hn::Set(df, 2.f), nl);
+    VF rx = hn::Sub(hn::Mul(n0, t2), ldx), ry = hn::Sub(hn::Mul(n1, t2), ldy), rz = hn::Sub(hn::Mul(n2, t2), ldz);
+    Normalize(rx, ry, rz);
+    const VF rv = Dot(vx, vy, vz, rx, ry, rz);
+    const MF up = hn::And(lit, hn::Gt(rv, zero));
+    const VF pw = PowLanes(hn::IfThenElseZero(lit, rv), f.specularPower);
+    s0 = hn::IfThenElse(up, hn::Add(s0, hn::Mul(hn::Set(df, L.specular.x), pw)), s0);
+    s1 = hn::IfThenElse(up, hn::Add(s1, hn::Mul(hn::Set(df, L.specular.y), pw)), s1);
+    s2 = hn::IfThenElse(up, hn::Add(s2, hn::Mul(hn::Set(df, L.specular.z), pw)), s2);
   }
   const vec3f a = f.lightAmbient;
-  const VF kd = hn::Set(df, f.diffuse);
-  r = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.x), hn::Mul(hn::Mul(kd, d0), r)), zero), zero, one);
-  g = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.y), hn::Mul(hn::Mul(kd, d1), g)), zero), zero, one);
-  b = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.z), hn::Mul(hn::Mul(kd, d2), b)), zero), zero, one);
+  const VF kd = hn::Set(df, f.diffuse), ks = hn::Set(df, f.specular);
+  r = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.x), hn::Mul(hn::Mul(kd, d0), r)), specular ? hn::Mul(ks, s0) : zero),
+            zero, one);
+  g = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.y), hn::Mul(hn::Mul(kd, d1), g)), specular ? hn::Mul(ks, s1) : zero),
+            zero, one);
+  b = Clamp(hn::Add(hn::Add(hn::Set(df, f.ambient * a.z), hn::Mul(hn::Mul(kd, d2), b)), specular ? hn::Mul(ks, s2) : zero),
+            zero, one);
 }
 
 /// lookup() of samples v and IntervalMarcher::composite into (ax, ay, az, aw) for the live
@@ -515,7 +590,11 @@ HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox
   const VF vdx = hn::Load(df, P.dx), vdy = hn::Load(df, P.dy), vdz = hn::Load(df, P.dz);
   const VF vt0 = hn::Load(df, P.t0);
   LaneShading<T> S{vox, nx, ny, nz, hn::Zero(df), hn::Zero(df), hn::Zero(df),
-                   hn::Load(df, P.lx), hn::Load(df, P.ly), hn::Load(df, P.lz)};
+                   hn::Load(df, P.lx), hn::Load(df, P.ly), hn::Load(df, P.lz),
+                   hn::Load(df, P.vx), hn::Load(df, P.vy), hn::Load(df, P.vz),
+                   vox_, voy, voz, vdx, vdy, vdz,
+                   hn::Load(df, P.wox), hn::Load(df, P.woy), hn::Load(df, P.woz),
+                   hn::Load(df, P.wdx), hn::Load(df, P.wdy), hn::Load(df, P.wdz)};
   const LaneShading<T>* shade = f.shade ? &S : nullptr;
   VI k = hn::Load(di, P.kc), kEnd = hn::Load(di, P.ke);
   VF ax = hn::Zero(df), ay = hn::Zero(df), az = hn::Zero(df), aw = hn::Zero(df);

@@ -4,8 +4,8 @@
 // are compared frame against frame: every voxel type, parallel and perspective views, jitter,
 // the first sample one step in (as the VTK mapper asks), early ray termination, NaN and Inf
 // voxels, a frame whose edges are not multiples of a packet and a camera inside the volume;
-// and every skipping structure, each lane walking its own ray's runs; shaded frames (ParaView's
-// defaults: no specular reflection, the headlight or the light kit's directional lights) too.
+// and every skipping structure, each lane walking its own ray's runs; shaded frames (the
+// headlight or directional lights, with and without specular reflection) too.
 #include "TestUtil.h"
 
 #include "src/CpuMarch.h"
@@ -155,7 +155,7 @@ TEST(CpuMarch, EverySkippingStructureWalksTheSameRunsAsTheScalarIntegrator) {
   }
 }
 
-TEST(CpuMarch, PacketsTakeShadedFramesWithoutSpecularAndDirectionalLights) {
+TEST(CpuMarch, PacketsTakeShadedFramesWithDirectionalLights) {
   if (std::strcmp(packetTarget(), "none") == 0) GTEST_SKIP() << "built without Highway: no packets";
   FrameView f{};
   f.blend = BlendMode::Composite;
@@ -171,15 +171,17 @@ TEST(CpuMarch, PacketsTakeShadedFramesWithoutSpecularAndDirectionalLights) {
   EXPECT_FALSE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "a positional light: the scalar integrator";
   f.lights[1].positional = 0;
   f.specular = 0.2f;
-  EXPECT_FALSE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "specular reflection: the scalar integrator";
-  f.specular = 0.f;
+  EXPECT_TRUE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "directional lights, Specular 0.2";
+  f.useLights = 0;
+  EXPECT_TRUE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "headlight, Specular 0.2";
   f.scatter.on = 1;
   EXPECT_FALSE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "scattering: the scalar integrator";
 }
 
 TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
   // The headlight (parallel and perspective views, a set light direction) and a light kit of
-  // directional lights (one-sided and two-sided), on an anisotropic grid (the gradient goes to
+  // directional lights (one-sided and two-sided), without and with specular reflection (VTK's
+  // default 0.2, power 10; ParaView's 0), on an anisotropic grid (the gradient goes to
   // world space through the inverse transpose), every voxel type, skipping structures, jitter,
   // early ray termination and NaN/Inf voxels.
   Volume base = generateVolume("noise", vec3l{33, 27, 30});
@@ -188,6 +190,7 @@ TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
   std::vector<Light> kit(3);
   kit[0].position[0] = 1, kit[0].position[1] = 2, kit[0].position[2] = 3;
   kit[0].diffuse[0] = 0.9, kit[0].diffuse[1] = 0.8, kit[0].diffuse[2] = 0.7;
+  kit[0].specular[0] = 0.6, kit[0].specular[1] = 0.7, kit[0].specular[2] = 0.8;
   kit[0].ambient[0] = kit[0].ambient[1] = kit[0].ambient[2] = 0.1;
   kit[1].position[0] = -2, kit[1].position[1] = 0.5, kit[1].position[2] = -1;
   kit[1].diffuse[0] = 0.3, kit[1].diffuse[1] = 0.35, kit[1].diffuse[2] = 0.4;
@@ -216,7 +219,10 @@ TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
           rp.shade = true;
           rp.ambient = 0.15;
           rp.diffuse = 0.8;
-          rp.specular = 0.0;  // ParaView's default
+          // Every other builder with specular reflection (VTK's default 0.2, power 10, or more),
+          // the others without (ParaView's default 0).
+          rp.specular = (variant / 4) % 2 ? 0.0 : 0.2 + 0.1 * (variant % 3);
+          rp.specularPower = (variant / 8) % 2 ? 37.5 : 10.0;
           rp.jitter = variant % 3 == 0;
           rp.jitterSeed = 11;
           rp.firstSampleOffset = variant % 2 ? 1.0 : 0.0;
@@ -229,7 +235,8 @@ TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
           }
           const bool persp = lights != 1;
           const std::string what = std::string("type ") + std::to_string(int(t)) + " tf " + preset + " " +
-                                   builderName(b) + " lights " + std::to_string(lights);
+                                   builderName(b) + " lights " + std::to_string(lights) + " specular " +
+                                   std::to_string(rp.specular);
           const BuildParams bp = test::builder(b, LeafCriterion::Deep, 0, 4, 8);
           const double az = 25.0 + 17.0 * (variant % 7), el = 30.0 - 9.0 * (variant % 5);
           const Image a = render(v, tf, rp, false, az, el, persp, 45, 38, 1.0, bp);
