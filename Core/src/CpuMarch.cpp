@@ -292,6 +292,18 @@ struct PacketLanes {
   HWY_ALIGN int32_t kc[kMaxLanes], ke[kMaxLanes];
   int64_t outAt[kMaxLanes];
   march_detail::LaneRuns<Iter> runs[kMaxLanes];
+
+  /// Lane l's ray, anchor and shading vectors from its set-up.
+  void put(size_t l, const march_detail::LaneSetup& s) {
+    auto put3 = [l](float* x, float* y, float* z, vec3f v) { x[l] = v.x, y[l] = v.y, z[l] = v.z; };
+    put3(ox, oy, oz, s.r.org);
+    put3(dx, dy, dz, s.r.dir);
+    put3(lx, ly, lz, s.light);
+    put3(vx, vy, vz, s.view);
+    put3(wox, woy, woz, s.orgW);
+    put3(wdx, wdy, wdz, s.dirW);
+    t0[l] = s.t0;
+  }
 };
 
 /// Sets up the packet of pixels from (bx, by) (bw wide, clipped to x1, y1), lane by lane. Empty
@@ -305,9 +317,8 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
   for (size_t l = 0; l < N; ++l) {
     const int x = bx + int(l) % bw, y = by + int(l) / bw;
     P.kc[l] = P.ke[l] = 0;
-    P.ox[l] = P.oy[l] = P.oz[l] = P.dx[l] = P.dy[l] = P.dz[l] = P.t0[l] = 0.f;
-    P.lx[l] = P.ly[l] = P.lz[l] = P.vx[l] = P.vy[l] = P.vz[l] = 0.f;
-    P.wox[l] = P.woy[l] = P.woz[l] = P.wdx[l] = P.wdy[l] = P.wdz[l] = 0.f;
+    const LaneSetup none{};
+    P.put(l, none);
     P.outAt[l] = -1;
     if (x >= x1 || y >= y1) continue;
     const int64_t at = int64_t(y) * f.width + x;
@@ -321,25 +332,7 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
       continue;
     }
     P.outAt[l] = at;
-    P.ox[l] = s.r.org.x;
-    P.oy[l] = s.r.org.y;
-    P.oz[l] = s.r.org.z;
-    P.dx[l] = s.r.dir.x;
-    P.dy[l] = s.r.dir.y;
-    P.dz[l] = s.r.dir.z;
-    P.t0[l] = s.t0;
-    P.lx[l] = s.light.x;
-    P.ly[l] = s.light.y;
-    P.lz[l] = s.light.z;
-    P.vx[l] = s.view.x;
-    P.vy[l] = s.view.y;
-    P.vz[l] = s.view.z;
-    P.wox[l] = s.orgW.x;
-    P.woy[l] = s.orgW.y;
-    P.woz[l] = s.orgW.z;
-    P.wdx[l] = s.dirW.x;
-    P.wdy[l] = s.dirW.y;
-    P.wdz[l] = s.dirW.z;
+    P.put(l, s);
     P.runs[l] = march_detail::LaneRuns<Iter>{};
     P.runs[l].wa = s.a;
     P.runs[l].wb = s.b;
