@@ -14,38 +14,56 @@
 namespace spaceskip {
 namespace march_detail {
 
+/// The most drawn parts of one ray: the cropping planes cut it into at most seven pieces.
+constexpr int kMaxParts = 7;
+
 /// One ray's share of a packet, set up as renderPixel sets it up: the ray (index space), the
-/// lattice anchor t0, the drawn part [a, b) of the ray and, in shaded frames, the light and
-/// view directions of the headlight model (rayLighting) and the ray in world space (the light
-/// list's view vector, IntervalMarcher::worldAt).
+/// lattice anchor t0, the drawn parts of the ray (the box cut by the clipping planes, then by
+/// the cropping regions: renderPixel's calls of its march, front to back) and, in shaded
+/// frames, the light and view directions of the headlight model (rayLighting) and the ray in
+/// world space (the light list's view vector, IntervalMarcher::worldAt).
 struct LaneSetup {
   enum Kind { Empty, Packet, Scalar } kind;
   Ray r;
   vec3f inv;
-  float t0, a, b;
+  float t0;
+  int numParts;
+  float part[2 * kMaxParts];  ///< [a, b) of each drawn part
   vec3f light, view, orgW, dirW;
 };
 
-/// renderPixel up to its march. Scalar: a pixel the packet leaves to
-/// renderPixel (its first sample lies past the box's exit, or sample indices too large for
-/// exact float lanes).
+/// renderPixel up to its march. Empty: nothing drawn (renderPixel returns 0). Scalar: a pixel
+/// the packet leaves to renderPixel (its first sample lies past the box's exit, or sample
+/// indices too large for exact float lanes).
 inline LaneSetup setupLane(const FrameView& f, int px, int py) {
   LaneSetup s{};
   const PrimaryRay p = primaryRay(f, px, py);
-  if (!(p.tEnter < p.tExit)) {
-    s.kind = LaneSetup::Empty;
-    return s;
-  }
-  const float lead =
+  s.kind = LaneSetup::Empty;
+  if (!(p.tEnter < p.tExit)) return s;
+  float lead =
       f.firstSample * f.dt + (f.jitter ? f.dt * float(hashPixel(px, py, f.jitterSeed) >> 8) * (1.f / 16777216.f) : 0.f);
-  const float a = p.tEnter, b = p.tExit;
-  if (f.firstSample > 0.f && !(a + lead < b)) {
-    s.kind = LaneSetup::Scalar;
-    return s;
+  float a = p.tEnter, b = p.tExit;
+  if (f.cut.numClipPlanes != 0 && !clipToPlanes(f.cut, p.r, a, b)) return s;
+  if (f.cut.cropping) {
+    lead -= f.firstSample * f.dt;  // cropped rays start on the first drawn region's face
+    forEachCroppedInterval(f.cut, p.r, a, b, [&](float x, float y) {
+      s.part[2 * s.numParts] = x;
+      s.part[2 * s.numParts + 1] = y;
+      return ++s.numParts < kMaxParts;
+    });
+    if (s.numParts == 0) return s;
+  } else {
+    if (f.firstSample > 0.f && !(a + lead < b)) {
+      s.kind = LaneSetup::Scalar;
+      return s;
+    }
+    s.part[0] = a;
+    s.part[1] = b;
+    s.numParts = 1;
   }
-  const float t0 = a + lead;
-  // Every run of the ray lies in [a, b): its sample indices are at most this one's.
-  const int64_t kEnd = sampleIndexCeil((b - t0) / f.dt);
+  const float t0 = s.part[0] + lead;  // anchored where the first drawn part starts
+  // Every run of the ray lies in its drawn parts: its sample indices are at most this one's.
+  const int64_t kEnd = sampleIndexCeil((s.part[2 * s.numParts - 1] - t0) / f.dt);
   constexpr int64_t kExact = int64_t(1) << 24;  // float(k) exact in a float lane
   if (kEnd > kExact) {
     s.kind = LaneSetup::Scalar;
@@ -55,8 +73,6 @@ inline LaneSetup setupLane(const FrameView& f, int px, int py) {
   s.r = p.r;
   s.inv = p.inv;
   s.t0 = t0;
-  s.a = a;
-  s.b = b;
   if (f.shade) {
     rayLighting(f, p, s.light, s.view);
     s.orgW = p.nearW;
@@ -140,30 +156,67 @@ struct LaneRuns {
 };
 
 /// The traversal iterator of frame `f` over [a, b) of ray r, as renderPixel's march starts it.
-inline void initIter(WholeIter& it, const FrameView&, const LaneSetup& s) { it = WholeIter{s.a, s.b, false}; }
-inline void initIter(GridIter& it, const FrameView& f, const LaneSetup& s) { it.init(f.grid, s.r, s.inv, s.a, s.b); }
-inline void initIter(GridPartsIter& it, const FrameView& f, const LaneSetup& s) {
-  it.init(f.grid, s.r, s.inv, s.a, s.b);
+inline void initIter(WholeIter& it, const FrameView&, const Ray&, vec3f, float a, float b) { it = WholeIter{a, b, false}; }
+inline void initIter(GridIter& it, const FrameView& f, const Ray& r, vec3f inv, float a, float b) {
+  it.init(f.grid, r, inv, a, b);
 }
-inline void initIter(TreeIter& it, const FrameView& f, const LaneSetup& s) { it.init(f.tree, s.r, s.inv, s.a, s.b); }
-inline void initIter(HybridIter& it, const FrameView& f, const LaneSetup& s) {
-  it.init(f.tree, f.grid, s.r, s.inv, s.a, s.b);
+inline void initIter(GridPartsIter& it, const FrameView& f, const Ray& r, vec3f inv, float a, float b) {
+  it.init(f.grid, r, inv, a, b);
 }
+inline void initIter(TreeIter& it, const FrameView& f, const Ray& r, vec3f inv, float a, float b) {
+  it.init(f.tree, r, inv, a, b);
+}
+inline void initIter(HybridIter& it, const FrameView& f, const Ray& r, vec3f inv, float a, float b) {
+  it.init(f.tree, f.grid, r, inv, a, b);
+}
+
+/// A lane's walk over its drawn parts: the runs of each part (LaneRuns), a fresh traversal per
+/// part as renderPixel's march starts one, the samples taken so far kept (nextK).
+template <class Iter>
+struct LaneParts {
+  LaneSetup s;
+  int part = 0;
+  LaneRuns<Iter> runs;
+
+  void start(const FrameView& f, const LaneSetup& setup) {
+    s = setup;
+    part = -1;
+    runs = LaneRuns<Iter>{};
+    nextPart(f);
+  }
+  void nextPart(const FrameView& f) {
+    ++part;
+    const int64_t taken = runs.nextK;
+    runs = LaneRuns<Iter>{};
+    runs.nextK = taken;
+    runs.wa = s.part[2 * part];
+    runs.wb = s.part[2 * part + 1];
+    initIter(runs.it, f, s.r, s.inv, runs.wa, runs.wb);
+  }
+  /// The next run with samples, k in [kBegin, kEnd); false: the ray has none left.
+  bool next(const FrameView& f, int64_t& kBegin, int64_t& kEnd) {
+    for (;;) {
+      if (runs.next(s.t0, f.dt, kBegin, kEnd)) return true;
+      if (part + 1 >= s.numParts) return false;
+      nextPart(f);
+    }
+  }
+};
 
 template <class T>
 vec4f scalarPixel(const FrameView& f, const T* v, int64_t nx, int64_t ny, int64_t nz, int px, int py) {
   const ArraySampler<T> s{v, nx, ny, nz};
-  return f.shade ? renderPixel<ArraySampler<T>, -1, false>(f, s, px, py)
-                 : renderPixel<ArraySampler<T>, -1, true>(f, s, px, py);
+  return isPlainFrame(f) ? renderPixel<ArraySampler<T>, -1, true>(f, s, px, py)
+                         : renderPixel<ArraySampler<T>, -1, false>(f, s, px, py);
 }
 
-/// Shaded composite frames the packets take: the gradient (Phong) shading with the headlight
-/// model or directional lights (ParaView's light kit); no positional lights, scattering,
-/// clipping, cropping, 2-D transfer function or gradient opacity.
-inline bool shadedPacketFrame(const FrameView& f) {
-  if (!(f.blend == BlendMode::Composite && f.shade && f.cut.numClipPlanes == 0 && !f.cut.cropping &&
-        f.gtf.mode == 0 && !f.scatter.on))
-    return false;
+/// Composite frames the packets take, with or without clipping planes and cropping: unshaded,
+/// or shaded with the headlight model or directional lights (ParaView's light kit); no
+/// positional lights, scattering, 2-D transfer function or gradient opacity.
+inline bool packetFrame(const FrameView& f) {
+  if (!(f.blend == BlendMode::Composite && f.gtf.mode == 0)) return false;
+  if (!f.shade) return true;
+  if (f.scatter.on) return false;
   if (f.useLights)
     for (int i = 0; i < f.numLights; ++i)
       if (f.lights[i].positional) return false;
@@ -291,7 +344,7 @@ struct PacketLanes {
       wox[kMaxLanes], woy[kMaxLanes], woz[kMaxLanes], wdx[kMaxLanes], wdy[kMaxLanes], wdz[kMaxLanes];
   HWY_ALIGN int32_t kc[kMaxLanes], ke[kMaxLanes];
   int64_t outAt[kMaxLanes];
-  march_detail::LaneRuns<Iter> runs[kMaxLanes];
+  march_detail::LaneParts<Iter> runs[kMaxLanes];
 
   /// Lane l's ray, anchor and shading vectors from its set-up.
   void put(size_t l, const march_detail::LaneSetup& s) {
@@ -333,12 +386,9 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
     }
     P.outAt[l] = at;
     P.put(l, s);
-    P.runs[l] = march_detail::LaneRuns<Iter>{};
-    P.runs[l].wa = s.a;
-    P.runs[l].wb = s.b;
-    march_detail::initIter(P.runs[l].it, f, s);
+    P.runs[l].start(f, s);
     int64_t kb = 0, kEnd = 0;
-    if (P.runs[l].next(s.t0, f.dt, kb, kEnd)) {
+    if (P.runs[l].next(f, kb, kEnd)) {
       P.kc[l] = int32_t(kb);
       P.ke[l] = int32_t(kEnd);
     }
@@ -361,7 +411,7 @@ HWY_INLINE void NextRuns(const FrameView& f, PacketLanes<Iter>& P, VI& k, VI& kE
   for (size_t l = 0; l < N; ++l) {
     if (stop[l] || P.kc[l] < P.ke[l]) continue;
     int64_t kb = 0, kx = 0;
-    if (P.runs[l].next(P.t0[l], f.dt, kb, kx)) {
+    if (P.runs[l].next(f, kb, kx)) {
       P.kc[l] = int32_t(kb);
       P.ke[l] = int32_t(kx);
     } else {
@@ -677,7 +727,7 @@ HWY_EXPORT(TargetName);
 
 bool packetMarchable(const FrameView& f, VoxelType type, int components, int64_t nx, int64_t ny, int64_t nz) {
 #ifdef SPACESKIP_HAVE_HWY
-  if (!(isPlainFrame(f) || march_detail::shadedPacketFrame(f)) || f.lattice.active || f.alphaIn || f.sampleCount || f.grid.vmin) return false;
+  if (!march_detail::packetFrame(f) || f.lattice.active || f.alphaIn || f.sampleCount || f.grid.vmin) return false;
   if (f.sampling != 0) return false;  // nearest and label sampling (render/LabelSampler.h)
   if (components != 1 || type == VoxelType::Float64) return false;
   // 32-bit gathers: float32 by index, the others by byte offset (voxel index * size + 1).

@@ -14,10 +14,10 @@
 
 namespace spaceskip {
 
-/// Whether marchPacketTile renders frame `f` over a volume of this type and shape: plain
-/// composite frames (isPlainFrame) and shaded composite ones without specular reflection and
-/// with directional lights only (ParaView's defaults: Specular 0, the light kit or the
-/// headlight) and without scattering, clipping, cropping or 2-D functions, with any traversal (each lane walks its own ray's runs with
+/// Whether marchPacketTile renders frame `f` over a volume of this type and shape: composite
+/// frames, with or without clipping planes and cropping, unshaded or shaded with the headlight
+/// or directional lights (ParaView's light kit), without positional lights, scattering or 2-D
+/// functions, with any traversal (each lane walks its own ray's runs with
 /// the shared iterators, Traversal.h, as IntervalMarcher::marchRuns does), serial (no piece),
 /// no incoming opacity, no sample counts; one component of 8- or 16-bit integers or float32,
 /// every axis at least 2 voxels, fewer than 2^31 voxel bytes (32-bit gather offsets). Else the
