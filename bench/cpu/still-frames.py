@@ -1,0 +1,60 @@
+"""Still frames of a dense Wavelet in ParaView (pvpython), Space Skipping Volume on the CPU backend
+and, with --stock, ParaView's own Volume in the same process: shading with ParaView's light kit
+(--shade, --specular), ParaView's Use Cropping (--crop). Each frame follows a 2-degree turn of
+the camera; the times are Render(view), waited for. To compare two builds of the plugin, run it
+once per build (SPACESKIP_PLUGIN) in separate processes, alternated.
+
+Usage (from the repository root, an X server on DISPLAY):
+  PYTHONPATH=Testing/Plugin SPACESKIP_PLUGIN=build-cpu/lib/paraview-5.11/plugins/SpaceSkip/SpaceSkip.so \
+  SPACESKIP_TEMP=/tmp/ss pvpython bench/cpu/still-frames.py [--size 256] [--frames 3] [--shade] \
+  [--specular 0.2] [--crop] [--stock]
+"""
+import argparse
+import statistics
+import time
+
+from paraview.simple import *
+import ssptest
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--size", type=int, default=256)
+parser.add_argument("--view", type=int, nargs=2, default=[800, 600])
+parser.add_argument("--frames", type=int, default=3)
+parser.add_argument("--shade", action="store_true", help="Shade on (ParaView's light kit)")
+parser.add_argument("--specular", type=float, default=0.0, help="Specular (ParaView's default 0)")
+parser.add_argument("--crop", action="store_true",
+                    help="Use Cropping: origin at 0.3 of x, scale 0.5 x 0.8 x 0.9 of the bounds")
+parser.add_argument("--stock", action="store_true", help="ParaView's own Volume too, after ours")
+args = parser.parse_args()
+N = args.size
+
+ssptest.load_plugin()
+source = Wavelet(WholeExtent=[-(N // 2), N - N // 2 - 1] * 3)
+view = CreateView("RenderView")
+view.ViewSize = args.view
+view.OrientationAxesVisibility = 0
+disp = Show(source, view)
+ColorBy(disp, ("POINTS", "RTData"))
+b = source.GetDataInformation().GetBounds()
+what = "Wavelet %d^3%s%s%s, view %dx%d" % (N, ", shaded" if args.shade else "",
+                                         ", specular %g" % args.specular if args.specular else "",
+                                         ", cropped" if args.crop else "", args.view[0], args.view[1])
+for rep in ["Space Skipping Volume"] + (["Volume"] if args.stock else []):
+    disp.SetRepresentationType(rep)
+    if rep != "Volume":
+        disp.Backend = "CPU"
+    disp.Shade = 1 if args.shade else 0
+    disp.Specular = args.specular
+    if args.crop:
+        disp.UseCropping = 1
+        disp.CroppingOrigin = [b[0] + 0.3 * (b[1] - b[0]), b[2], b[4]]
+        disp.CroppingScale = [0.5, 0.8, 0.9]
+    view.ResetCamera()
+    Render(view)
+    times = []
+    for i in range(args.frames):
+        GetActiveCamera().Azimuth(2.0)
+        t0 = time.perf_counter()
+        Render(view)
+        times.append(time.perf_counter() - t0)
+    print("%s, %s: median %.3f s (%s)" % (what, rep, statistics.median(times), " ".join("%.3f" % t for t in times)))
