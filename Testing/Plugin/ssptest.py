@@ -167,6 +167,19 @@ def make_scene(builder="KdTreeCPU", backend="CPU", size=IMAGE_SIZE, view=None):
     return reader, view, disp
 
 
+def dense_wavelet_scene(n, view_size):
+    """The benchmarks' dense volume: ParaView's Wavelet of n^3 points in a new render view of
+    view_size (no orientation axes), shown and coloured by RTData. Returns (source, view, disp)."""
+    from paraview.simple import Wavelet, CreateView, Show, ColorBy
+    source = Wavelet(WholeExtent=[-(n // 2), n - n // 2 - 1] * 3)
+    view = CreateView("RenderView")
+    view.ViewSize = view_size
+    view.OrientationAxesVisibility = 0
+    disp = Show(source, view)
+    ColorBy(disp, ("POINTS", "RTData"))
+    return source, view, disp
+
+
 def mapper_of(disp):
     """The vtkSpaceSkipVolumeRepresentation behind a display proxy (builtin session only)."""
     rep = disp.GetClientSideObject().GetActiveRepresentation()

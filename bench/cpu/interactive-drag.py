@@ -31,12 +31,7 @@ args = parser.parse_args()
 N = args.size
 
 ssptest.load_plugin()
-source = Wavelet(WholeExtent=[-(N // 2), N - N // 2 - 1] * 3)
-view = CreateView("RenderView")
-view.ViewSize = args.view
-view.OrientationAxesVisibility = 0
-disp = Show(source, view)
-ColorBy(disp, ("POINTS", "RTData"))
+source, view, disp = ssptest.dense_wavelet_scene(N, args.view)
 disp.SetRepresentationType("Space Skipping Volume")
 disp.Backend = "CPU"
 disp.Shade = 1 if args.shade else 0

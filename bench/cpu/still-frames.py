@@ -29,12 +29,7 @@ args = parser.parse_args()
 N = args.size
 
 ssptest.load_plugin()
-source = Wavelet(WholeExtent=[-(N // 2), N - N // 2 - 1] * 3)
-view = CreateView("RenderView")
-view.ViewSize = args.view
-view.OrientationAxesVisibility = 0
-disp = Show(source, view)
-ColorBy(disp, ("POINTS", "RTData"))
+source, view, disp = ssptest.dense_wavelet_scene(N, args.view)
 b = source.GetDataInformation().GetBounds()
 what = "Wavelet %d^3%s%s%s, view %dx%d" % (N, ", shaded" if args.shade else "",
                                          ", specular %g" % args.specular if args.specular else "",
