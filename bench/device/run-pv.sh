@@ -16,6 +16,7 @@
 #                volume (PVB_SHAPE nbody, PVB_N 2048: spaceskip generate, kept in PVB_DIR, default
 #                /tmp/pvb), PVB_FRAMES 60 at 1024^2, each N-rank first frame against the 1-rank one;
 #                PVB_STOCK=1: ParaView's Volume too (PVB_BACKEND CUDA, PVB_VIEW 1024)
+#                PVB_SMP: VTK's SMP backend for ParaView's own passes (default STDThread)
 #   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
 #                --raw; TS_WORKDIR keeps the written steps for a later run; TS_ARGS more options,
 #                e.g. "--cache 4000" for ParaView's animation cache)
@@ -133,6 +134,11 @@ if has bench-stock; then
   done
 fi
 if has bench-pvbatch; then
+  # ParaView's data information (the array's range, for every representation alike) runs through
+  # VTK's SMP tools, sequential unless told otherwise: at 512^3 it took 7.0 s against 0.78 s with
+  # STDThread, and a whole 1-rank pvbatch run at 2048^3 took 424 s without it (2026-11-29).
+  # PVB_SMP (default STDThread) sets VTK_SMP_BACKEND_IN_USE for the pvbatch runs.
+  export VTK_SMP_BACKEND_IN_USE=${PVB_SMP:-STDThread}
   n=${PVB_N:-2048}
   shape=${PVB_SHAPE:-nbody}
   mkdir -p "${PVB_DIR:-/tmp/pvb}"
