@@ -492,7 +492,7 @@ HWY_INLINE VF PowLanes(VF x, float power) {
   return hn::Load(df, a);
 }
 
-/// IntervalMarcher::shadeColor of colours (r, g, b) for the frames shadedPacketFrame accepts:
+/// IntervalMarcher::shadeColor of colours (r, g, b) for the shaded frames packetFrame accepts:
 /// the central differences one voxel apart, then shadeGradient with the headlight model or
 /// shadeLights over the directional lights, clamped to [0, 1]; each lane with the scalar
 /// integrator's float operations in its order.
@@ -515,7 +515,7 @@ HWY_INLINE void ShadeLanes(const FrameView& f, const LaneShading<T>& S, VF& r, V
     return hn::Add(hn::Add(hn::Mul(hn::Set(df, a), gx), hn::Mul(hn::Set(df, b2), gy)), hn::Mul(hn::Set(df, c), gz));
   };
   VF n0 = row(M[0], M[4], M[8]), n1 = row(M[1], M[5], M[9]), n2 = row(M[2], M[6], M[10]);
-  const VF len = hn::Sqrt(hn::Add(hn::Add(hn::Mul(n0, n0), hn::Mul(n1, n1)), hn::Mul(n2, n2)));
+  const VF len = hn::Sqrt(Dot(n0, n1, n2, n0, n1, n2));
   const MF pos = hn::Gt(len, zero);
   const VF inv = hn::Div(one, len);
   n0 = hn::IfThenElseZero(pos, hn::Mul(n0, inv));
