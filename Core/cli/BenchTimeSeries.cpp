@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -20,7 +22,10 @@ namespace spaceskip::cli {
 namespace {
 
 struct Playback {
-  std::vector<double> step, update, frame;  // ms per played step: all, setVolume + update, render
+  // ms per played step: all; setVolume + prefetchVolume (with prefetch: the wait for this step's
+  // upload and its value ranges); update (without prefetch: upload, ranges, classification, build;
+  // with it: classification, build); render (the frame, waited for).
+  std::vector<double> step, set, update, frame;
   double seconds = 0;
   std::string builder;
   int builds = 0, measurings = 0;
@@ -44,12 +49,14 @@ Playback play(Engine& e, const std::vector<Volume>& steps, int played, const dou
     // The next step's upload on the copy stream while this one is classified, built and drawn
     // (Engine::prefetchVolume uploads this one first, or swaps it in when it was prefetched).
     if (prefetch) p.prefetched += e.prefetchVolume(steps[size_t(i + 1) % steps.size()]) ? 1 : 0;
+    const auto s = Clock::now();
     e.update();
     const auto b = Clock::now();
     e.render(cam, w, h, img);
     (void)e.frameStats(true);
     const auto c = Clock::now();
-    p.update.push_back(1e3 * std::chrono::duration<double>(b - a).count());
+    p.set.push_back(1e3 * std::chrono::duration<double>(s - a).count());
+    p.update.push_back(1e3 * std::chrono::duration<double>(b - s).count());
     p.frame.push_back(1e3 * std::chrono::duration<double>(c - b).count());
     p.step.push_back(1e3 * std::chrono::duration<double>(c - a).count());
   }
@@ -61,10 +68,10 @@ Playback play(Engine& e, const std::vector<Volume>& steps, int played, const dou
 }
 
 void printPlayback(const char* what, const Playback& p, int played, double boundMs) {
-  std::printf("%s: %d steps in %.3f s: %.2f steps/s; a step median %.3f ms, max %.3f ms (update: upload, ranges, "
-              "classification, build %.3f ms; frame %.3f ms); %.2fx the upload bound; drew with %s, %d builds%s\n",
-              what, played, p.seconds, played / p.seconds, median(p.step), maxOf(p.step), median(p.update),
-              median(p.frame), boundMs > 0 ? median(p.step) / boundMs : 0.0, p.builder.c_str(), p.builds,
+  std::printf("%s: %d steps in %.3f s: %.2f steps/s; a step median %.3f ms, max %.3f ms (medians: set + prefetch "
+              "%.3f ms, update %.3f ms, frame %.3f ms); %.2fx the upload bound; drew with %s, %d builds%s\n",
+              what, played, p.seconds, played / p.seconds, median(p.step), maxOf(p.step), median(p.set),
+              median(p.update), median(p.frame), boundMs > 0 ? median(p.step) / boundMs : 0.0, p.builder.c_str(), p.builds,
               p.measurings ? (", " + std::to_string(p.measurings) + " Auto measurings").c_str() : "");
 }
 
@@ -87,17 +94,35 @@ int cmdBenchTimeSeries(const Options& o) {
   int w = 1024, h = 1024;
   imageSize(o, w, h);
 
+  // --step-memory pinned: the steps in the engine's step memory (page-locked on CUDA), as a
+  // reader that reads each step into Engine::allocateStepMemory hands them over; pageable
+  // (default): plain host memory, as most readers' arrays.
+  const std::string memoryName = o.get("--step-memory", "pageable");
+  if (memoryName != "pageable" && memoryName != "pinned")
+    throw std::invalid_argument("--step-memory '" + memoryName + "' is not pageable or pinned");
+  Engine engine(backendKind(o));
+
   // The steps, held in host memory (the data of every step differs from the one before; a
   // playback longer than --steps-held cycles over them).
   const auto tg = Clock::now();
   std::vector<Volume> steps;
+  std::vector<std::shared_ptr<unsigned char>> stepMemory;
   const uint64_t stepBytes = checkedByteSize(dims, type, cap, "a time step");
-  for (int k = 0; k < held; ++k)
+  for (int k = 0; k < held; ++k) {
     steps.push_back(allocating("time step " + std::to_string(k), stepBytes,
                                [&] { return generateTimeStep(shape, dims, k, type); }));
-  std::printf("time series %s %s: %s, %.1f MiB a step, %d steps held (generated in %.2f s), %d played\n",
+    if (memoryName == "pinned") {
+      stepMemory.push_back(allocating("step memory " + std::to_string(k), stepBytes,
+                                      [&] { return engine.allocateStepMemory(size_t(stepBytes)); }));
+      Volume& v = steps.back();
+      std::memcpy(stepMemory.back().get(), v.data, size_t(stepBytes));
+      v.data = stepMemory.back().get();
+      v.storage.reset();
+    }
+  }
+  std::printf("time series %s %s: %s, %.1f MiB a step, %d steps held in %s memory (generated in %.2f s), %d played\n",
               o.positional[0].c_str(), typeName.c_str(), dimsText(dims).c_str(), stepBytes / 1048576.0, held,
-              since(tg), played);
+              memoryName == "pinned" ? "the engine's step (page-locked)" : "pageable", since(tg), played);
   double b6[6];
   steps[0].worldBounds(b6);
   const TransferFunction tf = makeTF(o, steps[0]);
@@ -112,7 +137,6 @@ int cmdBenchTimeSeries(const Options& o) {
     e.setBuildParams(p);
     e.setRenderParams(renderParams(o));
   };
-  Engine engine(backendKind(o));
   makeEngine(engine, bp);
   const UploadRates rates = engine.measureUpload(size_t(stepBytes));
   const double boundMs = rates.pinned > 0 ? 1e3 * double(stepBytes) / rates.pinned : 0;

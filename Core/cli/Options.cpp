@@ -31,7 +31,7 @@ const std::set<std::string>& valueOptions() {
       "--max-diff", "--frames", "--build-reps", "--json", "--csv", "--max-volume-bytes", "--blend", "--iso",
       "--shade", "--cuda-block", "--scale", "--datasets", "--time-limit", "--memory-budget",
       "--pool-brick", "--edit-tf", "--edits", "--edit-cut", "--max-image-bytes", "--label-map", "--hide-labels",
-      "--toggles", "--visible-every", "--time-series", "--steps-held", "--step-type", "--scatter", "--tf2d"};
+      "--toggles", "--visible-every", "--time-series", "--steps-held", "--step-type", "--step-memory", "--scatter", "--tf2d"};
   return s;
 }
 const std::set<std::string>& flagOptions() {

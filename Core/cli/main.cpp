@@ -54,14 +54,15 @@ const char* kUsage = R"(usage:
       label at a still view, each setLabelTable + its frame (median, max) against a plain frame,
       with the counters (no voxel pass); exit 4 when a toggle read the voxels
 
-  spaceskip bench gen:nbody:N|gen:rm:N --time-series STEPS [--steps-held K] [--step-type uint8|float32]
+  spaceskip bench gen:nbody:N|gen:rm:N --time-series STEPS [--steps-held K] [--step-type uint8|float32] [--step-memory pageable|pinned]
                   [--builder B] [--check] [options]
       time-series playback: K (default min(STEPS, 10)) generated steps of the advected N-body
       stand-in (or of the mixing layer rm, widening over its first 25 steps: hold 25 to see it
       grow) held in memory, STEPS played (cycling), each step's upload, ranges, classification,
       build and frame at an orbiting camera waited for; beside the upload bound (bytes over the
       measured pinned host-to-device rate), Naive and a fresh engine per step; --check compares
-      each held step played with its static render (exit 3 above 1/255)
+      each held step played with its static render (exit 3 above 1/255); --step-memory pinned
+      holds the steps in the engine's step memory (page-locked on CUDA: one DMA a step)
 
   spaceskip sparse VOLUME --memory-budget N[K|M|G] [--pool-brick N] [--builders b1,b2] [--edit-tf PRESET]
                    [--no-in-core] [--frames N] [options]

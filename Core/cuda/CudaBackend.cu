@@ -6,6 +6,7 @@
 #include "DevicePool.cuh"
 #include "DeviceVolume.cuh"
 #include "HostStaging.cuh"
+#include "spaceskip/StepMemory.h"
 #include "DistanceField.cuh"
 #include "KdTreeBuilder.cuh"
 #include "LbvhBuilder.cuh"
@@ -395,6 +396,14 @@ bool cudaAvailable(std::string* why) {
 }
 
 int64_t cudaDeviceBytesInUse() { return cuda::liveDeviceBytes().load(); }
+
+std::shared_ptr<unsigned char> allocatePageLocked(size_t bytes) {
+  void* p = nullptr;
+  if (bytes > 0 && cudaMallocHost(&p, bytes) == cudaSuccess)
+    return std::shared_ptr<unsigned char>(static_cast<unsigned char*>(p), [](unsigned char* q) { cudaFreeHost(q); });
+  (void)cudaGetLastError();
+  return nullptr;
+}
 
 std::unique_ptr<Backend> makeCudaBackend() {
   std::string why;

@@ -38,7 +38,7 @@ DeviceVolume::DeviceVolume() = default;
 DeviceVolume::~DeviceVolume() { destroyTexture(); }
 
 void HostStaging::copy(void* dst, const void* src, size_t bytes, cudaStream_t stream) {
-  if (bytes < 2 * kChunk) {  // small: the driver's own staging is as fast
+  if (bytes < 2 * kChunk || pageLocked(src)) {  // small (the driver's own staging is as fast), or one DMA
     SS_CUDA_CHECK(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, stream));
     return;
   }
@@ -61,6 +61,15 @@ void HostStaging::copy(void* dst, const void* src, size_t bytes, cudaStream_t st
     SS_CUDA_CHECK(cudaMemcpyAsync(static_cast<char*>(dst) + off, chunk_[b].get(), n, cudaMemcpyHostToDevice, stream));
     SS_CUDA_CHECK(cudaEventRecord(done_[b], stream));
   }
+}
+
+bool HostStaging::pageLocked(const void* src) {
+  cudaPointerAttributes a{};
+  if (cudaPointerGetAttributes(&a, src) != cudaSuccess) {
+    (void)cudaGetLastError();
+    return false;
+  }
+  return a.type == cudaMemoryTypeHost;  // cudaMallocHost or cudaHostRegister (Engine::allocateStepMemory)
 }
 
 HostStaging::~HostStaging() {

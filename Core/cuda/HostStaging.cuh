@@ -10,7 +10,8 @@ namespace spaceskip::cuda {
 /// of pageable memory (one thread) does not (measured on the H200 host: 5-9 GB/s pageable, 55 GB/s
 /// pinned; two 32 MiB chunks: 33 GB/s for 128 MiB, 47-52 GB/s for 0.5-4 GiB). Chunks of 8 MiB
 /// (four) were slower, 22-29 GB/s: each chunk's wait and the threads' wake-up cost about as much
-/// as its copy. Falls back to a plain cudaMemcpyAsync when no pinned memory can be had.
+/// as its copy. Falls back to a plain cudaMemcpyAsync when no pinned memory can be had. A source
+/// that is page-locked already (Engine::allocateStepMemory) goes in one cudaMemcpyAsync.
 class HostStaging {
  public:
   static constexpr size_t kChunk = size_t(32) << 20;
@@ -20,8 +21,11 @@ class HostStaging {
   HostStaging(const HostStaging&) = delete;
   HostStaging& operator=(const HostStaging&) = delete;
   /// Copies `bytes` from host `src` to device `dst` in `stream`'s order. Returns when the host
-  /// side is done (`src` may change then); the device side finishes in `stream`.
+  /// side is done; the device side finishes in `stream`. `src` may change on return where it
+  /// is pageable, and once `stream` has finished the copy where it is page-locked.
   void copy(void* dst, const void* src, size_t bytes, cudaStream_t stream);
+  /// Whether the driver knows `src` as page-locked host memory.
+  static bool pageLocked(const void* src);
 
  private:
   PinnedBuffer chunk_[kChunks];

@@ -138,6 +138,13 @@ class Engine {
   /// The host-to-device copy rates with buffers of `bytes` (Types.h UploadRates; zeros on the
   /// CPU backend): the bound a time step's upload can reach, beside the engine's own upload.
   UploadRates measureUpload(size_t bytes);
+  /// Host memory for `bytes` of voxels that this engine's backend uploads at the link's full
+  /// rate: page-locked on the CUDA backend (the upload is one DMA, no staging copy through the
+  /// host's cores), plain memory on the CPU backend or where none can be locked. A reader that
+  /// reads time steps into it and hands them over as Volume::data (kept alive while drawn)
+  /// spares each step the pageable staging (measureUpload's staged rate against its pinned one).
+  /// Throws std::bad_alloc when no memory can be had.
+  std::shared_ptr<unsigned char> allocateStepMemory(size_t bytes);
   const Counters& counters() const;
   /// Host copies for tests and statistics (downloaded from the device if needed).
   const OccupancyGrid& occupancy();

@@ -5,6 +5,7 @@
 #include "spaceskip/Builders.h"
 #include "spaceskip/DistanceField.h"
 #include "spaceskip/GradientBound.h"
+#include "spaceskip/StepMemory.h"
 #include "src/CpuMarch.h"
 
 #include <tbb/blocked_range2d.h>
@@ -291,6 +292,7 @@ bool cudaAvailable(std::string* why) {
   return false;
 }
 int64_t cudaDeviceBytesInUse() { return 0; }
+std::shared_ptr<unsigned char> allocatePageLocked(size_t) { return nullptr; }
 std::vector<uint8_t> computeDistanceFieldCuda(const OccupancyGrid&, int) {
   throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
 }

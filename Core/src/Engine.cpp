@@ -5,6 +5,7 @@
 #include "spaceskip/Backend.h"
 #include "spaceskip/Builders.h"
 #include "spaceskip/GradientBound.h"
+#include "spaceskip/StepMemory.h"
 
 #include <algorithm>
 #include <chrono>
@@ -573,6 +574,12 @@ bool sameShape(const Volume& a, const Volume& b) {
 }  // namespace
 
 UploadRates Engine::measureUpload(size_t bytes) { return impl_->backend->measureUpload(bytes); }
+std::shared_ptr<unsigned char> Engine::allocateStepMemory(size_t bytes) {
+  if (impl_->backend->kind() == BackendKind::CUDA)
+    if (std::shared_ptr<unsigned char> p = allocatePageLocked(bytes)) return p;
+  // The CPU reads voxels in place; on CUDA without page-locked memory the upload stages as before.
+  return std::shared_ptr<unsigned char>(new unsigned char[bytes > 0 ? bytes : 1], std::default_delete<unsigned char[]>());
+}
 
 bool Engine::prefetchVolume(const Volume& next) {
   Impl& d = *impl_;

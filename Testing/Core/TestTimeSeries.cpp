@@ -6,6 +6,8 @@
 
 #include "spaceskip/Builders.h"
 
+#include <cstring>
+
 using namespace spaceskip;
 
 namespace {
@@ -213,6 +215,35 @@ TEST(TimeSeries, CudaPrefetchedPlaybackEqualsStaticRenders) {
   e.render(test::orbit(a[0], 10, 20), 64, 64, ref);
   EXPECT_EQ(compareImages(img, ref).maxAbs, 0.f);
   EXPECT_EQ(e.counters().prefetchedSteps, 0);
+}
+/// `steps` copied into `e`'s step memory (Engine::allocateStepMemory), as a reader that reads
+/// each step there hands them over; `keep` holds the memory.
+std::vector<Volume> inStepMemory(Engine& e, const std::vector<Volume>& steps,
+                                 std::vector<std::shared_ptr<unsigned char>>& keep) {
+  std::vector<Volume> out = steps;
+  for (Volume& v : out) {
+    keep.push_back(e.allocateStepMemory(v.byteSize()));
+    std::memcpy(keep.back().get(), v.data, v.byteSize());
+    v.data = keep.back().get();
+    v.storage.reset();
+  }
+  return out;
+}
+TEST(TimeSeries, StepsInTheEnginesStepMemoryPlayAsOthers) {
+  // Page-locked on CUDA (one DMA a step, above the staging's two-chunk threshold and below it),
+  // plain memory on the CPU: every played frame equals its step's static render.
+  std::vector<std::shared_ptr<unsigned char>> keep;
+  Engine cpu(BackendKind::CPU);
+  expectPlaybackEqualsStatic(BackendKind::CPU, inStepMemory(cpu, nbodySteps(48, 3, VoxelType::UInt8), keep),
+                             test::builder(BuilderKind::Grid), 1.f / 255.f, true);
+  if (!cudaAvailable()) return;
+  Engine cuda(BackendKind::CUDA);
+  expectPlaybackEqualsStatic(BackendKind::CUDA, inStepMemory(cuda, nbodySteps(384, 2, VoxelType::UInt8), keep),
+                             test::builder(BuilderKind::Auto), 1.f / 255.f, true);
+  expectPlaybackEqualsStatic(BackendKind::CUDA, inStepMemory(cuda, nbodySteps(200, 3, VoxelType::Float32), keep),
+                             test::builder(BuilderKind::DistanceGrid), 1.f / 255.f, true);
+  expectPlaybackEqualsStatic(BackendKind::CUDA, inStepMemory(cuda, nbodySteps(48, 3, VoxelType::UInt8), keep),
+                             test::builder(BuilderKind::Grid), 1.f / 255.f, false);
 }
 TEST(TimeSeries, CudaUploadRatesAreMeasured) {
   SKIP_WITHOUT_CUDA();

@@ -49,15 +49,18 @@ if [ "$what" != bench ]; then
   tail -3 "$out/core-tests.log" >> "$out/env.txt"
 fi
 # TS_SPECS: "SHAPE N TYPE HELD" items (default the N-body at 512^3 and 1024^3; rm: the mixing
-# layer, widening over its first 25 steps).
+# layer, widening over its first 25 steps); TS_MEMORY: the steps' host memory per run (pageable,
+# pinned: the engine's page-locked step memory).
 if [ "$what" != tests ]; then
   specs=${TS_SPECS:-"nbody 512 uint8 10,nbody 512 float32 10,nbody 1024 uint8 8,nbody 1024 float32 4"}
   IFS=, read -ra items <<< "$specs"
   for spec in "${items[@]}"; do
     set -- $spec
-    cmd="bench gen:$1:$2 --time-series 100 --steps-held $4 --step-type $3 --backend cuda --size 1024x1024 --check"
-    echo "== spaceskip $cmd" >> "$out/bench.log"
-    timeout ${TS_TIMEOUT:-140} $B/spaceskip $cmd >> "$out/bench.log" 2>&1
-    echo "rc=$?" >> "$out/bench.log"
+    for mem in ${TS_MEMORY:-pageable}; do  # TS_MEMORY="pageable pinned": the steps' host memory
+      cmd="bench gen:$1:$2 --time-series 100 --steps-held $4 --step-type $3 --step-memory $mem --backend cuda --size 1024x1024 --check"
+      echo "== spaceskip $cmd" >> "$out/bench.log"
+      timeout ${TS_TIMEOUT:-140} $B/spaceskip $cmd >> "$out/bench.log" 2>&1
+      echo "rc=$?" >> "$out/bench.log"
+    done
   done
 fi
