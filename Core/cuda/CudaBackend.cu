@@ -41,8 +41,12 @@ class CudaBackend final : public Backend {
     cls_.haveOcc = false;
     pool_.release();
     const int64_t budget = budget_ > 0 ? budget_ : defaultBudget(v, brick);
+    const bool haveNext = haveNext_;
+    haveNext_ = false;
     if (int64_t(v.byteSize()) <= budget) {
       prefetchedLast_ = takePrefetched(v);
+      // The step after it (Engine::prefetchVolume) starts now, into the buffer just swapped out.
+      if (prefetchedLast_ && haveNext) (void)prefetchVolume(nextVolume_);
       if (!prefetchedLast_) vol_->upload(v, stream_);
       cls_.setVolume(*vol_, brick, stream_);
       SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
@@ -205,7 +209,9 @@ class CudaBackend final : public Backend {
   // a copy stream, from a host thread (the pinned staging's host copies would otherwise hold
   // the caller), while the current step is drawn; setVolume(next) swaps the two volumes.
   bool prefetchVolume(const Volume& next) override {
+    if (prefetchPending_ && prefetchData_ == next.data) return true;  // started by setVolume (setNextVolume)
     finishPrefetch();
+    prefetchPending_ = false;
     if (pool_.active() || !next.data || vol_->volume().byteSize() != next.byteSize()) return false;
     const int64_t bytes = int64_t(next.byteSize());
     if (!next_ || next_->volume().byteSize() != next.byteSize()) {
@@ -216,8 +222,23 @@ class CudaBackend final : public Backend {
     }
     if (!copyStream_) copyStream_ = std::make_unique<cuda::Stream>();
     if (!prefetchDone_) prefetchDone_ = std::make_unique<cuda::Event>();
+    if (!readersDone_) readersDone_ = std::make_unique<cuda::Event>();
+    // The copy overwrites the step drawn before: after the work queued on the render stream.
+    SS_CUDA_CHECK(cudaEventRecord(*readersDone_, stream_));
+    SS_CUDA_CHECK(cudaStreamWaitEvent(*copyStream_, *readersDone_, 0));
     prefetchOk_ = false;
     prefetchData_ = next.data;
+    prefetchPending_ = true;
+    if (cuda::HostStaging::pageLocked(next.data)) {  // one DMA, queued from here: no host copy to run
+      try {
+        next_->upload(next, *copyStream_);
+        SS_CUDA_CHECK(cudaEventRecord(*prefetchDone_, *copyStream_));
+        prefetchOk_ = true;
+      } catch (const std::exception&) {
+        (void)cudaGetLastError();  // setVolume uploads the step itself
+      }
+      return true;
+    }
     int device = 0;
     SS_CUDA_CHECK(cudaGetDevice(&device));
     prefetch_ = std::thread([this, next, device] {
@@ -233,6 +254,10 @@ class CudaBackend final : public Backend {
     return true;
   }
   bool lastVolumePrefetched() const override { return prefetchedLast_; }
+  void setNextVolume(const Volume* next) override {
+    haveNext_ = next != nullptr;
+    nextVolume_ = next ? *next : Volume{};
+  }
 
   bool setImageOnDevice(bool on) override { return exec_.setImageOnDevice(on); }
   const void* deviceImage() const override { return exec_.deviceImage(); }
@@ -319,6 +344,7 @@ class CudaBackend final : public Backend {
   /// volume drawn (the volume drawn before keeps its allocation for the next prefetch).
   bool takePrefetched(const Volume& v) {
     finishPrefetch();
+    prefetchPending_ = false;
     if (!prefetchOk_ || !next_ || v.data != prefetchData_ || next_->volume().byteSize() != v.byteSize()) return false;
     prefetchOk_ = false;
     SS_CUDA_CHECK(cudaStreamWaitEvent(stream_, *prefetchDone_, 0));
@@ -343,7 +369,11 @@ class CudaBackend final : public Backend {
   std::unique_ptr<cuda::Stream> copyStream_;
   std::unique_ptr<cuda::Event> prefetchDone_;
   std::thread prefetch_;
+  std::unique_ptr<cuda::Event> readersDone_;  ///< the render stream's work before a prefetch's copy
   bool prefetchOk_ = false;       ///< set by the thread before it ends (read after join)
+  bool prefetchPending_ = false;  ///< a prefetch of prefetchData_ started and not taken yet
+  bool haveNext_ = false;         ///< setNextVolume: the step after the next setVolume's
+  Volume nextVolume_;
   const void* prefetchData_ = nullptr;
   bool prefetchedLast_ = false;   ///< the last setVolume took the prefetched step
   cuda::DevicePool pool_;

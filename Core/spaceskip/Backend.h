@@ -28,6 +28,11 @@ class Backend {
   virtual bool prefetchVolume(const Volume& /*next*/) { return false; }
   /// Whether the last setVolume() found its voxels prefetched (Counters::prefetchedSteps).
   virtual bool lastVolumePrefetched() const { return false; }
+  /// The step after the one the next setVolume() takes (nullptr: none): a backend that found
+  /// that one prefetched starts `next`'s prefetch as soon as it has swapped it in, before its
+  /// value ranges (prefetchVolume(next) afterwards then returns true at once). Consumed by that
+  /// setVolume(); `next` is copied, its voxels are the caller's (kept as for prefetchVolume).
+  virtual void setNextVolume(const Volume* /*next*/) {}
   /// Re-classifies bricks against the TF opacity and what `cc` leaves drawn (bricks no drawn
   /// sample can reach are empty); returns true when the occupancy changed.
   virtual bool classify(const TransferFunction& tf, const CropClip& cc) = 0;

@@ -590,9 +590,14 @@ bool Engine::prefetchVolume(const Volume& next) {
     return false;
   // The step set before goes to the backend first (its prefetched voxels swapped in): the next
   // one's upload then overlaps this one's classification, build and frame.
+  // The step set before, when it was prefetched, is swapped in and `next`'s copy starts right
+  // then, before that step's value ranges: the copies run back to back.
   try {
+    if (d.rangesDirty) d.backend->setNextVolume(&next);
     d.uploadIfNeeded();
+    d.backend->setNextVolume(nullptr);
   } catch (const BackendError& e) {
+    d.backend->setNextVolume(nullptr);
     if (d.backend->kind() != BackendKind::CUDA) throw;
     d.fallBackToCpu(e.what());
     return false;
