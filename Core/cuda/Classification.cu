@@ -336,8 +336,9 @@ bool BrickClassification::valueRange(double& lo, double& hi, cudaStream_t stream
 }
 
 void BrickClassification::computePartRanges(cudaStream_t stream) {
-  d_partSlot_.release();
-  d_partRanges_.release();
+  // The buffers are kept from step to step (a time step's ranges land in them): a cudaFree
+  // would wait for the whole device, the next step's copy on the prefetch stream included.
+  havePartRanges_ = false;
   partRangeBytes_ = 0;
   if (!d_voxels_ || components_ != 1 || !usesSubMasks(brick)) return;
   // Tuning::partRanges off (read at setVolume): no bounds stored, the masks from the voxels on
@@ -348,43 +349,47 @@ void BrickClassification::computePartRanges(cudaStream_t stream) {
   if (numSMs_ == 0) numSMs_ = multiprocessors();
   const size_t volumeBytes = size_t(dims_.x) * size_t(dims_.y) * size_t(dims_.z) * voxelSize(type_);
   try {
-    DeviceBuffer<uint32_t> flags{size_t(nb)};
+    d_partFlags_.reserve(size_t(nb));
+    uint32_t* flags = d_partFlags_.get();
     d_partSlot_.reserve(size_t(nb));
     dispatchVoxelType(type_, [&](auto t) {
       using T = decltype(t);
       using S = typename PartRangeStore<T>::type;
       const T* data = static_cast<const T*>(d_voxels_);
       partRangeKernel<T><<<numSMs_ * kRangeBlocksPerSM, kThreads, 0, stream>>>(
-          data, dims_, cellDims, bdims, brick, d_vmin.get(), d_vmax.get(), nullptr, flags.get(), nullptr);
+          data, dims_, cellDims, bdims, brick, d_vmin.get(), d_vmax.get(), nullptr, flags, nullptr);
       SS_CUDA_CHECK_LAUNCH(partRangeKernel);
       size_t tempBytes = 0;
-      SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, tempBytes, flags.get(), d_partSlot_.get(), nb, stream));
-      DeviceBuffer<unsigned char> temp{std::max<size_t>(tempBytes, 1)};
-      SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp.get(), tempBytes, flags.get(), d_partSlot_.get(), nb, stream));
+      SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, tempBytes, flags, d_partSlot_.get(), nb, stream));
+      void* temp = partScanTemp_.ensure(tempBytes);
+      SS_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(temp, tempBytes, flags, d_partSlot_.get(), nb, stream));
       uint32_t last[2] = {0, 0};
       SS_CUDA_CHECK(cudaMemcpyAsync(&last[0], d_partSlot_.get() + nb - 1, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
-      SS_CUDA_CHECK(cudaMemcpyAsync(&last[1], flags.get() + nb - 1, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
+      SS_CUDA_CHECK(cudaMemcpyAsync(&last[1], flags + nb - 1, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream));
       SS_CUDA_CHECK(cudaStreamSynchronize(stream));
       const size_t slots = size_t(last[0]) + size_t(last[1]);
       const size_t bytes = slots * 128 * sizeof(S);
       if (bytes + size_t(nb) * sizeof(uint32_t) > volumeBytes / 4) {
-        d_partSlot_.release();
+        d_partRanges_.release();  // a no-op from the second such step on
         return;
       }
+      if (d_partRanges_.capacity() > 2 * std::max<size_t>(bytes, 1)) d_partRanges_.release();  // only what is needed
       d_partRanges_.reserve(std::max<size_t>(bytes, 1));
       partRangeKernel<T><<<numSMs_ * kRangeBlocksPerSM, kThreads, 0, stream>>>(
-          data, dims_, cellDims, bdims, brick, d_vmin.get(), d_vmax.get(), flags.get(), d_partSlot_.get(),
+          data, dims_, cellDims, bdims, brick, d_vmin.get(), d_vmax.get(), flags, d_partSlot_.get(),
           reinterpret_cast<S*>(d_partRanges_.get()));
       SS_CUDA_CHECK_LAUNCH(partRangeKernel);
-      SS_CUDA_CHECK(cudaStreamSynchronize(stream));  // `flags` and `temp` are freed on return
       partRangeBytes_ = bytes + size_t(nb) * sizeof(uint32_t);
+      havePartRanges_ = true;
     });
   } catch (const BackendError&) {
     // No room on the device: the masks come from the voxels on the frame after an edit.
     (void)cudaGetLastError();
     d_partSlot_.release();
     d_partRanges_.release();
+    d_partFlags_.release();
     partRangeBytes_ = 0;
+    havePartRanges_ = false;
   }
 }
 
@@ -406,7 +411,9 @@ void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaS
   d_voxels_ = nullptr;  // sparse residency: no voxels on the device, no sub-brick masks
   d_partSlot_.release();
   d_partRanges_.release();
+  d_partFlags_.release();
   partRangeBytes_ = 0;
+  havePartRanges_ = false;
   brick = r.brick;
   cellDims = vol.cellDims();
   std::copy(vol.spacing, vol.spacing + 3, spacing_);
@@ -478,7 +485,7 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   // bricks occupied (the kernel learns the count on the device and does nothing above it).
   const unsigned editMaxCount =
       unsigned(std::min<int64_t>(nb / std::max<int64_t>(editMaskShare, 1), int64_t(kUniformBrick)));
-  const bool onPath = haveSub_ && d_partSlot_.get() != nullptr && setFraction <= editMaskMaxShare;
+  const bool onPath = haveSub_ && havePartRanges_ && setFraction <= editMaskMaxShare;
   if (onPath) masksFromRanges(stream, editMaxCount);
   bool changed = false;
   const ClassifyFlags* flags = finishClassification(stream, changed);
@@ -497,7 +504,7 @@ void BrickClassification::refreshMasks(cudaStream_t stream) {
   const int maxSet = subMaskMaxSet(tuning);
   // setParts is zeroed by classify()'s memset (a range mask kernel over its limit added nothing);
   // the list and its count are classify()'s.
-  if (d_partSlot_.get()) {
+  if (havePartRanges_) {
     masksFromRanges(stream, kUniformBrick);
   } else {
     dispatchVoxelType(type_, [&](auto t) {

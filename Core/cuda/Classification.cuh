@@ -101,7 +101,9 @@ class BrickClassification {
   void dropPartRanges() {
     d_partSlot_.release();
     d_partRanges_.release();
+    d_partFlags_.release();
     partRangeBytes_ = 0;
+    havePartRanges_ = false;
   }
   /// The masks and states of the last classification on the host (masks of bricks that are
   /// not occupied: 0), computing them first when pending. For tests.
@@ -133,6 +135,9 @@ class BrickClassification {
   /// brick's), and per slot 64 lower then 64 upper bounds (PartRangeStore of the voxel type).
   DeviceBuffer<uint32_t> d_partSlot_;
   DeviceBuffer<unsigned char> d_partRanges_;
+  DeviceBuffer<uint32_t> d_partFlags_;  ///< computePartRanges' per-brick flags (kept: no free a step)
+  TempStorage partScanTemp_;           ///< its scan's temporary storage (kept likewise)
+  bool havePartRanges_ = false;        ///< d_partSlot_/d_partRanges_ hold this volume's part ranges
   size_t partRangeBytes_ = 0;
   void computePartRanges(cudaStream_t stream);
   void masksFromRanges(cudaStream_t stream, unsigned maxCount);

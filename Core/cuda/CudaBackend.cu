@@ -34,7 +34,7 @@ class CudaBackend final : public Backend {
 
   void setVolume(const Volume& v, int brick) override {
     validate(v);
-    tree_ = cuda::DeviceTree{};
+    tree_.clear();  // the nodes' storage kept: freeing it would wait for the whole device (a prefetch's copy)
     hostTree_ = Tree{};
     traversal_ = TraversalKind::Naive;
     d_distField_ = nullptr;
