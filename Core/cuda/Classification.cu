@@ -447,11 +447,18 @@ const ClassifyFlags* BrickClassification::finishClassification(cudaStream_t stre
 bool BrickClassification::classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream) {
   // The sparse table over the TF's (uncorrected) opacity, built as on the CPU, queried on the device.
   const OpacityRangeMax table(tf);
+  // Uploaded only when they changed (a time step classifies with the levels of the step before):
+  // a host-to-device copy would queue behind a prefetched step's copy on the copy engine.
   const size_t levelBytes = table.levels().size() * sizeof(float);
-  d_levels_.reserve(table.levels().size());
-  h_levels_.reserve(levelBytes);
-  std::memcpy(h_levels_.get(), table.levels().data(), levelBytes);
-  SS_CUDA_CHECK(cudaMemcpyAsync(d_levels_.get(), h_levels_.get(), levelBytes, cudaMemcpyHostToDevice, stream));
+  if (levelBytes != levelBytes_ || !d_levels_.get() ||
+      std::memcmp(h_levels_.get(), table.levels().data(), levelBytes) != 0) {
+    levelBytes_ = 0;  // until the copy is queued
+    d_levels_.reserve(table.levels().size());
+    h_levels_.reserve(levelBytes);
+    std::memcpy(h_levels_.get(), table.levels().data(), levelBytes);
+    SS_CUDA_CHECK(cudaMemcpyAsync(d_levels_.get(), h_levels_.get(), levelBytes, cudaMemcpyHostToDevice, stream));
+    levelBytes_ = levelBytes;
+  }
   OpacityRangeMaxView rmq = table.view();
   rmq.levels = d_levels_.get();
   // A 2-D function over the gradient: its row-prefix tables, queried with each brick's
@@ -460,10 +467,15 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   GradientRowsView rows = gradRows.view();
   if (!gradRows.empty()) {
     const size_t rowBytes = gradRows.levels().size() * sizeof(float);
-    d_rowLevels_.reserve(gradRows.levels().size());
-    h_rowLevels_.reserve(rowBytes);
-    std::memcpy(h_rowLevels_.get(), gradRows.levels().data(), rowBytes);
-    SS_CUDA_CHECK(cudaMemcpyAsync(d_rowLevels_.get(), h_rowLevels_.get(), rowBytes, cudaMemcpyHostToDevice, stream));
+    if (rowBytes != rowLevelBytes_ || !d_rowLevels_.get() ||
+        std::memcmp(h_rowLevels_.get(), gradRows.levels().data(), rowBytes) != 0) {
+      rowLevelBytes_ = 0;
+      d_rowLevels_.reserve(gradRows.levels().size());
+      h_rowLevels_.reserve(rowBytes);
+      std::memcpy(h_rowLevels_.get(), gradRows.levels().data(), rowBytes);
+      SS_CUDA_CHECK(cudaMemcpyAsync(d_rowLevels_.get(), h_rowLevels_.get(), rowBytes, cudaMemcpyHostToDevice, stream));
+      rowLevelBytes_ = rowBytes;
+    }
     rows.prefix.levels = d_rowLevels_.get();
   }
 

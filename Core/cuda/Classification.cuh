@@ -130,6 +130,7 @@ class BrickClassification {
   DeviceBuffer<float> d_levels_;  ///< OpacityRangeMax's levels
   DeviceBuffer<float> d_rowLevels_;  ///< GradientRows' levels (a 2-D function over the gradient)
   PinnedBuffer h_rowLevels_;
+  size_t levelBytes_ = 0, rowLevelBytes_ = 0;  ///< the bytes of h_levels_/h_rowLevels_ on the device (0: none)
   double spacing_[3] = {1, 1, 1};  ///< the volume's (the gradient rule's normalisation)
   /// Part ranges: per brick its slot in d_partRanges_ (kUniformBrick: every part's range is the
   /// brick's), and per slot 64 lower then 64 upper bounds (PartRangeStore of the voxel type).

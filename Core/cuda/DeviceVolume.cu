@@ -38,7 +38,15 @@ DeviceVolume::DeviceVolume() = default;
 DeviceVolume::~DeviceVolume() { destroyTexture(); }
 
 void HostStaging::copy(void* dst, const void* src, size_t bytes, cudaStream_t stream) {
-  if (bytes < 2 * kChunk || pageLocked(src)) {  // small (the driver's own staging is as fast), or one DMA
+  if (pageLocked(src)) {
+    // DMAs straight from the caller's memory, in pieces: another stream's small host-to-device
+    // copy (a classification's table) waits for the piece on the copy engine, not the whole step.
+    for (size_t off = 0; off < bytes; off += kPinnedPiece)
+      SS_CUDA_CHECK(cudaMemcpyAsync(static_cast<char*>(dst) + off, static_cast<const char*>(src) + off,
+                                    std::min(kPinnedPiece, bytes - off), cudaMemcpyHostToDevice, stream));
+    return;
+  }
+  if (bytes < 2 * kChunk) {  // small: the driver's own staging is as fast
     SS_CUDA_CHECK(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, stream));
     return;
   }

@@ -16,6 +16,8 @@ class HostStaging {
  public:
   static constexpr size_t kChunk = size_t(32) << 20;
   static constexpr int kChunks = 3;
+  /// A page-locked source's DMA pieces.
+  static constexpr size_t kPinnedPiece = size_t(8) << 20;
   HostStaging() = default;
   ~HostStaging();
   HostStaging(const HostStaging&) = delete;
