@@ -206,8 +206,9 @@ class CudaBackend final : public Backend {
   ~CudaBackend() override { finishPrefetch(); }
 
   // Time steps (Engine::prefetchVolume): the next step's voxels go to a second device volume on
-  // a copy stream, from a host thread (the pinned staging's host copies would otherwise hold
-  // the caller), while the current step is drawn; setVolume(next) swaps the two volumes.
+  // a copy stream while the current step is drawn; setVolume(next) swaps the two volumes. A
+  // pageable step is staged from a host thread (the staging's host copies would otherwise hold
+  // the caller); a page-locked one's DMAs are queued from the caller.
   bool prefetchVolume(const Volume& next) override {
     if (prefetchPending_ && prefetchData_ == next.data) return true;  // started by setVolume (setNextVolume)
     finishPrefetch();
@@ -229,27 +230,28 @@ class CudaBackend final : public Backend {
     prefetchOk_ = false;
     prefetchData_ = next.data;
     prefetchPending_ = true;
-    if (cuda::HostStaging::pageLocked(next.data)) {  // one DMA, queued from here: no host copy to run
+    // The copy and its event; a failure leaves prefetchOk_ false (setVolume uploads the step itself).
+    auto copy = [this](const Volume& v) {
       try {
-        next_->upload(next, *copyStream_);
+        next_->upload(v, *copyStream_);
         SS_CUDA_CHECK(cudaEventRecord(*prefetchDone_, *copyStream_));
         prefetchOk_ = true;
       } catch (const std::exception&) {
-        (void)cudaGetLastError();  // setVolume uploads the step itself
+        (void)cudaGetLastError();
       }
+    };
+    if (cuda::HostStaging::pageLocked(next.data)) {  // DMAs queued from here: no host copy to run
+      copy(next);
       return true;
     }
     int device = 0;
     SS_CUDA_CHECK(cudaGetDevice(&device));
-    prefetch_ = std::thread([this, next, device] {
-      try {
-        SS_CUDA_CHECK(cudaSetDevice(device));
-        next_->upload(next, *copyStream_);
-        SS_CUDA_CHECK(cudaEventRecord(*prefetchDone_, *copyStream_));
-        prefetchOk_ = true;
-      } catch (const std::exception&) {
-        (void)cudaGetLastError();  // setVolume uploads the step itself
+    prefetch_ = std::thread([copy, next, device] {
+      if (cudaSetDevice(device) != cudaSuccess) {
+        (void)cudaGetLastError();
+        return;
       }
+      copy(next);
     });
     return true;
   }
