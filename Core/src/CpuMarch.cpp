@@ -211,16 +211,12 @@ vec4f scalarPixel(const FrameView& f, const T* v, int64_t nx, int64_t ny, int64_
 }
 
 /// Composite frames the packets take, with or without clipping planes and cropping: unshaded,
-/// or shaded with the headlight model or directional lights (ParaView's light kit); no
-/// positional lights, scattering, 2-D transfer function or gradient opacity.
+/// or shaded with the headlight model or the light list (ParaView's light kit, positional and
+/// spot lights); no scattering, 2-D transfer function or gradient opacity.
 inline bool packetFrame(const FrameView& f) {
   if (!(f.blend == BlendMode::Composite && f.gtf.mode == 0)) return false;
   if (!f.shade) return true;
-  if (f.scatter.on) return false;
-  if (f.useLights)
-    for (int i = 0; i < f.numLights; ++i)
-      if (f.lights[i].positional) return false;
-  return true;
+  return !f.scatter.on;
 }
 
 }  // namespace march_detail
@@ -492,10 +488,36 @@ HWY_INLINE VF PowLanes(VF x, float power) {
   return hn::Load(df, a);
 }
 
+/// A positional light's direction of travel (ld) and attenuation (att) at world positions
+/// (px, py, pz), lane by lane with IntervalMarcher::shadeLights' scalar code (its powf of the
+/// spot falloff included).
+HWY_INLINE void PositionalLanes(const LightView& L, VF px, VF py, VF pz, VF& ldx, VF& ldy, VF& ldz, VF& att) {
+  const DF df;
+  HWY_ALIGN float x[kMaxLanes], y[kMaxLanes], z[kMaxLanes], a[kMaxLanes];
+  hn::Store(px, df, x);
+  hn::Store(py, df, y);
+  hn::Store(pz, df, z);
+  for (size_t l = 0; l < hn::Lanes(df); ++l) {
+    const vec3f d = vec3f{x[l], y[l], z[l]} - L.pos;
+    const float dist = length(d);
+    const vec3f ld = dist > 0.f ? d * (1.f / dist) : L.dir;
+    float k = 1.f / (L.atten.x + L.atten.y * dist + L.atten.z * dist * dist);
+    if (L.cosCone > -2.f) {
+      const float coneDot = dot(ld, L.dir);
+      k = coneDot >= L.cosCone ? k * powf(coneDot, L.exponent) : 0.f;
+    }
+    x[l] = ld.x, y[l] = ld.y, z[l] = ld.z, a[l] = k;
+  }
+  ldx = hn::Load(df, x);
+  ldy = hn::Load(df, y);
+  ldz = hn::Load(df, z);
+  att = hn::Load(df, a);
+}
+
 /// IntervalMarcher::shadeColor of colours (r, g, b) for the shaded frames packetFrame accepts:
 /// the central differences one voxel apart, then shadeGradient with the headlight model or
-/// shadeLights over the directional lights, clamped to [0, 1]; each lane with the scalar
-/// integrator's float operations in its order.
+/// shadeLights over the light list, clamped to [0, 1]; each lane with the scalar integrator's
+/// float operations in its order.
 template <class T>
 HWY_INLINE void ShadeLanes(const FrameView& f, const LaneShading<T>& S, VF& r, VF& g, VF& b) {
   const DF df;
@@ -538,33 +560,50 @@ HWY_INLINE void ShadeLanes(const FrameView& f, const LaneShading<T>& S, VF& r, V
     b = Clamp(hn::Add(hn::Mul(k, b), spec), zero, one);
     return;
   }
-  // shadeLights over directional lights (attenuation 1).
+  // shadeLights over the light list: directional lights (attenuation 1) in vectors, a positional
+  // light's direction and attenuation lane by lane (PositionalLanes).
+  bool positional = false;
+  for (int i = 0; i < f.numLights; ++i) positional = positional || f.lights[i].positional != 0;
   VF vx = zero, vy = zero, vz = zero;  // eye -> sample, world space (IntervalMarcher::worldAt)
-  if (specular) {
+  VF wx = zero, wy = zero, wz = zero;  // the sample, world space
+  if (specular || positional) {
     const VF ex = hn::Sub(S.x, S.ox), ey = hn::Sub(S.y, S.oy), ez = hn::Sub(S.z, S.oz);
     const VF t = hn::Div(Dot(ex, ey, ez, S.dx, S.dy, S.dz), Dot(S.dx, S.dy, S.dz, S.dx, S.dy, S.dz));
-    vx = hn::Sub(hn::Add(S.wox, hn::Mul(S.wdx, t)), hn::Set(df, f.eyeW.x));
-    vy = hn::Sub(hn::Add(S.woy, hn::Mul(S.wdy, t)), hn::Set(df, f.eyeW.y));
-    vz = hn::Sub(hn::Add(S.woz, hn::Mul(S.wdz, t)), hn::Set(df, f.eyeW.z));
+    wx = hn::Add(S.wox, hn::Mul(S.wdx, t));
+    wy = hn::Add(S.woy, hn::Mul(S.wdy, t));
+    wz = hn::Add(S.woz, hn::Mul(S.wdz, t));
+  }
+  if (specular) {
+    vx = hn::Sub(wx, hn::Set(df, f.eyeW.x));
+    vy = hn::Sub(wy, hn::Set(df, f.eyeW.y));
+    vz = hn::Sub(wz, hn::Set(df, f.eyeW.z));
     Normalize(vx, vy, vz);
   }
   VF d0 = zero, d1 = zero, d2 = zero, s0 = zero, s1 = zero, s2 = zero;
   for (int i = 0; i < f.numLights; ++i) {
     const LightView& L = f.lights[i];
-    const VF ldx = hn::Set(df, L.dir.x), ldy = hn::Set(df, L.dir.y), ldz = hn::Set(df, L.dir.z);
+    VF ldx = hn::Set(df, L.dir.x), ldy = hn::Set(df, L.dir.y), ldz = hn::Set(df, L.dir.z), att = one;
+    if (L.positional) PositionalLanes(L, wx, wy, wz, ldx, ldy, ldz, att);
     VF nl = Dot(n0, n1, n2, ldx, ldy, ldz);
     if (f.twoSided) nl = hn::IfThenElse(hn::Lt(nl, zero), hn::Neg(nl), nl);
     const MF lit = hn::Gt(nl, zero);
-    d0 = hn::IfThenElse(lit, hn::Add(d0, hn::Mul(hn::Set(df, L.diffuse.x), nl)), d0);
-    d1 = hn::IfThenElse(lit, hn::Add(d1, hn::Mul(hn::Set(df, L.diffuse.y), nl)), d1);
-    d2 = hn::IfThenElse(lit, hn::Add(d2, hn::Mul(hn::Set(df, L.diffuse.z), nl)), d2);
+    VF m = nl;  // ss_max(0, att * nl): nl itself where att is 1
+    if (L.positional) {
+      m = hn::Mul(att, nl);
+      m = hn::IfThenElse(hn::Gt(zero, m), zero, m);
+    }
+    d0 = hn::IfThenElse(lit, hn::Add(d0, hn::Mul(hn::Set(df, L.diffuse.x), m)), d0);
+    d1 = hn::IfThenElse(lit, hn::Add(d1, hn::Mul(hn::Set(df, L.diffuse.y), m)), d1);
+    d2 = hn::IfThenElse(lit, hn::Add(d2, hn::Mul(hn::Set(df, L.diffuse.z), m)), d2);
     if (!specular || hn::AllFalse(df, lit)) continue;
     const VF t2 = hn::Mul(hn::Set(df, 2.f), nl);
     VF rx = hn::Sub(hn::Mul(n0, t2), ldx), ry = hn::Sub(hn::Mul(n1, t2), ldy), rz = hn::Sub(hn::Mul(n2, t2), ldz);
     Normalize(rx, ry, rz);
-    const VF rv = Dot(vx, vy, vz, rx, ry, rz);
+    VF rv = Dot(vx, vy, vz, rx, ry, rz);
+    if (L.positional && f.twoSided) rv = hn::IfThenElse(hn::Lt(rv, zero), hn::Neg(rv), rv);
     const MF up = hn::And(lit, hn::Gt(rv, zero));
-    const VF pw = PowLanes(hn::IfThenElseZero(lit, rv), f.specularPower);
+    VF pw = PowLanes(hn::IfThenElseZero(lit, rv), f.specularPower);
+    if (L.positional) pw = hn::Mul(att, pw);
     s0 = hn::IfThenElse(up, hn::Add(s0, hn::Mul(hn::Set(df, L.specular.x), pw)), s0);
     s1 = hn::IfThenElse(up, hn::Add(s1, hn::Mul(hn::Set(df, L.specular.y), pw)), s1);
     s2 = hn::IfThenElse(up, hn::Add(s2, hn::Mul(hn::Set(df, L.specular.z), pw)), s2);

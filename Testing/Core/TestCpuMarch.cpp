@@ -168,7 +168,7 @@ TEST(CpuMarch, PacketsTakeShadedFramesWithDirectionalLights) {
   f.numLights = 2;
   EXPECT_TRUE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "directional lights, Specular 0";
   f.lights[1].positional = 1;
-  EXPECT_FALSE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "a positional light: the scalar integrator";
+  EXPECT_TRUE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "a positional light";
   f.lights[1].positional = 0;
   f.specular = 0.2f;
   EXPECT_TRUE(packetMarchable(f, VoxelType::UInt8, 1, 8, 8, 8)) << "directional lights, Specular 0.2";
@@ -179,8 +179,9 @@ TEST(CpuMarch, PacketsTakeShadedFramesWithDirectionalLights) {
 }
 
 TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
-  // The headlight (parallel and perspective views, a set light direction) and a light kit of
-  // directional lights (one-sided and two-sided), without and with specular reflection (VTK's
+  // The headlight (parallel and perspective views, a set light direction), a light kit of
+  // directional lights and that kit plus a positional and a spot light (each one-sided and
+  // two-sided), without and with specular reflection (VTK's
   // default 0.2, power 10; ParaView's 0), on an anisotropic grid (the gradient goes to
   // world space through the inverse transpose), every voxel type, skipping structures, jitter,
   // early ray termination and NaN/Inf voxels.
@@ -195,6 +196,22 @@ TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
   kit[1].position[0] = -2, kit[1].position[1] = 0.5, kit[1].position[2] = -1;
   kit[1].diffuse[0] = 0.3, kit[1].diffuse[1] = 0.35, kit[1].diffuse[2] = 0.4;
   kit[2].position[0] = 0, kit[2].position[1] = -1, kit[2].position[2] = 0.2;
+  // The kit plus a positional light with attenuation and a spot light (cone 40 degrees, falloff
+  // exponent 2.5) whose cone takes in part of the volume.
+  std::vector<Light> scene = kit;
+  Light point, spot;
+  point.positional = true;
+  point.position[0] = 12, point.position[1] = -15, point.position[2] = 20;
+  point.attenuation[1] = 0.02, point.attenuation[2] = 0.001;
+  point.diffuse[0] = 0.7, point.diffuse[1] = 0.9, point.diffuse[2] = 0.6;
+  spot.positional = true;
+  spot.position[0] = 45, spot.position[1] = 13, spot.position[2] = 24;
+  spot.focalPoint[0] = 10, spot.focalPoint[1] = 13, spot.focalPoint[2] = 24;
+  spot.coneAngle = 40;
+  spot.exponent = 2.5;
+  spot.specular[1] = 0.5;
+  scene.push_back(point);
+  scene.push_back(spot);
   const VoxelType types[] = {VoxelType::UInt8, VoxelType::Int16, VoxelType::UInt16, VoxelType::Float32};
   const BuilderKind builders[] = {BuilderKind::Naive, BuilderKind::Grid, BuilderKind::DistanceGrid,
                                   BuilderKind::KdTreeCPU};
@@ -213,7 +230,7 @@ TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
     if (t == VoxelType::Float32) lo = -11.0, hi = 83.0;  // the finite values' range
     for (const char* preset : {"ramp", "spike"})
       for (BuilderKind b : builders)
-        for (int lights = 0; lights < 4; ++lights, ++variant) {
+        for (int lights = 0; lights < 6; ++lights, ++variant) {
           const TransferFunction tf = TransferFunction::preset(preset, lo, hi);
           RenderParams rp;
           rp.shade = true;
@@ -230,8 +247,8 @@ TEST(CpuMarch, ShadedPacketsEqualTheScalarIntegratorBitForBit) {
           if (lights == 1) rp.lightDirection[0] = 0.3, rp.lightDirection[1] = -0.5, rp.lightDirection[2] = 0.8;
           if (lights >= 2) {
             rp.useLights = true;
-            rp.lights = kit;
-            rp.twoSidedLighting = lights == 3;
+            rp.lights = lights >= 4 ? scene : kit;
+            rp.twoSidedLighting = lights % 2 == 1;
           }
           const bool persp = lights != 1;
           const std::string what = std::string("type ") + std::to_string(int(t)) + " tf " + preset + " " +

@@ -1,13 +1,14 @@
 """Still frames of a dense Wavelet in ParaView (pvpython), Space Skipping Volume on the CPU backend
 and, with --stock, ParaView's own Volume in the same process: shading with ParaView's light kit
-(--shade, --specular), ParaView's Use Cropping (--crop). Each frame follows a 2-degree turn of
+(--shade, --specular; --positional adds a positional scene light, a spot of 40 degrees, to the
+kit), ParaView's Use Cropping (--crop). Each frame follows a 2-degree turn of
 the camera; the times are Render(view), waited for. To compare two builds of the plugin, run it
 once per build (SPACESKIP_PLUGIN) in separate processes, alternated.
 
 Usage (from the repository root, an X server on DISPLAY):
   PYTHONPATH=Testing/Plugin SPACESKIP_PLUGIN=build-cpu/lib/paraview-5.11/plugins/SpaceSkip/SpaceSkip.so \
   SPACESKIP_TEMP=/tmp/ss pvpython bench/cpu/still-frames.py [--size 256] [--frames 3] [--shade] \
-  [--specular 0.2] [--crop] [--stock]
+  [--specular 0.2] [--positional] [--crop] [--stock]
 """
 import argparse
 import statistics
@@ -22,6 +23,8 @@ parser.add_argument("--view", type=int, nargs=2, default=[800, 600])
 parser.add_argument("--frames", type=int, default=3)
 parser.add_argument("--shade", action="store_true", help="Shade on (ParaView's light kit)")
 parser.add_argument("--specular", type=float, default=0.0, help="Specular (ParaView's default 0)")
+parser.add_argument("--positional", action="store_true",
+                    help="a positional scene light (spot, cone 40 degrees) beside the light kit")
 parser.add_argument("--crop", action="store_true",
                     help="Use Cropping: origin at 0.3 of x, scale 0.5 x 0.8 x 0.9 of the bounds")
 parser.add_argument("--stock", action="store_true", help="ParaView's own Volume too, after ours")
@@ -31,8 +34,17 @@ N = args.size
 ssptest.load_plugin()
 source, view, disp = ssptest.dense_wavelet_scene(N, args.view)
 b = source.GetDataInformation().GetBounds()
-what = "Wavelet %d^3%s%s%s, view %dx%d" % (N, ", shaded" if args.shade else "",
+if args.positional:
+    spot = AddLight(view=view)
+    spot.Coords = "Scene"
+    spot.Type = "Positional"
+    spot.Position = [b[1] + 0.5 * (b[1] - b[0]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])]
+    spot.FocalPoint = [0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])]
+    spot.ConeAngle = 40
+    spot.Intensity = 0.8
+what = "Wavelet %d^3%s%s%s%s, view %dx%d" % (N, ", shaded" if args.shade else "",
                                          ", specular %g" % args.specular if args.specular else "",
+                                         ", positional spot" if args.positional else "",
                                          ", cropped" if args.crop else "", args.view[0], args.view[1])
 for rep in ["Space Skipping Volume"] + (["Volume"] if args.stock else []):
     disp.SetRepresentationType(rep)
