@@ -19,6 +19,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace spaceskip {
@@ -33,6 +34,7 @@ class CudaBackend final : public Backend {
   const char* name() const override { return "cuda"; }
 
   void setVolume(const Volume& v, int brick) override {
+    const bool haveNext = std::exchange(haveNext_, false);  // consumed here, whatever follows
     validate(v);
     tree_.clear();  // the nodes' storage kept: freeing it would wait for the whole device (a prefetch's copy)
     hostTree_ = Tree{};
@@ -41,8 +43,6 @@ class CudaBackend final : public Backend {
     cls_.haveOcc = false;
     pool_.release();
     const int64_t budget = budget_ > 0 ? budget_ : defaultBudget(v, brick);
-    const bool haveNext = haveNext_;
-    haveNext_ = false;
     if (int64_t(v.byteSize()) <= budget) {
       prefetchedLast_ = takePrefetched(v);
       // The step after it (Engine::prefetchVolume) starts now, into the buffer just swapped out.

@@ -594,10 +594,14 @@ bool Engine::prefetchVolume(const Volume& next) {
   // then, before that step's value ranges: the copies run back to back.
   try {
     if (d.rangesDirty) d.backend->setNextVolume(&next);
-    d.uploadIfNeeded();
+    try {
+      d.uploadIfNeeded();
+    } catch (...) {
+      d.backend->setNextVolume(nullptr);  // never carried over to a later setVolume
+      throw;
+    }
     d.backend->setNextVolume(nullptr);
   } catch (const BackendError& e) {
-    d.backend->setNextVolume(nullptr);
     if (d.backend->kind() != BackendKind::CUDA) throw;
     d.fallBackToCpu(e.what());
     return false;
