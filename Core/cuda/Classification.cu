@@ -19,6 +19,22 @@ namespace {
 
 constexpr int kThreads = 256;
 
+/// `levels` to `d` through the pinned `h`, queued on `stream` only when they differ from the ones
+/// uploaded before (`uploaded`: their bytes, 0 for none). A time step classifies with the levels
+/// of the step before: a host-to-device copy would queue behind a prefetched step's copy on the
+/// copy engine.
+void uploadLevelsIfChanged(const std::vector<float>& levels, DeviceBuffer<float>& d, PinnedBuffer& h,
+                           size_t& uploaded, cudaStream_t stream) {
+  const size_t bytes = levels.size() * sizeof(float);
+  if (bytes == uploaded && d.get() && std::memcmp(h.get(), levels.data(), bytes) == 0) return;
+  uploaded = 0;  // until the copy is queued
+  d.reserve(levels.size());
+  h.reserve(bytes);
+  std::memcpy(h.get(), levels.data(), bytes);
+  SS_CUDA_CHECK(cudaMemcpyAsync(d.get(), h.get(), bytes, cudaMemcpyHostToDevice, stream));
+  uploaded = bytes;
+}
+
 // Launch shape: one thread per brick, 256 per block. brickRange over the brick's voxels.
 template <class T, int NC>
 __global__ void rangeKernel(const T* data, vec3l dims, vec3i bdims, int brick, float* vmin, float* vmax) {
@@ -385,11 +401,7 @@ void BrickClassification::computePartRanges(cudaStream_t stream) {
   } catch (const BackendError&) {
     // No room on the device: the masks come from the voxels on the frame after an edit.
     (void)cudaGetLastError();
-    d_partSlot_.release();
-    d_partRanges_.release();
-    d_partFlags_.release();
-    partRangeBytes_ = 0;
-    havePartRanges_ = false;
+    dropPartRanges();
   }
 }
 
@@ -409,11 +421,7 @@ void BrickClassification::setRanges(const Volume& vol, const RangeGrid& r, cudaS
   haveOcc = false;
   setFraction = 1.0;
   d_voxels_ = nullptr;  // sparse residency: no voxels on the device, no sub-brick masks
-  d_partSlot_.release();
-  d_partRanges_.release();
-  d_partFlags_.release();
-  partRangeBytes_ = 0;
-  havePartRanges_ = false;
+  dropPartRanges();
   brick = r.brick;
   cellDims = vol.cellDims();
   std::copy(vol.spacing, vol.spacing + 3, spacing_);
@@ -447,18 +455,7 @@ const ClassifyFlags* BrickClassification::finishClassification(cudaStream_t stre
 bool BrickClassification::classify(const TransferFunction& tf, const CropClip& cc, cudaStream_t stream) {
   // The sparse table over the TF's (uncorrected) opacity, built as on the CPU, queried on the device.
   const OpacityRangeMax table(tf);
-  // Uploaded only when they changed (a time step classifies with the levels of the step before):
-  // a host-to-device copy would queue behind a prefetched step's copy on the copy engine.
-  const size_t levelBytes = table.levels().size() * sizeof(float);
-  if (levelBytes != levelBytes_ || !d_levels_.get() ||
-      std::memcmp(h_levels_.get(), table.levels().data(), levelBytes) != 0) {
-    levelBytes_ = 0;  // until the copy is queued
-    d_levels_.reserve(table.levels().size());
-    h_levels_.reserve(levelBytes);
-    std::memcpy(h_levels_.get(), table.levels().data(), levelBytes);
-    SS_CUDA_CHECK(cudaMemcpyAsync(d_levels_.get(), h_levels_.get(), levelBytes, cudaMemcpyHostToDevice, stream));
-    levelBytes_ = levelBytes;
-  }
+  uploadLevelsIfChanged(table.levels(), d_levels_, h_levels_, levelBytes_, stream);
   OpacityRangeMaxView rmq = table.view();
   rmq.levels = d_levels_.get();
   // A 2-D function over the gradient: its row-prefix tables, queried with each brick's
@@ -466,16 +463,7 @@ bool BrickClassification::classify(const TransferFunction& tf, const CropClip& c
   const GradientRows gradRows(tf, spacing_);
   GradientRowsView rows = gradRows.view();
   if (!gradRows.empty()) {
-    const size_t rowBytes = gradRows.levels().size() * sizeof(float);
-    if (rowBytes != rowLevelBytes_ || !d_rowLevels_.get() ||
-        std::memcmp(h_rowLevels_.get(), gradRows.levels().data(), rowBytes) != 0) {
-      rowLevelBytes_ = 0;
-      d_rowLevels_.reserve(gradRows.levels().size());
-      h_rowLevels_.reserve(rowBytes);
-      std::memcpy(h_rowLevels_.get(), gradRows.levels().data(), rowBytes);
-      SS_CUDA_CHECK(cudaMemcpyAsync(d_rowLevels_.get(), h_rowLevels_.get(), rowBytes, cudaMemcpyHostToDevice, stream));
-      rowLevelBytes_ = rowBytes;
-    }
+    uploadLevelsIfChanged(gradRows.levels(), d_rowLevels_, h_rowLevels_, rowLevelBytes_, stream);
     rows.prefix.levels = d_rowLevels_.get();
   }
 

@@ -97,7 +97,8 @@ class BrickClassification {
   /// ... and only when the last masks had at most this share of their parts set (the frames
   /// walk parts then, CudaBackend's kPartsShare; else the edit's frame would not use them).
   double editMaskMaxShare = 0.2;
-  /// Drops the part ranges (the masks then come from the voxels, refreshMasks): for tests.
+  /// Drops the part ranges and frees their buffers (the masks then come from the voxels,
+  /// refreshMasks): sparse residency, no room on the device, and tests.
   void dropPartRanges() {
     d_partSlot_.release();
     d_partRanges_.release();
