@@ -394,7 +394,8 @@ int vtkSpaceSkipVolumeRepresentation::RequestUpdateExtent(
     return 0;
   }
   // Pieces share their face points, so a trilinear sample in a piece's own cells reads its own
-  // voxels; shading's central differences read one voxel further: one ghost layer. A
+  // voxels: no ghost layer (ParaView asks none of an image by default). A gradient's central
+  // differences read one voxel further: one layer, only while a sample reads one. A
   // rectilinear grid's piece, if non-uniform, is resampled on the whole grid's lattice, whose
   // points next to the owned cells (and one further, for shading) can lie more than one grid
   // step beyond them: three layers (vtkSpaceSkipRectilinearImage warns where even that is short).
@@ -411,7 +412,8 @@ int vtkSpaceSkipVolumeRepresentation::RequestUpdateExtent(
         ? info->Get(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS())
         : 0;
       const bool grid = vtkRectilinearGrid::SafeDownCast(info->Get(vtkDataObject::DATA_OBJECT())) != nullptr;
-      info->Set(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS(), std::max(levels, grid ? 3 : 1));
+      const int needed = grid ? 3 : (this->NeedsNeighbourPoints() ? 1 : 0);
+      info->Set(SDDP::UPDATE_NUMBER_OF_GHOST_LEVELS(), std::max(levels, needed));
     }
   }
   return 1;
@@ -752,6 +754,44 @@ vtkSpaceSkipForwardGet(FrameCount, int)
 vtkSpaceSkipForwardBool(EarlyRayTermination)
 vtkSpaceSkipForwardBool(UseJittering)
 vtkSpaceSkipForwardBool(InteractiveAdjustSampleDistances)
+
+bool vtkSpaceSkipVolumeRepresentation::NeedsNeighbourPoints()
+{
+  return this->Property->GetShade() != 0 || (this->UseTransfer2D && this->UseGradientForTransfer2D);
+}
+
+void vtkSpaceSkipVolumeRepresentation::NeighbourNeedMayHaveChanged(bool before)
+{
+  // Serially no ghost layer is ever asked for, and a new request would only hand the mapper a
+  // new copy of the same volume to upload.
+  vtkMultiProcessController* controller = vtkMultiProcessController::GetGlobalController();
+  if (before != this->NeedsNeighbourPoints() && controller && controller->GetNumberOfProcesses() > 1)
+  {
+    this->MarkModified();
+  }
+}
+
+void vtkSpaceSkipVolumeRepresentation::SetShade(bool shade)
+{
+  const bool before = this->NeedsNeighbourPoints();
+  this->Superclass::SetShade(shade);
+  this->NeighbourNeedMayHaveChanged(before);
+}
+
+void vtkSpaceSkipVolumeRepresentation::SetUseTransfer2D(bool use)
+{
+  const bool before = this->NeedsNeighbourPoints();
+  this->Superclass::SetUseTransfer2D(use);
+  this->NeighbourNeedMayHaveChanged(before);
+}
+
+void vtkSpaceSkipVolumeRepresentation::SetUseGradientForTransfer2D(bool use)
+{
+  const bool before = this->NeedsNeighbourPoints();
+  this->Superclass::SetUseGradientForTransfer2D(use);
+  this->NeighbourNeedMayHaveChanged(before);
+}
+
 void vtkSpaceSkipVolumeRepresentation::SetGlobalIlluminationReach(float reach)
 {
   this->Superclass::SetGlobalIlluminationReach(reach);

@@ -130,9 +130,9 @@ else:
         disp.UseTransfer2D = 1
         disp.UseGradientForTransfer2D = 0
         disp.ColorArray2Name = ["POINTS", "second"]
-    if scene == "rectnu":
+    if scene == "rectnu" or os.environ.get("SPACESKIP_PARALLEL_SHADE"):
         # Shaded: the central differences read one lattice point beyond a piece's own, which
-        # three ghost layers of the grid hold here (the representation asks a grid for three).
+        # the ghost layers hold (the representation asks an image for one, a grid for three).
         disp.Shade = 1
     if not stock:
         disp.Builder = builder
@@ -181,3 +181,8 @@ print("SPACESKIP_PARALLEL ranks=%d process_id_range=%s" % (n, rng))
 if not stock:
     s = ssptest.stats(shown)
     print("SPACESKIP_PARALLEL rank0_stats=%s" % s)
+    # The piece the representation drew (all ranks' together): with or without a ghost layer.
+    drawn = shown.GetRepresentedDataInformation()
+    arrays = drawn.GetPointDataInformation()
+    names = [arrays.GetArrayInformation(i).GetName() for i in range(arrays.GetNumberOfArrays())]
+    print("SPACESKIP_PARALLEL drawn_points=%d ghost_array=%d" % (drawn.GetNumberOfPoints(), "vtkGhostType" in names))
