@@ -5,6 +5,9 @@
 #include "vtkDataArray.h"
 #include "vtkDataSetAttributes.h"
 #include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationInformationVectorKey.h"
+#include "vtkInformationVector.h"
 #include "vtkMatrix3x3.h"
 #include "vtkNew.h"
 #include "vtkPointData.h"
@@ -22,6 +25,7 @@
 #include <cmath>
 #include <cstdio>
 #include <utility>
+#include <vector>
 
 namespace
 {
@@ -362,6 +366,62 @@ int UnmarkedCellsOf(vtkDataSet* data, const int ext[6], int cells[6])
 
 } // namespace
 
+bool vtkSpaceSkipInputConverter::FillRangeCaches(vtkDataArray* array)
+{
+  spaceskip::VoxelType type;
+  const int nc = array ? array->GetNumberOfComponents() : 0;
+  const vtkIdType n = array ? array->GetNumberOfTuples() : 0;
+  if (nc < 1 || nc > 4 || n < 1 || !array->HasStandardMemoryLayout() ||
+    !CoreTypeOf(array->GetDataType(), type))
+  {
+    return false;
+  }
+  vtkInformation* info = array->GetInformation();
+  if (info->Has(vtkAbstractArray::PER_COMPONENT()) && info->Has(vtkAbstractArray::PER_FINITE_COMPONENT()))
+  {
+    return false;
+  }
+  const auto* base = static_cast<const unsigned char*>(array->GetVoidPointer(0));
+  const size_t size = static_cast<size_t>(array->GetDataTypeSize());
+  // Ranges of every component (all values but NaN, or the finite ones), or none.
+  auto ranges = [&](bool finiteOnly, std::vector<double>& r) {
+    r.assign(2 * static_cast<size_t>(nc), 0.0);
+    for (int c = 0; c < nc; ++c)
+    {
+      if (!spaceskip::valueRange(type, base + c * size, n, nc, finiteOnly, r[2 * c], r[2 * c + 1]))
+      {
+        return false;
+      }
+    }
+    return true;
+  };
+  auto store = [&](vtkInformationInformationVectorKey* key, const std::vector<double>& r) {
+    vtkNew<vtkInformationVector> perComponent;
+    perComponent->SetNumberOfInformationObjects(nc);
+    for (int c = 0; c < nc; ++c)
+    {
+      perComponent->GetInformationObject(c)->Set(vtkDataArray::COMPONENT_RANGE(), r.data() + 2 * c, 2);
+    }
+    info->Set(key, perComponent);
+  };
+  const bool integral = type != spaceskip::VoxelType::Float32 && type != spaceskip::VoxelType::Float64;
+  std::vector<double> all, finite;
+  if (!ranges(false, all) || !(integral ? (finite = all, true) : ranges(true, finite)))
+  {
+    return false; // a component of NaN only (or of no finite value): left to VTK
+  }
+  if (!info->Has(vtkAbstractArray::PER_COMPONENT()))
+  {
+    store(vtkAbstractArray::PER_COMPONENT(), all);
+  }
+  if (!info->Has(vtkAbstractArray::PER_FINITE_COMPONENT()))
+  {
+    store(vtkAbstractArray::PER_FINITE_COMPONENT(), finite);
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
 int vtkSpaceSkipInputConverter::UnmarkedCells(vtkImageData* image, int cells[6])
 {
   return UnmarkedCellsOf(image, image->GetExtent(), cells);

@@ -84,6 +84,9 @@ public:
   static spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
     bool exact, double bias, const WarnFunction& warn);
 
+  /// vtkSpaceSkippingVolumeMapper::FillRangeCaches.
+  static bool FillRangeCaches(vtkDataArray* array);
+
   /// Forgets what the engine was given (a new engine): the next Update hands the volume again.
   void Reset();
 

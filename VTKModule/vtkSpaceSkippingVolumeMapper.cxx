@@ -8,6 +8,7 @@
 #include "vtkCompositeDataSet.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
+#include "vtkLogger.h"
 #include "vtkMath.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
@@ -698,6 +699,8 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   namespace pc = vtkSpaceSkipPieceCompositing;
   vtkInternals& d = *this->Internals;
   const std::shared_ptr<PieceExchange> exchange = d.Exchange;
+  // The frame's phases, logged at verbosity 5 (pvbatch -v 5): where a composited frame goes.
+  const auto t0 = std::chrono::steady_clock::now();
   exchange->Begin();
   std::vector<PieceImage> mine;
   double eye[3] = { 0, 0, 0 }, dir[3] = { 0, 0, 1 };
@@ -758,10 +761,21 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   int width = 0, height = 0, x0 = 0, y0 = 0;
   ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
   std::vector<PieceImage> others;
+  const double drawnAt = SecondsSince(t0);
+  const vtkSpaceSkipStatistics piece = d.Image.Statistics(true);
   const int draw = exchange->Finish(width, height, mine, others);
+  const double exchangedAt = SecondsSince(t0);
+  auto phases = [&](const char* end) {
+    vtkVLogF(vtkLogger::VERBOSITY_5,
+      "exchanged frame: piece %.3f ms (update %.3f, depth read %.3f, engine %.3f, kernel %.3f), "
+      "exchange %.3f ms, %s %.3f ms",
+      1e3 * drawnAt, 1e3 * piece.UpdateSeconds, 1e3 * piece.DepthReadSeconds, 1e3 * piece.EngineRenderSeconds,
+      1e3 * piece.KernelSeconds, 1e3 * (exchangedAt - drawnAt), end, 1e3 * (SecondsSince(t0) - exchangedAt));
+  };
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
   if (draw == 0 || !renWin || width <= 0 || height <= 0)
   {
+    phases("nothing drawn");
     return;
   }
   const bool eightBit = this->EightBitComposite != 0;
@@ -786,12 +800,22 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     const double stopAt =
       s.AccumulatesOpacity() ? vtkSpaceSkipPropertyTranslator::EarlyTerminationOpacity(s) : 2.0;
     pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged, stopAt);
+    const double blendedAt = SecondsSince(t0);
     drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
+    vtkVLogF(vtkLogger::VERBOSITY_5, "exchanged frame: blend of %d pieces %.3f ms",
+      static_cast<int>(others.size()), 1e3 * (blendedAt - exchangedAt));
   }
+  phases("blend + draw");
   if (!drawn)
   {
     d.Fail("could not compile the compositing shader: nothing drawn");
   }
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkippingVolumeMapper::FillRangeCaches(vtkDataArray* array)
+{
+  return vtkSpaceSkipInputConverter::FillRangeCaches(array);
 }
 
 //------------------------------------------------------------------------------

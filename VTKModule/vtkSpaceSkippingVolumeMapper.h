@@ -44,6 +44,7 @@
 #include <memory> // For std::unique_ptr
 #include <string> // For WarnOnce
 
+class vtkDataArray;
 class vtkRenderer;
 struct vtkSpaceSkipLabelEdit;
 class vtkVolume;
@@ -401,6 +402,18 @@ public:
    * none is marked. False (`extent` its own extent) when every cell is marked.
    */
   static bool GetOwnedExtent(vtkImageData* image, int extent[6]);
+
+  /**
+   * Fills `array`'s range caches, the per-component ranges vtkDataArray::GetRange and
+   * GetFiniteRange return (its PER_COMPONENT and PER_FINITE_COMPONENT information), in one
+   * parallel pass per component, where VTK holds none yet; the same values VTK would compute
+   * (GetRange skips NaN, GetFiniteRange +-Inf too). VTK 9.2 takes a range one value at a time
+   * (about 22 ns a value on one core: 1.5 s for 64 Mi voxels), and ParaView takes both ranges of
+   * every array of every new piece it draws. Contiguous arrays of the types the mapper reads
+   * natively (8/16-bit integers, float, double) with 1 to 4 components; false (nothing set) for
+   * others, for an empty array or one whose caches are already filled.
+   */
+  static bool FillRangeCaches(vtkDataArray* array);
 
   ///@{
   /**

@@ -9,7 +9,7 @@ frame, backend, builder) and, with --reference, the PSNR and largest difference 
 against a reference image (e.g. the one-rank image: N ranks == 1 rank).
 
   [mpiexec -n N] pvbatch bench/pvbatch-orbit.py --plugin SpaceSkip.so --raw FILE_XxYxZ_uint8.raw
-      [--view 1024] [--frames 60] [--backend CUDA] [--builder Auto] [--stock] [--png first.png]
+      [--view 1024] [--frames 60] [--backend CUDA] [--builder Auto] [--stock] [--shade] [--png first.png]
       [--reference first-1rank.png]
 The raw file's name gives its dimensions and type (spaceskip generate writes such names:
 `spaceskip generate nbody --dims 2048 2048 2048 -o /tmp/nbody_2048x2048x2048_uint8.raw`).
@@ -30,6 +30,7 @@ parser.add_argument("--turn", type=float, default=6.0)
 parser.add_argument("--backend", default="Auto")
 parser.add_argument("--builder", default="Auto")
 parser.add_argument("--stock", action="store_true", help="ParaView's own Volume instead of ours")
+parser.add_argument("--shade", action="store_true", help="shaded (under MPI the pieces then take a ghost layer)")
 parser.add_argument("--png", default="", help="save the first frame here")
 parser.add_argument("--reference", default="", help="compare the first frame with this image")
 args = parser.parse_args()
@@ -65,6 +66,7 @@ lut.ApplyPreset("Cool to Warm", True)
 lut.RescaleTransferFunction(lo, hi)
 pwf = simple.GetOpacityTransferFunction("ImageFile")
 pwf.Points = [lo, 0.0, 0.5, 0.0, hi, 1.0, 0.5, 0.0]
+disp.Shade = 1 if args.shade else 0
 if not args.stock:
     disp.Backend = args.backend
     disp.Builder = args.builder
@@ -93,8 +95,8 @@ used = ""
 if not args.stock:
     disp.UpdatePropertyInformation()
     used = " backend=%s builder=%s" % (disp.GetPropertyValue("BackendUsed"), disp.GetPropertyValue("BuilderUsed"))
-print("PVBATCH_ORBIT ranks=%d rep=%s volume=%dx%dx%d %s view=%d frames=%d fps=%.1f median_ms=%.3f "
-      "first_s=%.3f%s" % (ranks, "Volume" if args.stock else "SpaceSkip", dims[0], dims[1], dims[2],
+print("PVBATCH_ORBIT ranks=%d rep=%s%s volume=%dx%dx%d %s view=%d frames=%d fps=%.1f median_ms=%.3f "
+      "first_s=%.3f%s" % (ranks, "Volume" if args.stock else "SpaceSkip", " shaded" if args.shade else "", dims[0], dims[1], dims[2],
                           m.group(4), args.view, args.frames, 1.0 / med, 1e3 * med, first, used), flush=True)
 
 if args.reference and args.png:

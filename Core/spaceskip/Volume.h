@@ -91,4 +91,11 @@ uint64_t defaultMaxVolumeBytes();
 /// or it exceeds maxBytes (the message names the cap and how to raise it).
 uint64_t checkedByteSize(vec3l dims, VoxelType t, uint64_t maxBytes, const std::string& what);
 
+/// Min/max of `count` values of type `t` at `data`, every `stride`-th one (a component of
+/// interleaved tuples), in one oneTBB pass: the finite values only (`finiteOnly`), else every
+/// value but NaN (vtkDataArray::GetRange's rule; GetFiniteRange's is the former). False when no
+/// value counts (lo > hi then).
+bool valueRange(VoxelType t, const void* data, int64_t count, int64_t stride, bool finiteOnly, double& lo,
+                double& hi);
+
 }  // namespace spaceskip

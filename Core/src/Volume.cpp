@@ -103,17 +103,18 @@ namespace {
 // the task overhead vanishes, small enough to balance 8 GiB over all cores.
 constexpr int64_t kRangeGrain = int64_t(1) << 20;
 
-// Finite min/max of n voxels of type T, oneTBB parallel (a 2048^3 uint8 volume is 8 Gi voxels:
-// the serial per-voxel switch took tens of seconds there).
-// Values p[i * stride] for i < n (stride: the component count when one component is wanted).
+// Min/max of n voxels of type T, oneTBB parallel (a 2048^3 uint8 volume is 8 Gi voxels:
+// the serial per-voxel switch took tens of seconds there): the finite ones, or (!finiteOnly)
+// all but NaN. Values p[i * stride] for i < n (stride: the component count when one component
+// is wanted).
 template <class T>
-bool finiteRange(const void* data, int64_t n, double& lo, double& hi, int64_t stride = 1) {
+bool finiteRange(const void* data, int64_t n, double& lo, double& hi, int64_t stride = 1, bool finiteOnly = true) {
   const T* p = static_cast<const T*>(data);
   using MinMax = std::pair<double, double>;
   const MinMax empty{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   const MinMax r = tbb::parallel_reduce(
       tbb::blocked_range<int64_t>(0, n, kRangeGrain), empty,
-      [p, stride](const tbb::blocked_range<int64_t>& br, MinMax acc) {
+      [p, stride, finiteOnly](const tbb::blocked_range<int64_t>& br, MinMax acc) {
         if constexpr (std::is_integral_v<T>) {
           T mn = std::numeric_limits<T>::max(), mx = std::numeric_limits<T>::lowest();
           if (stride == 1) {
@@ -132,7 +133,7 @@ bool finiteRange(const void* data, int64_t n, double& lo, double& hi, int64_t st
         } else {
           for (int64_t i = br.begin(); i < br.end(); ++i) {
             const double v = double(p[i * stride]);
-            if (!std::isfinite(v)) continue;
+            if (finiteOnly ? !std::isfinite(v) : std::isnan(v)) continue;
             acc.first = std::min(acc.first, v);
             acc.second = std::max(acc.second, v);
           }
@@ -147,6 +148,13 @@ bool finiteRange(const void* data, int64_t n, double& lo, double& hi, int64_t st
   return lo <= hi;
 }
 }  // namespace
+
+bool valueRange(VoxelType t, const void* data, int64_t count, int64_t stride, bool finiteOnly, double& lo,
+                double& hi) {
+  return dispatchVoxelType(t, [&](auto voxel) {
+    return finiteRange<decltype(voxel)>(data, count, lo, hi, stride, finiteOnly);
+  });
+}
 
 bool Volume::scalarRange(double& lo, double& hi) const {
   const int64_t n = voxelCount() * components;

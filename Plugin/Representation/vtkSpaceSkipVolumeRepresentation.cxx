@@ -434,6 +434,22 @@ int vtkSpaceSkipVolumeRepresentation::RequestData(
     ? this->RequestPieceWithGhosts(input, request, inputVector, outputVector)
     : this->Superclass::RequestData(request, inputVector, outputVector);
   this->SpaceSkipMapper->SetWholeExtent(this->WholeExtent);
+  // The ranges of the drawn piece's arrays, in one parallel pass each, where VTK has none yet:
+  // ParaView takes them of every array of the piece for its array lists (and the whole range
+  // below takes the colour array's), one value at a time. A piece with a ghost layer is new
+  // data after the reader ran again for it (6 of the 8.4 s of a shaded 2-rank first frame at
+  // 512^3 on the 2-core machine).
+  if (auto* piece = vtkDataSet::SafeDownCast(this->Cache))
+  {
+    for (vtkDataSetAttributes* attributes :
+      { static_cast<vtkDataSetAttributes*>(piece->GetPointData()), static_cast<vtkDataSetAttributes*>(piece->GetCellData()) })
+    {
+      for (int i = 0; i < attributes->GetNumberOfArrays(); ++i)
+      {
+        vtkSpaceSkippingVolumeMapper::FillRangeCaches(attributes->GetArray(i));
+      }
+    }
+  }
 
   // The colour array's range over all ranks (collective: every rank runs RequestData).
   this->WholeRanges.clear();

@@ -16,7 +16,8 @@
 #                volume (PVB_SHAPE nbody, PVB_N 2048: spaceskip generate, kept in PVB_DIR, default
 #                /tmp/pvb), PVB_FRAMES 60 at 1024^2, each N-rank first frame against the 1-rank one;
 #                PVB_STOCK=1: ParaView's Volume too (PVB_BACKEND CUDA, PVB_VIEW 1024)
-#                PVB_SMP: VTK's SMP backend for ParaView's own passes (default STDThread)
+#                PVB_SMP: VTK's SMP backend for ParaView's own passes (default STDThread);
+#                PVB_VERBOSITY 5: each composited frame's phases in logs/pvbatch-N.log
 #   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
 #                --raw; TS_WORKDIR keeps the written steps for a later run; TS_ARGS more options,
 #                e.g. "--cache 4000" for ParaView's animation cache)
@@ -151,6 +152,8 @@ if has bench-pvbatch; then
       tag=pvbatch-$r${stock:+-stock}
       launch=("$pvbatch")
       [ "$r" = 1 ] || launch=(mpirun --allow-run-as-root --oversubscribe --bind-to none -n "$r" "$pvbatch")
+      # PVB_VERBOSITY 5: the mapper logs each composited frame's phases (logs/pvbatch-N.log).
+      [ -z "${PVB_VERBOSITY:-}" ] || launch+=(-v "$PVB_VERBOSITY")
       ref=()
       [ "$r" = 1 ] || ref=(--reference "$work/logs/pvbatch-1${stock:+-stock}.png")
       TAIL=3 run "$tag" 600 "${launch[@]}" "$src/bench/pvbatch-orbit.py" --plugin "$SPACESKIP_PLUGIN" \
