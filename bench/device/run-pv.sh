@@ -17,7 +17,8 @@
 #                /tmp/pvb), PVB_FRAMES 60 at 1024^2, each N-rank first frame against the 1-rank one;
 #                PVB_STOCK=1: ParaView's Volume too (PVB_BACKEND CUDA, PVB_VIEW 1024)
 #                PVB_SMP: VTK's SMP backend for ParaView's own passes (default STDThread);
-#                PVB_VERBOSITY 5: each composited frame's phases in logs/pvbatch-N.log
+#                PVB_VERBOSITY 5: each composited frame's phases in logs/pvbatch-N.log;
+#                PVB_ARGS: more options of pvbatch-orbit.py (e.g. --shade)
 #   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
 #                --raw; TS_WORKDIR keeps the written steps for a later run; TS_ARGS more options,
 #                e.g. "--cache 4000" for ParaView's animation cache)
@@ -157,7 +158,8 @@ if has bench-pvbatch; then
       ref=()
       [ "$r" = 1 ] || ref=(--reference "$work/logs/pvbatch-1${stock:+-stock}.png")
       TAIL=3 run "$tag" 600 "${launch[@]}" "$src/bench/pvbatch-orbit.py" --plugin "$SPACESKIP_PLUGIN" \
-        --raw "$raw" --frames "${PVB_FRAMES:-60}" --backend "${PVB_BACKEND:-CUDA}" --view "${PVB_VIEW:-1024}" $stock --png "$work/logs/$tag.png" "${ref[@]}"
+        --raw "$raw" --frames "${PVB_FRAMES:-60}" --backend "${PVB_BACKEND:-CUDA}" --view "${PVB_VIEW:-1024}" $stock \
+        ${PVB_ARGS:-} --png "$work/logs/$tag.png" "${ref[@]}"
     done
   done
   grep -h "^PVBATCH_ORBIT" "$work"/logs/pvbatch-*.log >> "$out/pv.log"
