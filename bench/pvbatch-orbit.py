@@ -33,7 +33,17 @@ parser.add_argument("--stock", action="store_true", help="ParaView's own Volume 
 parser.add_argument("--shade", action="store_true", help="shaded (under MPI the pieces then take a ghost layer)")
 parser.add_argument("--png", default="", help="save the first frame here")
 parser.add_argument("--reference", default="", help="compare the first frame with this image")
+parser.add_argument("--result", default="", help="append the result lines to this file too (pvbatch -v N "
+                    "loses the script's printed lines)")
 args = parser.parse_args()
+
+
+def report(line):
+    print(line, flush=True)
+    if args.result:
+        with open(args.result, "a") as f:
+            f.write(line + "\n")
+
 
 from paraview import simple  # noqa: E402
 from paraview import servermanager  # noqa: E402
@@ -95,9 +105,9 @@ used = ""
 if not args.stock:
     disp.UpdatePropertyInformation()
     used = " backend=%s builder=%s" % (disp.GetPropertyValue("BackendUsed"), disp.GetPropertyValue("BuilderUsed"))
-print("PVBATCH_ORBIT ranks=%d rep=%s%s volume=%dx%dx%d %s view=%d frames=%d fps=%.1f median_ms=%.3f "
-      "first_s=%.3f%s" % (ranks, "Volume" if args.stock else "SpaceSkip", " shaded" if args.shade else "", dims[0], dims[1], dims[2],
-                          m.group(4), args.view, args.frames, 1.0 / med, 1e3 * med, first, used), flush=True)
+report("PVBATCH_ORBIT ranks=%d rep=%s%s volume=%dx%dx%d %s view=%d frames=%d fps=%.1f median_ms=%.3f "
+       "first_s=%.3f%s" % (ranks, "Volume" if args.stock else "SpaceSkip", " shaded" if args.shade else "", dims[0], dims[1], dims[2],
+                           m.group(4), args.view, args.frames, 1.0 / med, 1e3 * med, first, used))
 
 if args.reference and args.png:
     from vtkmodules.vtkIOImage import vtkPNGReader
@@ -110,10 +120,10 @@ if args.reference and args.png:
         return vtk_to_numpy(r.GetOutput().GetPointData().GetScalars()).astype("float64")
     a, b = read(args.png), read(args.reference)
     if a.shape != b.shape:
-        print("PVBATCH_ORBIT_COMPARE sizes differ: %s vs %s" % (a.shape, b.shape))
+        report("PVBATCH_ORBIT_COMPARE sizes differ: %s vs %s" % (a.shape, b.shape))
     else:
         mse = ((a - b) ** 2).mean()
         psnr = float("inf") if mse == 0 else 10 * math.log10(255.0 ** 2 / mse)
         over = float((abs(a - b).max(axis=-1) > 1).mean() * 100) if a.ndim > 1 else 0.0
-        print("PVBATCH_ORBIT_COMPARE vs %s: PSNR %.2f dB, max |diff| %d/255, %.3f %% of pixels over 1/255"
-              % (os.path.basename(args.reference), psnr, int(abs(a - b).max()), over), flush=True)
+        report("PVBATCH_ORBIT_COMPARE vs %s: PSNR %.2f dB, max |diff| %d/255, %.3f %% of pixels over 1/255"
+               % (os.path.basename(args.reference), psnr, int(abs(a - b).max()), over))

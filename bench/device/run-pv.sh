@@ -159,10 +159,10 @@ if has bench-pvbatch; then
       [ "$r" = 1 ] || ref=(--reference "$work/logs/pvbatch-1${stock:+-stock}.png")
       TAIL=3 run "$tag" 600 "${launch[@]}" "$src/bench/pvbatch-orbit.py" --plugin "$SPACESKIP_PLUGIN" \
         --raw "$raw" --frames "${PVB_FRAMES:-60}" --backend "${PVB_BACKEND:-CUDA}" --view "${PVB_VIEW:-1024}" $stock \
-        ${PVB_ARGS:-} --png "$work/logs/$tag.png" "${ref[@]}"
+        ${PVB_ARGS:-} --png "$work/logs/$tag.png" --result "$work/logs/$tag.result" "${ref[@]}"
     done
   done
-  grep -h "^PVBATCH_ORBIT" "$work"/logs/pvbatch-*.log >> "$out/pv.log"
+  cat "$work"/logs/pvbatch-*.result >> "$out/pv.log" 2>/dev/null
 fi
 if has bench-ts; then
   TAIL=4 run "time-series" 600 "$pvpython" "$src/bench/time-series-vs-stock.py" --plugin "$SPACESKIP_PLUGIN" \
