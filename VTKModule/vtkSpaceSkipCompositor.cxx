@@ -5,6 +5,7 @@
 #include "vtkCommand.h"
 #include "vtkImageData.h"
 #include "vtkLogger.h"
+#include "vtkMath.h"
 #include "vtkOpenGLFramebufferObject.h"
 #include "vtkOpenGLQuadHelper.h"
 #include "vtkOpenGLRenderUtilities.h"
@@ -233,7 +234,15 @@ bool vtkSpaceSkipCompositor::SceneHasDepth(vtkRenderer* ren)
   props->InitTraversal(it);
   while (vtkProp* p = props->GetNextProp(it))
   {
-    if (p->GetVisibility() && !vtkVolume::SafeDownCast(p) && !vtkActor2D::SafeDownCast(p))
+    if (!p->GetVisibility() || vtkVolume::SafeDownCast(p) || vtkActor2D::SafeDownCast(p))
+    {
+      continue;
+    }
+    // A prop with no geometry writes no depth: ParaView's render view keeps a visible actor of
+    // empty bounds in every view, whose depth read cost 2.1-2.7 ms of each 1024^2 frame on the
+    // H200. Bounds it cannot say (null) count as geometry.
+    const double* bounds = p->GetBounds();
+    if (!bounds || vtkMath::AreBoundsInitialized(bounds))
     {
       return true;
     }
