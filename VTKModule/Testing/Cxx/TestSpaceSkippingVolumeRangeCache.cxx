@@ -76,37 +76,26 @@ void Compare(vtkDataArray* a, const std::string& name)
     Check(r[0] == s[0] && r[1] == s[1] && fr[0] == fs[0] && fr[1] == fs[1], line);
   }
 }
+
+// One array of type A with random values, filled and compared with VTK's own ranges.
+template <class A>
+void Case(vtkIdType n, int nc, std::mt19937& rng, const std::string& name)
+{
+  vtkNew<A> a;
+  Randomise(a, n, nc, rng);
+  Compare(a, name);
+}
 }
 
 int TestSpaceSkippingVolumeRangeCache(int, char*[])
 {
   std::mt19937 rng(35);
   const vtkIdType n = 300007;
-  {
-    vtkNew<vtkUnsignedCharArray> a;
-    Randomise(a, n, 1, rng);
-    Compare(a, "uint8");
-  }
-  {
-    vtkNew<vtkShortArray> a;
-    Randomise(a, n, 1, rng);
-    Compare(a, "int16");
-  }
-  {
-    vtkNew<vtkUnsignedShortArray> a;
-    Randomise(a, n, 2, rng);
-    Compare(a, "uint16 x2");
-  }
-  {
-    vtkNew<vtkFloatArray> a;
-    Randomise(a, 4 * n, 1, rng); // more than one parallel chunk (2^20 values)
-    Compare(a, "float with NaN and +-Inf");
-  }
-  {
-    vtkNew<vtkDoubleArray> a;
-    Randomise(a, n, 4, rng);
-    Compare(a, "double x4 with NaN and +-Inf");
-  }
+  Case<vtkUnsignedCharArray>(n, 1, rng, "uint8");
+  Case<vtkShortArray>(n, 1, rng, "int16");
+  Case<vtkUnsignedShortArray>(n, 2, rng, "uint16 x2");
+  Case<vtkFloatArray>(4 * n, 1, rng, "float with NaN and +-Inf"); // more than one parallel chunk (2^20 values)
+  Case<vtkDoubleArray>(n, 4, rng, "double x4 with NaN and +-Inf");
   {
     // VTK answers from the filled cache: values changed without Modified() are not seen.
     vtkNew<vtkFloatArray> a;
