@@ -762,10 +762,15 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   ren->GetTiledSizeAndOrigin(&width, &height, &x0, &y0);
   std::vector<PieceImage> others;
   const double drawnAt = SecondsSince(t0);
-  const vtkSpaceSkipStatistics piece = d.Image.Statistics(true);
+  const bool logPhases = vtkLogger::GetCurrentVerbosityCutoff() >= vtkLogger::VERBOSITY_5;
+  const vtkSpaceSkipStatistics piece = logPhases ? d.Image.Statistics(true) : vtkSpaceSkipStatistics();
   const int draw = exchange->Finish(width, height, mine, others);
   const double exchangedAt = SecondsSince(t0);
   auto phases = [&](const char* end) {
+    if (!logPhases)
+    {
+      return;
+    }
     vtkVLogF(vtkLogger::VERBOSITY_5,
       "exchanged frame: piece %.3f ms (update %.3f, depth read %.3f, engine %.3f, kernel %.3f), "
       "exchange %.3f ms, %s %.3f ms",
@@ -802,8 +807,11 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged, stopAt);
     const double blendedAt = SecondsSince(t0);
     drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
-    vtkVLogF(vtkLogger::VERBOSITY_5, "exchanged frame: blend of %d pieces %.3f ms",
-      static_cast<int>(others.size()), 1e3 * (blendedAt - exchangedAt));
+    if (logPhases)
+    {
+      vtkVLogF(vtkLogger::VERBOSITY_5, "exchanged frame: blend of %d pieces %.3f ms",
+        static_cast<int>(others.size()), 1e3 * (blendedAt - exchangedAt));
+    }
   }
   phases("blend + draw");
   if (!drawn)
