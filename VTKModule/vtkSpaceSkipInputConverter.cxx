@@ -377,7 +377,9 @@ bool vtkSpaceSkipInputConverter::FillRangeCaches(vtkDataArray* array)
     return false;
   }
   vtkInformation* info = array->GetInformation();
-  if (info->Has(vtkAbstractArray::PER_COMPONENT()) && info->Has(vtkAbstractArray::PER_FINITE_COMPONENT()))
+  const bool needAll = !info->Has(vtkAbstractArray::PER_COMPONENT());
+  const bool needFinite = !info->Has(vtkAbstractArray::PER_FINITE_COMPONENT());
+  if (!needAll && !needFinite)
   {
     return false;
   }
@@ -405,16 +407,22 @@ bool vtkSpaceSkipInputConverter::FillRangeCaches(vtkDataArray* array)
     info->Set(key, perComponent);
   };
   const bool integral = type != spaceskip::VoxelType::Float32 && type != spaceskip::VoxelType::Float64;
+  // Only the missing caches are computed (integers: one pass serves both). A component of NaN
+  // only (or of no finite value) leaves the array to VTK.
   std::vector<double> all, finite;
-  if (!ranges(false, all) || !(integral ? (finite = all, true) : ranges(true, finite)))
+  if ((needAll || integral) && !ranges(false, all))
   {
-    return false; // a component of NaN only (or of no finite value): left to VTK
+    return false;
   }
-  if (!info->Has(vtkAbstractArray::PER_COMPONENT()))
+  if (needFinite && !(integral ? (finite = all, true) : ranges(true, finite)))
+  {
+    return false;
+  }
+  if (needAll)
   {
     store(vtkAbstractArray::PER_COMPONENT(), all);
   }
-  if (!info->Has(vtkAbstractArray::PER_FINITE_COMPONENT()))
+  if (needFinite)
   {
     store(vtkAbstractArray::PER_FINITE_COMPONENT(), finite);
   }
