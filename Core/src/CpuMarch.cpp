@@ -498,15 +498,9 @@ HWY_INLINE void PositionalLanes(const LightView& L, VF px, VF py, VF pz, VF& ldx
   hn::Store(py, df, y);
   hn::Store(pz, df, z);
   for (size_t l = 0; l < hn::Lanes(df); ++l) {
-    const vec3f d = vec3f{x[l], y[l], z[l]} - L.pos;
-    const float dist = length(d);
-    const vec3f ld = dist > 0.f ? d * (1.f / dist) : L.dir;
-    float k = 1.f / (L.atten.x + L.atten.y * dist + L.atten.z * dist * dist);
-    if (L.cosCone > -2.f) {
-      const float coneDot = dot(ld, L.dir);
-      k = coneDot >= L.cosCone ? k * powf(coneDot, L.exponent) : 0.f;
-    }
-    x[l] = ld.x, y[l] = ld.y, z[l] = ld.z, a[l] = k;
+    vec3f ld;
+    positionalLight(L, vec3f{x[l], y[l], z[l]}, ld, a[l]);
+    x[l] = ld.x, y[l] = ld.y, z[l] = ld.z;
   }
   ldx = hn::Load(df, x);
   ldy = hn::Load(df, y);

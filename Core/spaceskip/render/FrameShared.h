@@ -69,6 +69,22 @@ struct LightView {
   int positional;
 };
 
+/// A positional light at world point pw (origin-relative): its direction of travel `ld` (unit;
+/// the light's axis where pw is the light's position) and attenuation `att` (distance, then the
+/// spot cone's falloff), as vtkGPUVolumeRayCastMapper computes them. The scalar integrator
+/// (IntervalMarcher::shadeLights) and the CPU ray packets (CpuMarch.cpp, lane by lane) both
+/// call it, so that their images agree bit for bit.
+SS_FUNC void positionalLight(const LightView& L, vec3f pw, vec3f& ld, float& att) {
+  const vec3f d = pw - L.pos;
+  const float dist = length(d);
+  ld = dist > 0.f ? d * (1.f / dist) : L.dir;
+  att = 1.f / (L.atten.x + L.atten.y * dist + L.atten.z * dist * dist);
+  if (L.cosCone > -2.f) {
+    const float coneDot = dot(ld, L.dir);
+    att = coneDot >= L.cosCone ? att * powf(coneDot, L.exponent) : 0.f;
+  }
+}
+
 /// A 2-D transfer function or gradient opacity (TransferFunction::table2D / gradientOpacity) as
 /// the integrator reads it (render/GradientTF.h): their entries follow the 1-D table in the
 /// table the backend uploads (FrameView::tf.table + offset). Composite; one component, or for

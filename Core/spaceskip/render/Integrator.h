@@ -244,16 +244,7 @@ struct IntervalMarcher {
       const LightView& L = f->lights[i];
       vec3f ld = L.dir;
       float att = 1.f;
-      if (L.positional) {
-        const vec3f d = pw - L.pos;
-        const float dist = length(d);
-        ld = dist > 0.f ? d * (1.f / dist) : L.dir;
-        att = 1.f / (L.atten.x + L.atten.y * dist + L.atten.z * dist * dist);
-        if (L.cosCone > -2.f) {
-          const float coneDot = dot(ld, L.dir);
-          att = coneDot >= L.cosCone ? att * powf(coneDot, L.exponent) : 0.f;
-        }
-      }
+      if (L.positional) positionalLight(L, pw, ld, att);
       float nl = dot(n, ld);
       if (nl < 0.f && f->twoSided) nl = -nl;
       if (nl > 0.f) {
