@@ -184,6 +184,8 @@ spaceskip::Counters vtkSpaceSkipImageRenderer::Counts() const
     c.frames += e.frames;
     c.colorCompares += e.colorCompares;
     c.opacityCompares += e.opacityCompares;
+    c.timeSteps += e.timeSteps;
+    c.prefetchedSteps += e.prefetchedSteps;
   }
   return c;
 }
@@ -274,6 +276,12 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
   {
     spaceskip::Engine& engine = *this->Engine;
     this->Frame.ScalarRangeSeconds = this->Input.Update(engine, this->Warn);
+    // The next time step's upload starts now, behind this one's (PrefetchTimeStep).
+    std::string why;
+    if (mode.Prefetch && !this->Input.Prefetch(engine, mode.Prefetch, why) && !why.empty())
+    {
+      this->Warn("PrefetchTimeStep: not prefetched: " + why);
+    }
     // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
     // composite input uses the range of all blocks.
     this->Piece = vtkSpaceSkipInputConverter::PieceOf(input, s.WholeExtent, mode.Owned,
@@ -445,6 +453,8 @@ vtkSpaceSkipStatistics vtkSpaceSkipImageRenderer::Statistics(bool deviceTimes) c
   s.Classifications = c.classifications;
   s.ColorUpdates = c.colorUpdates;
   s.Frames = c.frames;
+  s.TimeSteps = c.timeSteps;
+  s.PrefetchedTimeSteps = c.prefetchedSteps;
   s.ColorTableSamples = this->Properties.GetColorTableSamples();
   s.OpacityTableSamples = this->Properties.GetOpacityTableSamples();
   s.CompositePath = this->Compositor.GetCompositePath();

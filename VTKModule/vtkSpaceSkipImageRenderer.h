@@ -46,6 +46,7 @@ public:
     bool Defer = false;
     bool Exact = false; // no 8-bit rounding bias (composited in float)
     const float* IncomingAlpha = nullptr;
+    vtkDataArray* Prefetch = nullptr; // the next time step's scalars (PrefetchTimeStep)
   };
 
   /**

@@ -207,6 +207,25 @@ bool vtkSpaceSkipInputConverter::Select(vtkImageData* input, vtkDataArray* scala
 }
 
 //------------------------------------------------------------------------------
+namespace
+{
+// The volume's lattice (dims, spacing, origin, direction) of `input`, no voxels yet.
+spaceskip::Volume LatticeOf(vtkImageData* input)
+{
+  spaceskip::Volume v;
+  int dims[3], ext[6];
+  input->GetDimensions(dims);
+  input->GetExtent(ext);
+  v.dims = spaceskip::vec3l{ dims[0], dims[1], dims[2] };
+  const double* sp = input->GetSpacing();
+  std::copy(sp, sp + 3, v.spacing);
+  input->TransformIndexToPhysicalPoint(ext[0], ext[2], ext[4], v.origin);
+  const double* dir = input->GetDirectionMatrix()->GetData();
+  std::copy(dir, dir + 9, v.direction);
+  return v;
+}
+} // namespace
+
 double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnFunction& warnOnce)
 {
   vtkImageData* input = this->Input;
@@ -221,16 +240,7 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
     return 0.0;
   }
   this->Selection = selection;
-  spaceskip::Volume v;
-  int dims[3], ext[6];
-  input->GetDimensions(dims);
-  input->GetExtent(ext);
-  v.dims = spaceskip::vec3l{ dims[0], dims[1], dims[2] };
-  const double* sp = input->GetSpacing();
-  std::copy(sp, sp + 3, v.spacing);
-  input->TransformIndexToPhysicalPoint(ext[0], ext[2], ext[4], v.origin);
-  const double* dir = input->GetDirectionMatrix()->GetData();
-  std::copy(dir, dir + 9, v.direction);
+  spaceskip::Volume v = LatticeOf(input);
   spaceskip::VoxelType vtype = spaceskip::VoxelType::Float32;
   const bool native = CoreTypeOf(scalars->GetDataType(), vtype);
   v.components = this->Dependent ? this->NumberOfComponents : 1;
@@ -273,6 +283,7 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   // settings, memory budget and brick size among them, are already those of this view).
   const int steps = engine.counters().timeSteps;
   engine.setVolume(v);
+  this->Prefetched = nullptr; // taken from the device, or no longer the step that comes
   const bool step = engine.counters().timeSteps > steps;
   // The table's range: for a time step of one component from the engine's brick ranges, which
   // it computes where the voxels land anyway (on the GPU right after the upload; a step's host
@@ -313,12 +324,61 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
 }
 
 //------------------------------------------------------------------------------
+bool vtkSpaceSkipInputConverter::DrawnInPlace(int vtkType)
+{
+  spaceskip::VoxelType t;
+  return CoreTypeOf(vtkType, t);
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkipInputConverter::Prefetch(
+  spaceskip::Engine& engine, vtkDataArray* next, std::string& why)
+{
+  vtkDataArray* shown = this->Borrowed;
+  if (!this->HaveVolume || !shown || this->SecondAxis)
+  {
+    why = "the volume shown is not drawn in place from its array (a converted type, a selected "
+          "component or the magnitude, a second array as the 2-D transfer function's y axis)";
+    return false;
+  }
+  if (next == shown)
+  {
+    return false; // the step shown: nothing to fetch
+  }
+  if (next->GetDataType() != shown->GetDataType() ||
+    next->GetNumberOfComponents() != shown->GetNumberOfComponents() ||
+    next->GetNumberOfTuples() != shown->GetNumberOfTuples() || !next->HasStandardMemoryLayout())
+  {
+    why = std::string("the next step's array (") + next->GetDataTypeAsString() + ", " +
+      std::to_string(next->GetNumberOfComponents()) + " components, " +
+      std::to_string(next->GetNumberOfTuples()) + " tuples) is not of the type, components, "
+      "tuple count and layout of the array shown (" + shown->GetDataTypeAsString() + ", " +
+      std::to_string(shown->GetNumberOfComponents()) + ", " +
+      std::to_string(shown->GetNumberOfTuples()) + ")";
+    return false;
+  }
+  spaceskip::Volume v = LatticeOf(this->Input);
+  spaceskip::VoxelType vtype = spaceskip::VoxelType::Float32;
+  CoreTypeOf(next->GetDataType(), vtype);
+  v.type = vtype;
+  v.components = this->Dependent ? this->NumberOfComponents : 1;
+  v.data = next->GetVoidPointer(0);
+  if (!engine.prefetchVolume(v))
+  {
+    return false; // the backend uploads it when it is shown (the CPU backend reads in place)
+  }
+  this->Prefetched = next;
+  return true;
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkipInputConverter::Reset()
 {
   this->InputKey = this->ScalarsKey = this->YAxisKey = nullptr;
   this->InputMTime = this->ScalarsMTime = this->YAxisMTime = 0;
   this->HaveVolume = false;
   this->Borrowed = nullptr;
+  this->Prefetched = nullptr;
 }
 
 //------------------------------------------------------------------------------

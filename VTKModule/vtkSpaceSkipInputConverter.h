@@ -50,6 +50,16 @@ public:
    */
   double Update(spaceskip::Engine& engine, const WarnFunction& warnOnce);
 
+  /**
+   * A time step's scalars before they are shown (vtkSpaceSkippingVolumeMapper::PrefetchTimeStep):
+   * after this frame's Update, the engine starts uploading `next` (Engine::prefetchVolume), and
+   * a later Update that finds `next` as the scalars takes it from the device. Only for an array
+   * drawn in place as the volume of this frame is (its type, components, tuple count, standard
+   * layout; no second axis): else `why` says why and nothing starts. The array is held until
+   * the next volume reaches the engine. True when the upload started.
+   */
+  bool Prefetch(spaceskip::Engine& engine, vtkDataArray* next, std::string& why);
+
   /// Finite range of the scalars the engine reads ({0, 1} when none is finite); with dependent
   /// components, of component 0 (the colour TF's range, as vtkGPUVolumeRayCastMapper's).
   const double* GetScalarRange() const { return this->ScalarRange; }
@@ -84,6 +94,9 @@ public:
   static spaceskip::VolumePiece PieceOf(vtkImageData* input, const int whole[6], const int* owned,
     bool exact, double bias, const WarnFunction& warn);
 
+  /// Whether scalars of VTK type `vtkType` are drawn in place (no conversion to float).
+  static bool DrawnInPlace(int vtkType);
+
   /// vtkSpaceSkippingVolumeMapper::FillRangeCaches.
   static bool FillRangeCaches(vtkDataArray* array);
 
@@ -115,6 +128,9 @@ private:
   std::vector<float> Converted; // int/long scalars (or a component, the magnitude) as float
   // The array whose voxels the engine borrows: held so it outlives the engine's use of it.
   vtkSmartPointer<vtkDataArray> Borrowed;
+  // The next time step's array whose upload the engine started (Prefetch): held until the next
+  // volume reaches the engine, as Engine::prefetchVolume asks.
+  vtkSmartPointer<vtkDataArray> Prefetched;
   double ScalarRange[2] = { 0, 1 };
   double OpacityRange[2] = { 0, 1 };
 };

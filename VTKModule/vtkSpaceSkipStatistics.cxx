@@ -47,7 +47,8 @@ vtkSpaceSkipStatistics vtkSpaceSkipStatistics::Combine(
     for (int vtkSpaceSkipStatistics::*c :
       { &vtkSpaceSkipStatistics::Builds, &vtkSpaceSkipStatistics::Classifications,
         &vtkSpaceSkipStatistics::ColorUpdates, &vtkSpaceSkipStatistics::Frames,
-        &vtkSpaceSkipStatistics::ColorTableSamples, &vtkSpaceSkipStatistics::OpacityTableSamples })
+        &vtkSpaceSkipStatistics::ColorTableSamples, &vtkSpaceSkipStatistics::OpacityTableSamples,
+        &vtkSpaceSkipStatistics::TimeSteps, &vtkSpaceSkipStatistics::PrefetchedTimeSteps })
     {
       s.*c += b.*c;
     }
@@ -89,4 +90,6 @@ void vtkSpaceSkipStatistics::Print(std::ostream& os, vtkIndent indent) const
   os << indent << "BuildCount: " << this->Builds << "\n";
   os << indent << "ClassifyCount: " << this->Classifications << "\n";
   os << indent << "ColorUpdateCount: " << this->ColorUpdates << "\n";
+  os << indent << "TimeStepCount: " << this->TimeSteps << " (prefetched " << this->PrefetchedTimeSteps
+     << ")\n";
 }

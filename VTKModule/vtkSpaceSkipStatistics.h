@@ -49,6 +49,8 @@ struct vtkSpaceSkipStatistics
   int Frames = 0;
   int ColorTableSamples = 0;
   int OpacityTableSamples = 0;
+  int TimeSteps = 0;           // volumes of the last one's shape (Engine counters' timeSteps)
+  int PrefetchedTimeSteps = 0; // of those, found on the device (PrefetchTimeStep)
 
   /// The mapper's PrintSelf lines for what ran and the hierarchy.
   void Print(std::ostream& os, vtkIndent indent) const;

@@ -6,6 +6,7 @@
 #include "vtkSpaceSkippingVolumeMapper.h"
 
 #include "vtkCompositeDataSet.h"
+#include "vtkDataArray.h"
 #include "vtkImageData.h"
 #include "vtkInformation.h"
 #include "vtkLogger.h"
@@ -29,6 +30,7 @@
 
 #include "spaceskip/Backend.h"
 #include "spaceskip/Engine.h"
+#include "spaceskip/StepMemory.h"
 
 #include <algorithm>
 #include <chrono>
@@ -148,6 +150,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   // How a frame is drawn: a block of composite input (set by vtkBlock) or a piece for the
   // exchange keeps its float image, with the table range of all blocks and its own cells.
   vtkSpaceSkipImageRenderer::FrameMode Mode;
+  vtkSmartPointer<vtkDataArray> NextTimeStep; // PrefetchTimeStep, for the next RenderImage
   double TableRange[2] = { 0, 1 };
   int Owned[6] = { 0, 0, 0, 0, 0, 0 };
 
@@ -344,7 +347,10 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::RenderImage(vtkRenderer* ren, v
   vtkDataArray* scalars = input ? vtkAbstractMapper::GetScalars(input, self->ScalarMode,
                                     self->ArrayAccessMode, self->ArrayId, self->ArrayName, cellFlag)
                                 : nullptr;
-  if (this->Image.Render(ren, vol, renWin, cam, input, scalars, cellFlag, s, this->Mode))
+  vtkSpaceSkipImageRenderer::FrameMode mode = this->Mode;
+  mode.Prefetch = this->NextTimeStep;
+  this->NextTimeStep = nullptr; // one Render() each (the converter holds it while it uploads)
+  if (this->Image.Render(ren, vol, renWin, cam, input, scalars, cellFlag, s, mode))
   {
     this->Image.SetMapperSeconds(SecondsSince(t0));
     this->FrameDrawn(SecondsSince(t0), s.SampleDistance, input);
@@ -443,6 +449,8 @@ vtkStatisticGetterMacro(int, BuildCount, Builds, false);
 vtkStatisticGetterMacro(int, ClassifyCount, Classifications, false);
 vtkStatisticGetterMacro(int, ColorUpdateCount, ColorUpdates, false);
 vtkStatisticGetterMacro(int, FrameCount, Frames, false);
+vtkStatisticGetterMacro(int, TimeStepCount, TimeSteps, false);
+vtkStatisticGetterMacro(int, PrefetchedTimeStepCount, PrefetchedTimeSteps, false);
 vtkStatisticGetterMacro(int, ColorTableSampleCount, ColorTableSamples, false);
 vtkStatisticGetterMacro(int, OpacityTableSampleCount, OpacityTableSamples, false);
 void vtkSpaceSkippingVolumeMapper::GetLastCompositeRect(int rect[4])
@@ -824,6 +832,47 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
 bool vtkSpaceSkippingVolumeMapper::FillRangeCaches(vtkDataArray* array)
 {
   return vtkSpaceSkipInputConverter::FillRangeCaches(array);
+}
+
+//------------------------------------------------------------------------------
+vtkDataArray* vtkSpaceSkippingVolumeMapper::NewTimeStepArray(
+  int dataType, int numberOfComponents, vtkIdType numberOfTuples)
+{
+  if (!vtkSpaceSkipInputConverter::DrawnInPlace(dataType) || numberOfComponents < 1 ||
+    numberOfTuples < 0)
+  {
+    vtkErrorMacro(<< "NewTimeStepArray: no array of type " << dataType << " with "
+                  << numberOfComponents << " components and " << numberOfTuples
+                  << " tuples is drawn in place (types: unsigned char, char, signed char, "
+                     "short, unsigned short, float, double)");
+    return nullptr;
+  }
+  vtkDataArray* a = vtkDataArray::CreateDataArray(dataType);
+  a->SetNumberOfComponents(numberOfComponents);
+  const vtkIdType values = numberOfTuples * numberOfComponents;
+  const size_t bytes = static_cast<size_t>(values) * static_cast<size_t>(a->GetDataTypeSize());
+  const int backend = Overrides().Backend >= 0 ? Overrides().Backend : this->Backend;
+  void* locked = backend == CPU ? nullptr : spaceskip::allocatePageLockedRaw(bytes);
+  if (locked)
+  {
+    a->SetVoidArray(locked, values, 0, vtkAbstractArray::VTK_DATA_ARRAY_USER_DEFINED);
+    a->SetArrayFreeFunction(spaceskip::freePageLocked);
+    return a;
+  }
+  a->SetNumberOfTuples(numberOfTuples);
+  if (values > 0 && !a->GetVoidPointer(0))
+  {
+    vtkErrorMacro(<< "NewTimeStepArray: " << bytes << " bytes cannot be had");
+    a->Delete();
+    return nullptr;
+  }
+  return a;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::PrefetchTimeStep(vtkDataArray* next)
+{
+  this->Internals->NextTimeStep = next;
 }
 
 //------------------------------------------------------------------------------

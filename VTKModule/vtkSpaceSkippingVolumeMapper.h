@@ -39,6 +39,7 @@
 #include "vtkSpaceSkipModule.h"        // For export macro
 #include "vtkSpaceSkipPieceExchange.h" // For PieceImage, PieceExchange
 #include "vtkVolumeMapper.h"
+#include "vtkWrappingHints.h" // For VTK_NEWINSTANCE
 
 #include <map>    // For GetLabelEdits
 #include <memory> // For std::unique_ptr
@@ -417,6 +418,32 @@ public:
 
   ///@{
   /**
+   * Time steps: a simulation's steps played as new scalar arrays of the same image.
+   *
+   * NewTimeStepArray: an array for one step's scalars in host memory that the CUDA backend
+   * uploads at the link's full rate, in one DMA with no staging copy (page-locked; ordinary
+   * memory with Backend CPU or where none can be locked): `dataType` one the mapper draws in
+   * place (VTK_UNSIGNED_CHAR, VTK_CHAR, VTK_SIGNED_CHAR, VTK_SHORT, VTK_UNSIGNED_SHORT,
+   * VTK_FLOAT, VTK_DOUBLE), `numberOfComponents` x `numberOfTuples` values, not initialized. A
+   * reader or simulation that writes its steps into such arrays spares each step the staging
+   * copy that pageable memory takes. Returns a new reference (its memory goes with the last
+   * reference), or nullptr with an error for another type or a size that cannot be had.
+   *
+   * PrefetchTimeStep: the array the input's scalars will be next (drawn in place: the type,
+   * components and tuple count of the scalars shown). At the next Render() the CUDA backend
+   * starts uploading it on a second stream while that frame is drawn; the Render() that shows
+   * it takes it from the device. The mapper holds the array until then: keep its values
+   * unchanged meanwhile. One call serves one Render(). The CPU backend reads voxels in place
+   * and does nothing here; an array that cannot be drawn in place is said once and uploaded when
+   * shown. Image input only (composite input ignores it). nullptr: none.
+   */
+  VTK_NEWINSTANCE
+  vtkDataArray* NewTimeStepArray(int dataType, int numberOfComponents, vtkIdType numberOfTuples);
+  void PrefetchTimeStep(vtkDataArray* next);
+  ///@}
+
+  ///@{
+  /**
    * The range of the 2-D transfer function's y-axis array (Transfer2DYAxisArray, its component
    * Transfer2DYAxisComponent) over the whole data this input is a piece of: the 2-D table's
    * rows span it on every rank, as they span the whole array's range in a serial render (set by
@@ -518,6 +545,10 @@ public:
   int GetClassifyCount();
   int GetColorUpdateCount();
   int GetFrameCount();
+  /// Volumes of the shape shown before (time steps), and how many of them the Render() that
+  /// showed them found on the device (PrefetchTimeStep).
+  int GetTimeStepCount();
+  int GetPrefetchedTimeStepCount();
   /// How often the colour (scalar-opacity) function was sampled into the engine's table: only
   /// when that function, its range (or the property's unit distance, for opacity) changed.
   int GetColorTableSampleCount();

@@ -429,12 +429,21 @@ bool cudaAvailable(std::string* why) {
 
 int64_t cudaDeviceBytesInUse() { return cuda::liveDeviceBytes().load(); }
 
-std::shared_ptr<unsigned char> allocatePageLocked(size_t bytes) {
+void* allocatePageLockedRaw(size_t bytes) {
   void* p = nullptr;
-  if (bytes > 0 && cudaMallocHost(&p, bytes) == cudaSuccess)
-    return std::shared_ptr<unsigned char>(static_cast<unsigned char*>(p), [](unsigned char* q) { cudaFreeHost(q); });
+  if (bytes > 0 && cudaMallocHost(&p, bytes) == cudaSuccess) return p;
   (void)cudaGetLastError();
   return nullptr;
+}
+
+void freePageLocked(void* p) {
+  if (p) cudaFreeHost(p);
+}
+
+std::shared_ptr<unsigned char> allocatePageLocked(size_t bytes) {
+  void* p = allocatePageLockedRaw(bytes);
+  if (!p) return nullptr;
+  return std::shared_ptr<unsigned char>(static_cast<unsigned char*>(p), [](unsigned char* q) { freePageLocked(q); });
 }
 
 std::unique_ptr<Backend> makeCudaBackend() {

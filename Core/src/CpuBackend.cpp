@@ -293,6 +293,8 @@ bool cudaAvailable(std::string* why) {
 }
 int64_t cudaDeviceBytesInUse() { return 0; }
 std::shared_ptr<unsigned char> allocatePageLocked(size_t) { return nullptr; }
+void* allocatePageLockedRaw(size_t) { return nullptr; }
+void freePageLocked(void*) {}
 std::vector<uint8_t> computeDistanceFieldCuda(const OccupancyGrid&, int) {
   throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
 }
