@@ -275,13 +275,8 @@ bool vtkSpaceSkipImageRenderer::Render(vtkRenderer* ren, vtkVolume* vol,
   try
   {
     spaceskip::Engine& engine = *this->Engine;
-    this->Frame.ScalarRangeSeconds = this->Input.Update(engine, this->Warn);
-    // The next time step's upload starts now, behind this one's (PrefetchTimeStep).
-    std::string why;
-    if (mode.Prefetch && !this->Input.Prefetch(engine, mode.Prefetch, why) && !why.empty())
-    {
-      this->Warn("PrefetchTimeStep: not prefetched: " + why);
-    }
+    // With the next time step's upload started behind this one's (PrefetchTimeStep).
+    this->Frame.ScalarRangeSeconds = this->Input.Update(engine, this->Warn, mode.Prefetch);
     // A piece of a larger image (MPI): the whole image's lattice and scalar range. A block of a
     // composite input uses the range of all blocks.
     this->Piece = vtkSpaceSkipInputConverter::PieceOf(input, s.WholeExtent, mode.Owned,

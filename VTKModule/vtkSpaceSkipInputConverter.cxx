@@ -226,7 +226,8 @@ spaceskip::Volume LatticeOf(vtkImageData* input)
 }
 } // namespace
 
-double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnFunction& warnOnce)
+double vtkSpaceSkipInputConverter::Update(
+  spaceskip::Engine& engine, const WarnFunction& warnOnce, vtkDataArray* next)
 {
   vtkImageData* input = this->Input;
   vtkDataArray* scalars = this->Scalars;
@@ -237,6 +238,10 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
     this->Selection == selection && this->YAxisKey == yAxis &&
     (!yAxis || (this->YAxisMTime == yAxis->GetMTime() && this->YAxisComponent == this->YComponent)))
   {
+    if (next)
+    {
+      this->Prefetch(engine, next, warnOnce);
+    }
     return 0.0;
   }
   this->Selection = selection;
@@ -285,6 +290,13 @@ double vtkSpaceSkipInputConverter::Update(spaceskip::Engine& engine, const WarnF
   engine.setVolume(v);
   this->Prefetched = nullptr; // taken from the device, or no longer the step that comes
   const bool step = engine.counters().timeSteps > steps;
+  if (next)
+  {
+    // setVolume(t); prefetchVolume(t + 1), before anything waits for step t: when t was itself
+    // prefetched, t + 1's copy queues right behind it (measured in the VTK window on an H200,
+    // 512^3 uint8: 3.45 ms a step with t + 1 prefetched after t's value ranges, X ms here).
+    this->Prefetch(engine, next, warnOnce);
+  }
   // The table's range: for a time step of one component from the engine's brick ranges, which
   // it computes where the voxels land anyway (on the GPU right after the upload; a step's host
   // pass over its voxels was up to 60 % of the step: 174 ms of 278 ms for 1024^3 float32 on an
@@ -331,31 +343,33 @@ bool vtkSpaceSkipInputConverter::DrawnInPlace(int vtkType)
 }
 
 //------------------------------------------------------------------------------
-bool vtkSpaceSkipInputConverter::Prefetch(
-  spaceskip::Engine& engine, vtkDataArray* next, std::string& why)
+void vtkSpaceSkipInputConverter::Prefetch(
+  spaceskip::Engine& engine, vtkDataArray* next, const WarnFunction& warnOnce)
 {
   vtkDataArray* shown = this->Borrowed;
-  if (!this->HaveVolume || !shown || this->SecondAxis)
-  {
-    why = "the volume shown is not drawn in place from its array (a converted type, a selected "
-          "component or the magnitude, a second array as the 2-D transfer function's y axis)";
-    return false;
-  }
   if (next == shown)
   {
-    return false; // the step shown: nothing to fetch
+    return; // the step shown: nothing to fetch
+  }
+  const std::string prefix = "PrefetchTimeStep: not prefetched: ";
+  if (!shown || this->SecondAxis)
+  {
+    warnOnce(prefix + "the volume shown is not drawn in place from its array (a converted type, a "
+                   "selected component or the magnitude, a second array as the 2-D transfer "
+                   "function's y axis)");
+    return;
   }
   if (next->GetDataType() != shown->GetDataType() ||
     next->GetNumberOfComponents() != shown->GetNumberOfComponents() ||
     next->GetNumberOfTuples() != shown->GetNumberOfTuples() || !next->HasStandardMemoryLayout())
   {
-    why = std::string("the next step's array (") + next->GetDataTypeAsString() + ", " +
+    warnOnce(prefix + "the next step's array (" + next->GetDataTypeAsString() + ", " +
       std::to_string(next->GetNumberOfComponents()) + " components, " +
       std::to_string(next->GetNumberOfTuples()) + " tuples) is not of the type, components, "
       "tuple count and layout of the array shown (" + shown->GetDataTypeAsString() + ", " +
       std::to_string(shown->GetNumberOfComponents()) + ", " +
-      std::to_string(shown->GetNumberOfTuples()) + ")";
-    return false;
+      std::to_string(shown->GetNumberOfTuples()) + ")");
+    return;
   }
   spaceskip::Volume v = LatticeOf(this->Input);
   spaceskip::VoxelType vtype = spaceskip::VoxelType::Float32;
@@ -363,12 +377,10 @@ bool vtkSpaceSkipInputConverter::Prefetch(
   v.type = vtype;
   v.components = this->Dependent ? this->NumberOfComponents : 1;
   v.data = next->GetVoidPointer(0);
-  if (!engine.prefetchVolume(v))
+  if (engine.prefetchVolume(v)) // else it is uploaded when shown (the CPU reads it in place)
   {
-    return false; // the backend uploads it when it is shown (the CPU backend reads in place)
+    this->Prefetched = next;
   }
-  this->Prefetched = next;
-  return true;
 }
 
 //------------------------------------------------------------------------------

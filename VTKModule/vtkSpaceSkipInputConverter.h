@@ -46,19 +46,10 @@ public:
    * Hands the selected volume to the engine when the data, the array or the component changed
    * since the last call (borrowing native single-component arrays, converting the others to
    * float), then recomputes the scalar range. Returns the seconds of that range pass (0 when
-   * nothing changed).
+   * nothing changed). `next` (PrefetchTimeStep): the next time step's array, prefetched right
+   * after the volume is set (Prefetch), so that its copy queues behind this step's.
    */
-  double Update(spaceskip::Engine& engine, const WarnFunction& warnOnce);
-
-  /**
-   * A time step's scalars before they are shown (vtkSpaceSkippingVolumeMapper::PrefetchTimeStep):
-   * after this frame's Update, the engine starts uploading `next` (Engine::prefetchVolume), and
-   * a later Update that finds `next` as the scalars takes it from the device. Only for an array
-   * drawn in place as the volume of this frame is (its type, components, tuple count, standard
-   * layout; no second axis): else `why` says why and nothing starts. The array is held until
-   * the next volume reaches the engine. True when the upload started.
-   */
-  bool Prefetch(spaceskip::Engine& engine, vtkDataArray* next, std::string& why);
+  double Update(spaceskip::Engine& engine, const WarnFunction& warnOnce, vtkDataArray* next = nullptr);
 
   /// Finite range of the scalars the engine reads ({0, 1} when none is finite); with dependent
   /// components, of component 0 (the colour TF's range, as vtkGPUVolumeRayCastMapper's).
@@ -133,6 +124,15 @@ private:
   vtkSmartPointer<vtkDataArray> Prefetched;
   double ScalarRange[2] = { 0, 1 };
   double OpacityRange[2] = { 0, 1 };
+
+  /**
+   * A time step's scalars before they are shown (Update's `next`): the engine starts uploading
+   * `next` (Engine::prefetchVolume) and a later Update that finds it as the scalars takes it from
+   * the device. Only for an array drawn in place as the volume set is (its type, components,
+   * tuple count, standard layout; no second axis): else said once through `warnOnce`. The array
+   * is held until the next volume reaches the engine.
+   */
+  void Prefetch(spaceskip::Engine& engine, vtkDataArray* next, const WarnFunction& warnOnce);
 };
 
 /**
