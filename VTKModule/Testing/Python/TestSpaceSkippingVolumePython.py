@@ -4,13 +4,16 @@ A wavelet (vtkRTAnalyticSource) whose opacity is 0 below 200, so about half the 
 empty; CPU backend. Checks: the wrapped mapper takes VTK's own vtkImageData/vtkVolume/vtkRenderer;
 an all-transparent transfer function draws nothing (so the emptiness check below can fail) while
 the real one draws; Grid and KdTreeCPU give Naive's image within 1/255; the statistics read back
-(Grid has no tree: node count and height are checked on the k-d tree).
+(Grid has no tree: node count and height are checked on the k-d tree); time steps in
+NewTimeStepArray's arrays written through numpy and played with PrefetchTimeStep, each frame equal
+to the frame of the same values in an ordinary array.
 Exit status 0 on success; an AssertionError (status 1) names what differed.
 """
 import sys
 
 import numpy
-from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+from vtkmodules.vtkCommonCore import VTK_FLOAT, VTK_INT
 from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
 from vtkmodules.vtkImagingCore import vtkRTAnalyticSource
 from vtkmodules.vtkRenderingCore import (vtkColorTransferFunction, vtkRenderer, vtkRenderWindow,
@@ -121,6 +124,37 @@ def main():
     assert mapper.GetBuilderUsed() == "KdTreeCPU", mapper.GetBuilderUsed()
     assert mapper.GetNodeCount() > 0 and mapper.GetTreeHeight() > 0
     assert mapper.GetFrameCount() >= 4, mapper.GetFrameCount()  # grab() may render again
+
+    # Time steps from Python: NewTimeStepArray's arrays written through numpy (no copy), the next
+    # one handed to PrefetchTimeStep before each frame; each frame equals the frame of the same
+    # values in an ordinary array (the wavelet shifted by k, as float).
+    values = vtk_to_numpy(image.GetPointData().GetScalars()).astype(numpy.float32)
+    n = image.GetNumberOfPoints()
+    steps, expected = [], []
+    mapper.SetBuilderToGrid()
+    for k in range(3):
+        a = mapper.NewTimeStepArray(VTK_FLOAT, 1, n)
+        assert a is not None and a.GetNumberOfTuples() == n and a.GetDataType() == VTK_FLOAT
+        vtk_to_numpy(a)[:] = values + 6.0 * k  # writes the array's own memory
+        a.SetName("step")
+        steps.append(a)
+        plain = numpy_to_vtk(values + 6.0 * k, deep=1)
+        plain.SetName("step")
+        image.GetPointData().SetScalars(plain)
+        window.Render()
+        expected.append(grab(window))
+    for i in range(5):
+        image.GetPointData().SetScalars(steps[i % 3])
+        mapper.PrefetchTimeStep(steps[(i + 1) % 3])
+        window.Render()
+        diff = int(numpy.abs(grab(window).astype(int) - expected[i % 3].astype(int)).max())
+        assert diff <= 1, "time step %d differs from its ordinary array's frame by %d/255" % (i % 3, diff)
+    assert mapper.GetTimeStepCount() >= 5, mapper.GetTimeStepCount()
+    errors = []
+    mapper.AddObserver("ErrorEvent", lambda obj, event: errors.append(event))  # observed: not printed
+    assert mapper.NewTimeStepArray(VTK_INT, 1, 4) is None and len(errors) == 1  # refused, with an error
+    print("time steps through NewTimeStepArray + PrefetchTimeStep: %d played, each == its static frame"
+          % 5)
     print("ok")
     return 0
 
