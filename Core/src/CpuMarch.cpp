@@ -212,9 +212,10 @@ vec4f scalarPixel(const FrameView& f, const T* v, int64_t nx, int64_t ny, int64_
 
 /// Composite frames the packets take, with or without clipping planes and cropping: unshaded,
 /// or shaded with the headlight model or the light list (ParaView's light kit, positional and
-/// spot lights); no scattering, 2-D transfer function or gradient opacity.
+/// spot lights); the 1-D transfer function, gradient opacity or a 2-D transfer function over
+/// the gradient magnitude (not over a second array: two components); no scattering.
 inline bool packetFrame(const FrameView& f) {
-  if (!(f.blend == BlendMode::Composite && f.gtf.mode == 0)) return false;
+  if (!(f.blend == BlendMode::Composite && f.gtf.mode >= 0 && f.gtf.mode <= 2)) return false;
   if (!f.shade) return true;
   return !f.scatter.on;
 }
@@ -612,17 +613,101 @@ HWY_INLINE void ShadeLanes(const FrameView& f, const LaneShading<T>& S, VF& r, V
             zero, one);
 }
 
-/// lookup() of samples v and IntervalMarcher::composite into (ax, ay, az, aw) for the live
-/// lanes: NaN is transparent; opacity first, colour only where a lane composites (shaded when
-/// `S` is given); a lane that composites and reaches the threshold stops.
+/// gradientMagnitude (render/GradientTF.h) lane by lane at the lanes' positions: VTK's normalised
+/// gradient magnitude in [0, 1] (NaN: 0), with the scalar code's central differences.
 template <class T>
-HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF live, const LaneShading<T>* S,
-                                VF& ax, VF& ay, VF& az, VF& aw, MF& stopped) {
+HWY_INLINE VF GradientMagnitudeLanes(const FrameView& f, const LaneShading<T>& S) {
+  const DF df;
+  const VF one = hn::Set(df, 1.f), zero = hn::Zero(df);
+  // p + vec3f{1, 0, 0} adds 0.f to the other coordinates, as in ShadeLanes.
+  const VF xp = hn::Add(S.x, zero), yp = hn::Add(S.y, zero), zp = hn::Add(S.z, zero);
+  const float* k = f.gtf.gradScale;
+  const VF gx = hn::Mul(hn::Sub(Sample(S.vox, S.nx, S.ny, S.nz, hn::Add(S.x, one), yp, zp),
+                                Sample(S.vox, S.nx, S.ny, S.nz, hn::Sub(S.x, one), S.y, S.z)),
+                        hn::Set(df, k[0]));
+  const VF gy = hn::Mul(hn::Sub(Sample(S.vox, S.nx, S.ny, S.nz, xp, hn::Add(S.y, one), zp),
+                                Sample(S.vox, S.nx, S.ny, S.nz, S.x, hn::Sub(S.y, one), S.z)),
+                        hn::Set(df, k[1]));
+  const VF gz = hn::Mul(hn::Sub(Sample(S.vox, S.nx, S.ny, S.nz, xp, yp, hn::Add(S.z, one)),
+                                Sample(S.vox, S.nx, S.ny, S.nz, S.x, S.y, hn::Sub(S.z, one))),
+                        hn::Set(df, k[2]));
+  const VF m = hn::Sqrt(hn::Add(hn::Add(hn::Mul(gx, gx), hn::Mul(gy, gy)), hn::Mul(gz, gz)));
+  return hn::IfThenZeroElse(hn::IsNaN(m), Clamp(m, zero, one));
+}
+
+/// texelAxis (render/GradientTF.h) lane by lane: the entries i0, i1 of `n` and the weight at
+/// texel-centred positions x (not NaN).
+HWY_INLINE void TexelAxisLanes(VF x, int n, VI& i0, VI& i1, VF& w) {
+  const DF df;
+  const DI di;
+  x = Clamp(x, hn::Zero(df), hn::Set(df, float(n - 1)));
+  i0 = hn::ConvertTo(di, x);
+  i1 = hn::Min(hn::Add(i0, hn::Set(di, 1)), hn::Set(di, n - 1));
+  w = hn::Sub(x, hn::ConvertTo(df, i0));
+}
+
+/// Channel `c` of entries `i` of the vec4f table at `T` (one gather).
+HWY_INLINE VF TableChannel(const float* T, VI i, int c) {
+  const DF df;
+  return hn::GatherIndex(df, T + c, hn::ShiftLeft<2>(i));
+}
+
+/// a + (b - a) * w, as lerp4 and lookup() take it.
+HWY_INLINE VF Lerp(VF a, VF b, VF w) { return hn::Add(a, hn::Mul(hn::Sub(b, a), w)); }
+
+/// classifyWithGradient's 2-D table (mode 2) lane by lane: table2DAt at the column of value v
+/// (not NaN) and the row of gradient magnitude gm.
+HWY_INLINE void Table2DLanes(const FrameView& f, VF v, VF gm, VF& r, VF& g, VF& b, VF& a) {
+  const DF df;
+  const GradientTFView& G = f.gtf;
+  const float* T = reinterpret_cast<const float*>(f.tf.table + G.offset);
+  const VF half = hn::Set(df, 0.5f);
+  VI x0, x1, y0, y1;
+  VF wx, wy;
+  TexelAxisLanes(hn::Sub(hn::Mul(hn::Sub(v, hn::Set(df, G.xLo)), hn::Set(df, G.xScale)), half), G.width, x0, x1, wx);
+  TexelAxisLanes(hn::Sub(hn::Mul(gm, hn::Set(df, float(G.height))), half), G.height, y0, y1, wy);
+  const DI di;
+  const VI w = hn::Set(di, G.width);
+  const VI r0 = hn::Mul(y0, w), r1 = hn::Mul(y1, w);
+  const VI ia = hn::Add(r0, x0), ib = hn::Add(r0, x1), ic = hn::Add(r1, x0), id = hn::Add(r1, x1);
+  VF* out[4] = {&r, &g, &b, &a};
+  for (int c = 0; c < 4; ++c) {
+    const VF ab = Lerp(TableChannel(T, ia, c), TableChannel(T, ib, c), wx);
+    const VF cd = Lerp(TableChannel(T, ic, c), TableChannel(T, id, c), wx);
+    *out[c] = Lerp(ab, cd, wy);
+  }
+}
+
+/// lookup() of samples v (or classifyWithGradient's gradient opacity or 2-D table) and
+/// IntervalMarcher::composite into (ax, ay, az, aw) for the live lanes: NaN is transparent;
+/// opacity first, colour only where a lane composites (shaded when `shade`); a lane that
+/// composites and reaches the threshold stops. `S` holds the lanes' positions.
+template <class T>
+HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF live, const LaneShading<T>& S,
+                                bool shade, VF& ax, VF& ay, VF& az, VF& aw, MF& stopped) {
   const DF df;
   const DI di;
   const VF onef = hn::Set(df, 1.f), ert = hn::Set(df, f.ertThreshold);
   const VF tfLo = hn::Set(df, f.tf.lo), tfScale = hn::Set(df, f.tf.scale), tfHi = hn::Set(df, float(f.tf.size - 1));
   const int64_t pairStride = 2 * int64_t(f.tf.size);  // floats per channel in `pairs`
+  if (f.gtf.mode == 2) {
+    // The 2-D table at (value, gradient magnitude): colour and raw opacity (NaN: transparent).
+    const MF nanV = hn::IsNaN(v);
+    const MF any = hn::AndNot(nanV, live);
+    if (hn::AllFalse(df, any)) return;
+    VF cx, cy, cz, cw;
+    Table2DLanes(f, hn::IfThenZeroElse(nanV, v), GradientMagnitudeLanes(f, S), cx, cy, cz, cw);
+    const MF comp = hn::And(any, hn::Gt(cw, hn::Zero(df)));
+    if (hn::AllFalse(df, comp)) return;
+    if (shade) ShadeLanes(f, S, cx, cy, cz);
+    const VF w = hn::Mul(hn::Sub(onef, aw), cw);
+    ax = hn::IfThenElse(comp, hn::Add(ax, hn::Mul(w, cx)), ax);
+    ay = hn::IfThenElse(comp, hn::Add(ay, hn::Mul(w, cy)), ay);
+    az = hn::IfThenElse(comp, hn::Add(az, hn::Mul(w, cz)), az);
+    aw = hn::IfThenElse(comp, hn::Add(aw, w), aw);
+    stopped = hn::Or(stopped, hn::AndNot(hn::Lt(aw, ert), comp));
+    return;
+  }
   VF xt = hn::Mul(hn::Sub(v, tfLo), tfScale);
   const MF nan = hn::IsNaN(xt);
   xt = Clamp(hn::IfThenZeroElse(nan, xt), hn::Zero(df), tfHi);
@@ -632,9 +717,20 @@ HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF
   const VI q = hn::ShiftLeft<1>(e0);
   VF a0, a1;
   GatherPairs(pairs + 3 * pairStride, q, a0, a1);
-  const VF cw = hn::Add(a0, hn::Mul(hn::Sub(a1, a0), fr));
-  const MF comp = hn::And(live, hn::AndNot(nan, hn::Gt(cw, hn::Zero(df))));
+  VF cw = hn::Add(a0, hn::Mul(hn::Sub(a1, a0), fr));
+  MF comp = hn::And(live, hn::AndNot(nan, hn::Gt(cw, hn::Zero(df))));
   if (hn::AllFalse(df, comp)) return;
+  if (f.gtf.mode == 1) {
+    // Gradient opacity: the 1-D opacity times the table's factor at the gradient magnitude.
+    const float* go = reinterpret_cast<const float*>(f.tf.table + f.gtf.offset);
+    VI i0, i1;
+    VF wg;
+    TexelAxisLanes(hn::Sub(hn::Mul(GradientMagnitudeLanes(f, S), hn::Set(df, float(f.gtf.width))), hn::Set(df, 0.5f)),
+                   f.gtf.width, i0, i1, wg);
+    cw = hn::Mul(cw, Lerp(TableChannel(go, i0, 3), TableChannel(go, i1, 3), wg));
+    comp = hn::And(comp, hn::Gt(cw, hn::Zero(df)));
+    if (hn::AllFalse(df, comp)) return;
+  }
   VF r0, r1, g0, g1, b0, b1;
   GatherPairs(pairs, q, r0, r1);
   GatherPairs(pairs + pairStride, q, g0, g1);
@@ -642,7 +738,7 @@ HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF
   VF cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
   VF cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
   VF cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
-  if (S) ShadeLanes(f, *S, cx, cy, cz);
+  if (shade) ShadeLanes(f, S, cx, cy, cz);
   // IntervalMarcher::composite, front-to-back "over".
   const VF w = hn::Mul(hn::Sub(onef, aw), cw);
   ax = hn::IfThenElse(comp, hn::Add(ax, hn::Mul(w, cx)), ax);
@@ -671,7 +767,6 @@ HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox
                    vox_, voy, voz, vdx, vdy, vdz,
                    hn::Load(df, P.wox), hn::Load(df, P.woy), hn::Load(df, P.woz),
                    hn::Load(df, P.wdx), hn::Load(df, P.wdy), hn::Load(df, P.wdz)};
-  const LaneShading<T>* shade = f.shade ? &S : nullptr;
   VI k = hn::Load(di, P.kc), kEnd = hn::Load(di, P.ke);
   VF ax = hn::Zero(df), ay = hn::Zero(df), az = hn::Zero(df), aw = hn::Zero(df);
   MF stopped = hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd)));  // no samples, or terminated
@@ -686,7 +781,7 @@ HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox
     S.y = hn::Add(voy, hn::Mul(vdy, t));
     S.z = hn::Add(voz, hn::Mul(vdz, t));
     const VF v = Sample(vox, nx, ny, nz, S.x, S.y, S.z);
-    LookupComposite(f, pairs, v, live, shade, ax, ay, az, aw, stopped);
+    LookupComposite(f, pairs, v, live, S, f.shade, ax, ay, az, aw, stopped);
     k = hn::Add(k, one);
   }
   HWY_ALIGN float rx[kMaxLanes], ry[kMaxLanes], rz[kMaxLanes], rw[kMaxLanes];

@@ -11,19 +11,7 @@ using namespace spaceskip;
 
 namespace {
 
-/// A 2-D table over [lo, hi] x gradient magnitude: opaque (alpha `a`) in a box of normalised
-/// value [x0, x1] and normalised gradient magnitude [y0, y1], colour varying over both axes.
-void setBox(TransferFunction& tf, int w, int h, float x0, float x1, float y0, float y1, float a) {
-  tf.width2D = w;
-  tf.height2D = h;
-  tf.table2D.assign(size_t(w) * size_t(h), vec4f{0, 0, 0, 0});
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const float u = (float(x) + 0.5f) / float(w), g = (float(y) + 0.5f) / float(h);
-      const bool in = u >= x0 && u <= x1 && g >= y0 && g <= y1;
-      tf.table2D[size_t(y) * size_t(w) + size_t(x)] = vec4f{u, 1.f - g, 0.5f, in ? a : 0.f};
-    }
-}
+using test::setBox;
 
 vec4f at(const Image& img, int x, int y) { return img.rgba[size_t(y) * size_t(img.width) + size_t(x)]; }
 
