@@ -94,11 +94,13 @@ private:
   MessageFunction Warn;
   MessageFunction Fail;
   ProgressFunction Progress;
+  // Before the engine, so that it goes after it: the arrays it holds (the volume the engine
+  // borrows, a time step whose copy the engine may still be making) outlive the engine's use.
+  vtkSpaceSkipInputConverter Input;
   std::unique_ptr<spaceskip::Engine> Engine;
   int EngineBackend = -1;
   spaceskip::Counters CountOffset; // stages run by engines replaced after a backend change
   spaceskip::Tuning Tuning;
-  vtkSpaceSkipInputConverter Input;
   vtkSpaceSkipPropertyTranslator Properties;
   vtkSpaceSkipStatistics Frame; // the last frame's times and what ran
   spaceskip::Image Image;
