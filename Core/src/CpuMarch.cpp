@@ -690,54 +690,48 @@ HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF
   const VF onef = hn::Set(df, 1.f), ert = hn::Set(df, f.ertThreshold);
   const VF tfLo = hn::Set(df, f.tf.lo), tfScale = hn::Set(df, f.tf.scale), tfHi = hn::Set(df, float(f.tf.size - 1));
   const int64_t pairStride = 2 * int64_t(f.tf.size);  // floats per channel in `pairs`
+  VF cx, cy, cz, cw;  // the sample's colour and opacity where it composites (comp)
+  MF comp;
   if (f.gtf.mode == 2) {
     // The 2-D table at (value, gradient magnitude): colour and raw opacity (NaN: transparent).
     const MF nanV = hn::IsNaN(v);
     const MF any = hn::AndNot(nanV, live);
     if (hn::AllFalse(df, any)) return;
-    VF cx, cy, cz, cw;
     Table2DLanes(f, hn::IfThenZeroElse(nanV, v), GradientMagnitudeLanes(f, S), cx, cy, cz, cw);
-    const MF comp = hn::And(any, hn::Gt(cw, hn::Zero(df)));
+    comp = hn::And(any, hn::Gt(cw, hn::Zero(df)));
     if (hn::AllFalse(df, comp)) return;
-    if (shade) ShadeLanes(f, S, cx, cy, cz);
-    const VF w = hn::Mul(hn::Sub(onef, aw), cw);
-    ax = hn::IfThenElse(comp, hn::Add(ax, hn::Mul(w, cx)), ax);
-    ay = hn::IfThenElse(comp, hn::Add(ay, hn::Mul(w, cy)), ay);
-    az = hn::IfThenElse(comp, hn::Add(az, hn::Mul(w, cz)), az);
-    aw = hn::IfThenElse(comp, hn::Add(aw, w), aw);
-    stopped = hn::Or(stopped, hn::AndNot(hn::Lt(aw, ert), comp));
-    return;
-  }
-  VF xt = hn::Mul(hn::Sub(v, tfLo), tfScale);
-  const MF nan = hn::IsNaN(xt);
-  xt = Clamp(hn::IfThenZeroElse(nan, xt), hn::Zero(df), tfHi);
-  const VI e0 = hn::ConvertTo(di, xt);
-  const VF fr = hn::Sub(xt, hn::ConvertTo(df, e0));
-  // Entry e0 and the next one (e1 = min(e0 + 1, size - 1)) side by side in the pair table.
-  const VI q = hn::ShiftLeft<1>(e0);
-  VF a0, a1;
-  GatherPairs(pairs + 3 * pairStride, q, a0, a1);
-  VF cw = hn::Add(a0, hn::Mul(hn::Sub(a1, a0), fr));
-  MF comp = hn::And(live, hn::AndNot(nan, hn::Gt(cw, hn::Zero(df))));
-  if (hn::AllFalse(df, comp)) return;
-  if (f.gtf.mode == 1) {
-    // Gradient opacity: the 1-D opacity times the table's factor at the gradient magnitude.
-    const float* go = reinterpret_cast<const float*>(f.tf.table + f.gtf.offset);
-    VI i0, i1;
-    VF wg;
-    TexelAxisLanes(hn::Sub(hn::Mul(GradientMagnitudeLanes(f, S), hn::Set(df, float(f.gtf.width))), hn::Set(df, 0.5f)),
-                   f.gtf.width, i0, i1, wg);
-    cw = hn::Mul(cw, Lerp(TableChannel(go, i0, 3), TableChannel(go, i1, 3), wg));
-    comp = hn::And(comp, hn::Gt(cw, hn::Zero(df)));
+  } else {
+    VF xt = hn::Mul(hn::Sub(v, tfLo), tfScale);
+    const MF nan = hn::IsNaN(xt);
+    xt = Clamp(hn::IfThenZeroElse(nan, xt), hn::Zero(df), tfHi);
+    const VI e0 = hn::ConvertTo(di, xt);
+    const VF fr = hn::Sub(xt, hn::ConvertTo(df, e0));
+    // Entry e0 and the next one (e1 = min(e0 + 1, size - 1)) side by side in the pair table.
+    const VI q = hn::ShiftLeft<1>(e0);
+    VF a0, a1;
+    GatherPairs(pairs + 3 * pairStride, q, a0, a1);
+    cw = hn::Add(a0, hn::Mul(hn::Sub(a1, a0), fr));
+    comp = hn::And(live, hn::AndNot(nan, hn::Gt(cw, hn::Zero(df))));
     if (hn::AllFalse(df, comp)) return;
+    if (f.gtf.mode == 1) {
+      // Gradient opacity: the 1-D opacity times the table's factor at the gradient magnitude.
+      const float* go = reinterpret_cast<const float*>(f.tf.table + f.gtf.offset);
+      VI i0, i1;
+      VF wg;
+      TexelAxisLanes(hn::Sub(hn::Mul(GradientMagnitudeLanes(f, S), hn::Set(df, float(f.gtf.width))), hn::Set(df, 0.5f)),
+                     f.gtf.width, i0, i1, wg);
+      cw = hn::Mul(cw, Lerp(TableChannel(go, i0, 3), TableChannel(go, i1, 3), wg));
+      comp = hn::And(comp, hn::Gt(cw, hn::Zero(df)));
+      if (hn::AllFalse(df, comp)) return;
+    }
+    VF r0, r1, g0, g1, b0, b1;
+    GatherPairs(pairs, q, r0, r1);
+    GatherPairs(pairs + pairStride, q, g0, g1);
+    GatherPairs(pairs + 2 * pairStride, q, b0, b1);
+    cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
+    cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
+    cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
   }
-  VF r0, r1, g0, g1, b0, b1;
-  GatherPairs(pairs, q, r0, r1);
-  GatherPairs(pairs + pairStride, q, g0, g1);
-  GatherPairs(pairs + 2 * pairStride, q, b0, b1);
-  VF cx = hn::Add(r0, hn::Mul(hn::Sub(r1, r0), fr));
-  VF cy = hn::Add(g0, hn::Mul(hn::Sub(g1, g0), fr));
-  VF cz = hn::Add(b0, hn::Mul(hn::Sub(b1, b0), fr));
   if (shade) ShadeLanes(f, S, cx, cy, cz);
   // IntervalMarcher::composite, front-to-back "over".
   const VF w = hn::Mul(hn::Sub(onef, aw), cw);
