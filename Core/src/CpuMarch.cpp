@@ -330,10 +330,10 @@ HWY_INLINE void Axis(VF p, VF hiF, VI hiI, VI& i0, VF& fr) {
 
 constexpr size_t kMaxLanes = HWY_MAX_BYTES / sizeof(float);
 
-/// A packet's lanes: each one's ray, lattice anchor t0, current run of samples [kc, ke), its
-/// traversal, and where its pixel goes (outAt, -1: nowhere).
-template <class Iter>
-struct PacketLanes {
+/// A packet's rays, lane by lane: each one's ray, lattice anchor t0, current run of samples
+/// [kc, ke) and where its pixel goes (outAt, -1: nowhere). What the march needs of a packet,
+/// whatever its traversal (PacketLanes adds that).
+struct PacketRays {
   HWY_ALIGN float ox[kMaxLanes], oy[kMaxLanes], oz[kMaxLanes], dx[kMaxLanes], dy[kMaxLanes], dz[kMaxLanes],
       t0[kMaxLanes];
   // Shaded frames: the headlight model's light and view directions, the ray in world space.
@@ -341,7 +341,6 @@ struct PacketLanes {
       wox[kMaxLanes], woy[kMaxLanes], woz[kMaxLanes], wdx[kMaxLanes], wdy[kMaxLanes], wdz[kMaxLanes];
   HWY_ALIGN int32_t kc[kMaxLanes], ke[kMaxLanes];
   int64_t outAt[kMaxLanes];
-  march_detail::LaneParts<Iter> runs[kMaxLanes];
 
   /// Lane l's ray, anchor and shading vectors from its set-up.
   void put(size_t l, const march_detail::LaneSetup& s) {
@@ -356,11 +355,24 @@ struct PacketLanes {
   }
 };
 
+/// A packet's rays and each lane's traversal (its drawn parts and their runs).
+template <class Iter>
+struct PacketLanes : PacketRays {
+  march_detail::LaneParts<Iter> runs[kMaxLanes];
+};
+
+/// The pixel at (x, y) as the scalar integrator draws it (march_detail::scalarPixel for the
+/// frame's voxel type): pixels a packet leaves to renderPixel.
+using ScalarPixelFn = vec4f (*)(const FrameView&, const void* vox, int64_t nx, int64_t ny, int64_t nz, int x, int y);
+/// Gives the lanes whose run is used up (kc == ke, stop[l] == 0) their next run.
+using AdvanceFn = void (*)(const FrameView&, PacketRays&, const int32_t* stop);
+
 /// Sets up the packet of pixels from (bx, by) (bw wide, clipped to x1, y1), lane by lane. Empty
 /// pixels and those left to renderPixel are written at once. false: no lane marches.
-template <class T, class Iter>
-HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_t ny, int64_t nz, int bx, int by,
-                            int bw, int x1, int y1, vec4f* px, PacketLanes<Iter>& P) {
+/// Not inlined, and independent of the voxel type: one copy per traversal and target.
+template <class Iter>
+HWY_NOINLINE bool SetupPacket(const FrameView& f, ScalarPixelFn scalar, const void* vox, int64_t nx, int64_t ny,
+                              int64_t nz, int bx, int by, int bw, int x1, int y1, vec4f* px, PacketLanes<Iter>& P) {
   using march_detail::LaneSetup;
   const size_t N = hn::Lanes(DF());
   bool any = false;
@@ -378,7 +390,7 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
       continue;
     }
     if (s.kind == LaneSetup::Scalar) {
-      px[at] = march_detail::scalarPixel(f, vox, nx, ny, nz, x, y);
+      px[at] = scalar(f, vox, nx, ny, nz, x, y);
       continue;
     }
     P.outAt[l] = at;
@@ -394,17 +406,13 @@ HWY_INLINE bool SetupPacket(const FrameView& f, const T* vox, int64_t nx, int64_
   return any;
 }
 
-/// Lanes whose run is used up (and that have not stopped) take their next run
-/// (IntervalMarcher::marchRuns, lane by lane); lanes with none left stop.
+/// AdvanceFn of traversal Iter (IntervalMarcher::marchRuns, lane by lane): lanes with no run
+/// left get an empty one. Not inlined: the march calls it through a pointer when a lane's run
+/// is used up, so that the march is compiled once per voxel type, not per type and traversal.
 template <class Iter>
-HWY_INLINE void NextRuns(const FrameView& f, PacketLanes<Iter>& P, VI& k, VI& kEnd, MF& stopped) {
-  const DF df;
-  const DI di;
-  const size_t N = hn::Lanes(df);
-  hn::Store(k, di, P.kc);
-  hn::Store(kEnd, di, P.ke);
-  HWY_ALIGN int32_t stop[kMaxLanes];
-  hn::Store(hn::VecFromMask(di, hn::RebindMask(di, stopped)), di, stop);
+HWY_NOINLINE void AdvanceLanes(const FrameView& f, PacketRays& R, const int32_t* stop) {
+  PacketLanes<Iter>& P = static_cast<PacketLanes<Iter>&>(R);
+  const size_t N = hn::Lanes(DF());
   for (size_t l = 0; l < N; ++l) {
     if (stop[l] || P.kc[l] < P.ke[l]) continue;
     int64_t kb = 0, kx = 0;
@@ -415,6 +423,18 @@ HWY_INLINE void NextRuns(const FrameView& f, PacketLanes<Iter>& P, VI& k, VI& kE
       P.kc[l] = P.ke[l] = 0;
     }
   }
+}
+
+/// Lanes whose run is used up (and that have not stopped) take their next run; lanes with none
+/// left stop.
+HWY_INLINE void NextRuns(const FrameView& f, PacketRays& P, AdvanceFn advance, VI& k, VI& kEnd, MF& stopped) {
+  const DF df;
+  const DI di;
+  hn::Store(k, di, P.kc);
+  hn::Store(kEnd, di, P.ke);
+  HWY_ALIGN int32_t stop[kMaxLanes];
+  hn::Store(hn::VecFromMask(di, hn::RebindMask(di, stopped)), di, stop);
+  advance(f, P, stop);
   k = hn::Load(di, P.kc);
   kEnd = hn::Load(di, P.ke);
   stopped = hn::Or(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
@@ -743,10 +763,13 @@ HWY_INLINE void LookupComposite(const FrameView& f, const float* pairs, VF v, MF
   stopped = hn::Or(stopped, hn::AndNot(hn::Lt(aw, ert), comp));
 }
 
-/// Marches the set-up packet P to the end (all lanes stopped) and writes its pixels.
-template <class T, class Iter>
-HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny, int64_t nz,
-                            PacketLanes<Iter>& P, vec4f* px) {
+/// Marches the set-up packet P to the end (all lanes stopped) and writes its pixels; `advance`
+/// gives the lanes their next runs (AdvanceLanes of the frame's traversal). Not inlined: one copy
+/// per voxel type and target (the sampling, lookup and shading code is most of this file's
+/// machine code and compile time).
+template <class T>
+HWY_NOINLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny,
+                              int64_t nz, PacketRays& P, AdvanceFn advance, vec4f* px) {
   const DF df;
   const DI di;
   const size_t N = hn::Lanes(df);
@@ -766,7 +789,7 @@ HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox
   MF stopped = hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd)));  // no samples, or terminated
   for (;;) {
     const MF spent = hn::AndNot(stopped, hn::RebindMask(df, hn::Not(hn::Lt(k, kEnd))));
-    if (!hn::AllFalse(df, spent)) NextRuns(f, P, k, kEnd, stopped);
+    if (!hn::AllFalse(df, spent)) NextRuns(f, P, advance, k, kEnd, stopped);
     const MF live = hn::Not(stopped);
     if (hn::AllFalse(df, live)) break;
     // IntervalMarcher::take(k): t = t0 + float(k) * dt, p = org + dir * t.
@@ -787,6 +810,11 @@ HWY_INLINE void MarchPacket(const FrameView& f, const float* pairs, const T* vox
     if (P.outAt[l] >= 0) px[P.outAt[l]] = vec4f{rx[l], ry[l], rz[l], rw[l]};
 }
 
+template <class T>
+vec4f ScalarPixelOf(const FrameView& f, const void* vox, int64_t nx, int64_t ny, int64_t nz, int x, int y) {
+  return march_detail::scalarPixel(f, static_cast<const T*>(vox), nx, ny, nz, x, y);
+}
+
 template <class T, class Iter>
 void MarchTileT(const FrameView& f, const float* pairs, const T* vox, int64_t nx, int64_t ny, int64_t nz, int x0,
                 int y0, int x1, int y1, vec4f* px) {
@@ -798,7 +826,8 @@ void MarchTileT(const FrameView& f, const float* pairs, const T* vox, int64_t nx
   PacketLanes<Iter> P;
   for (int by = y0; by < y1; by += bh)
     for (int bx = x0; bx < x1; bx += bw)
-      if (SetupPacket(f, vox, nx, ny, nz, bx, by, bw, x1, y1, px, P)) MarchPacket(f, pairs, vox, nx, ny, nz, P, px);
+      if (SetupPacket(f, &ScalarPixelOf<T>, vox, nx, ny, nz, bx, by, bw, x1, y1, px, P))
+        MarchPacket(f, pairs, vox, nx, ny, nz, P, &AdvanceLanes<Iter>, px);
 }
 
 template <class T>
