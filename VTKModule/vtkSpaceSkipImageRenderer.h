@@ -77,6 +77,9 @@ public:
   void SetReport(bool report) { this->Report = report; }
   vtkSpaceSkipCompositor& GetCompositor() { return this->Compositor; }
   void ReleaseGraphicsResources(vtkWindow* win) { this->Compositor.ReleaseGraphicsResources(win); }
+  /// The next Render's input is a rectilinear grid's points drawn through its coordinates
+  /// (vtkSpaceSkipRectilinearImage path 4), or an image (nullptr).
+  void SetWarp(std::shared_ptr<const spaceskip::AxisWarp> warp) { this->Input.SetWarp(std::move(warp)); }
 
 private:
   bool UpdateEngine(int backend);

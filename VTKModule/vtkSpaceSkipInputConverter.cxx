@@ -233,7 +233,8 @@ double vtkSpaceSkipInputConverter::Update(
   vtkDataArray* scalars = this->Scalars;
   const int selection = this->Dependent ? -2 : (this->Magnitude ? -1 : this->Component);
   vtkDataArray* yAxis = this->SecondAxis ? this->YAxis : nullptr;
-  if (this->HaveVolume && this->InputKey == input && this->InputMTime == input->GetMTime() &&
+  if (this->HaveVolume && this->WarpKey == this->Warp.get() && this->InputKey == input &&
+    this->InputMTime == input->GetMTime() &&
     this->ScalarsKey == scalars && this->ScalarsMTime == scalars->GetMTime() &&
     this->Selection == selection && this->YAxisKey == yAxis &&
     (!yAxis || (this->YAxisMTime == yAxis->GetMTime() && this->YAxisComponent == this->YComponent)))
@@ -286,6 +287,16 @@ double vtkSpaceSkipInputConverter::Update(
   }
   // A time step, as the engine counts one (a volume of the last one's shape: the engine's other
   // settings, memory budget and brick size among them, are already those of this view).
+  if (this->Warp && v.components == 1)
+  {
+    v.warp = this->Warp; // a rectilinear grid through its coordinates
+  }
+  else if (this->Warp)
+  {
+    warnOnce("a rectilinear grid with more than one drawn component is drawn as the uniform image "
+             "of its points (its coordinates are not used)");
+  }
+  this->WarpKey = this->Warp.get();
   const int steps = engine.counters().timeSteps;
   engine.setVolume(v);
   this->Prefetched = nullptr; // taken from the device, or no longer the step that comes
@@ -797,7 +808,7 @@ bool vtkSpaceSkipRectilinearImage::WholeGrid::Valid() const
 
 //------------------------------------------------------------------------------
 vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
-  const WarnFunction& warn, std::string& problem, const WholeGrid* wholeGrid)
+  const WarnFunction& warn, std::string& problem, const WholeGrid* wholeGrid, bool throughCoordinates)
 {
   const WholeGrid whole = wholeGrid && wholeGrid->Valid() ? *wholeGrid : WholeGrid();
   vtkDataArray* coords[3] = { grid->GetXCoordinates(), grid->GetYCoordinates(),
@@ -812,7 +823,8 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
       std::equal(w.SmallestStep, w.SmallestStep + 3, whole.SmallestStep) &&
       std::equal(w.Extent, w.Extent + 6, whole.Extent);
   };
-  if (this->Key == grid && this->MTime == mtime && sameWhole(this->KeyWhole))
+  if (this->Key == grid && this->MTime == mtime && sameWhole(this->KeyWhole) &&
+    this->KeyThrough == throughCoordinates)
   {
     problem = this->Problem;
     return this->Image;
@@ -820,7 +832,9 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
   this->Key = grid;
   this->MTime = mtime;
   this->KeyWhole = whole;
+  this->KeyThrough = throughCoordinates;
   this->Image = nullptr;
+  this->Warp = nullptr;
   this->Path = 0;
   this->Problem.clear();
   int ext[6];
@@ -881,6 +895,56 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
     this->Image = image;
     this->Path = 1;
     return this->Image;
+  }
+  // The whole grid (serially ParaView gives its own extent as the whole one): drawn through its
+  // coordinates where the mapper allows it.
+  const bool alone = !whole.Valid() || std::equal(whole.Extent, whole.Extent + 6, ext);
+  if (throughCoordinates && alone)
+  {
+    std::vector<double> axis[3];
+    const double* at[3];
+    int64_t count[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      axis[a].resize(static_cast<size_t>(axes[a].Count));
+      for (vtkIdType i = 0; i < axes[a].Count; ++i)
+      {
+        axis[a][static_cast<size_t>(i)] = coords[a]->GetComponent(i, 0);
+      }
+      at[a] = axis[a].data();
+      count[a] = axes[a].Count;
+    }
+    try
+    {
+      auto warp = spaceskip::AxisWarp::fromCoordinates(at, count);
+      // The virtual lattice: index (i, j, k) of the extent at first + (i - ext0) * step per axis,
+      // a descending axis with -1 in the direction matrix, as for a uniform grid.
+      auto image = vtkSmartPointer<vtkImageData>::New();
+      image->SetExtent(ext);
+      double spacing[3], origin[3];
+      double direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+      for (int a = 0; a < 3; ++a)
+      {
+        const double sign = axes[a].Mean < 0 ? -1.0 : 1.0;
+        spacing[a] = warp->spacing(a);
+        direction[4 * a] = sign;
+        origin[a] = axes[a].First - sign * spacing[a] * ext[2 * a];
+      }
+      image->SetSpacing(spacing);
+      image->SetOrigin(origin);
+      image->SetDirectionMatrix(direction);
+      image->GetPointData()->ShallowCopy(grid->GetPointData());
+      image->GetCellData()->ShallowCopy(grid->GetCellData());
+      image->GetFieldData()->ShallowCopy(grid->GetFieldData());
+      this->Image = image;
+      this->Warp = std::move(warp);
+      this->Path = 4;
+      return this->Image;
+    }
+    catch (const std::exception& e)
+    {
+      warn(name + ": " + e.what() + "; resampled instead");
+    }
   }
   if (descending)
   {
@@ -978,7 +1042,8 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
     std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]) +
     " lattice (the smallest step per axis, at most " +
     std::to_string(static_cast<int>(kMaxResampleFactor)) + "x the " + (piece ? "whole " : "") +
-    "grid's points); sampling through the coordinate arrays is not done yet");
+    "grid's points); a whole grid drawn alone, linear interpolation and one drawn component are "
+    "drawn through the coordinates instead");
   if (!seams.empty())
   {
     warn(name + ": the piece's ghost layers do not reach the lattice points next to the cells it "

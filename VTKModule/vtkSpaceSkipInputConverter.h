@@ -7,6 +7,7 @@
 #include "vtkType.h"         // For vtkMTimeType, vtkIdType
 
 #include <functional> // For WarnFunction
+#include <memory>     // For the warp
 #include <string>     // For the problem and warning texts
 #include <vector>     // For Converted
 
@@ -16,6 +17,7 @@ class vtkRectilinearGrid;
 namespace spaceskip
 {
 class Engine;
+struct AxisWarp;
 struct VolumePiece;
 }
 
@@ -50,6 +52,13 @@ public:
    * after the volume is set (Prefetch), so that its copy queues behind this step's.
    */
   double Update(spaceskip::Engine& engine, const WarnFunction& warnOnce, vtkDataArray* next = nullptr);
+
+  /**
+   * The input is a rectilinear grid's points on the virtual lattice over its bounds, drawn
+   * through the grid's coordinates (spaceskip::AxisWarp; vtkSpaceSkipRectilinearImage path 4);
+   * nullptr: an image. A change reaches the engine with the next Update.
+   */
+  void SetWarp(std::shared_ptr<const spaceskip::AxisWarp> warp) { this->Warp = std::move(warp); }
 
   /// Finite range of the scalars the engine reads ({0, 1} when none is finite); with dependent
   /// components, of component 0 (the colour TF's range, as vtkGPUVolumeRayCastMapper's).
@@ -115,6 +124,8 @@ private:
   int YAxisComponent = 0;
   vtkMTimeType YAxisMTime = 0;
   bool HaveVolume = false;
+  std::shared_ptr<const spaceskip::AxisWarp> Warp;
+  const void* WarpKey = nullptr; // the warp the engine's volume has
   int Selection = 0; // the component the volume was made from; -1: the magnitude; -2: all
   std::vector<float> Converted; // int/long scalars (or a component, the magnitude) as float
   // The array whose voxels the engine borrows: held so it outlives the engine's use of it.
@@ -143,6 +154,11 @@ private:
  *   the same points as an image (origin and extent from the first coordinates, spacing the mean
  *   steps; a descending array: a positive spacing and -1 in the direction matrix), the grid's
  *   point, cell and field data shallow-copied (no copy of the scalars). Drawn as that image.
+ * - Otherwise, with `throughCoordinates` (a whole grid, not a piece; one drawn component, linear
+ *   interpolation: the mapper decides), strictly monotonic coordinates, ascending or descending:
+ *   the grid's arrays shallow-copied onto the virtual lattice over its bounds (spacing (last -
+ *   first) / (n - 1) per axis) and the coordinates as a spaceskip::AxisWarp, through which the
+ *   engine samples the grid exactly (trilinear in the grid's cells); nothing resampled, no warning.
  * - Otherwise (strictly monotonic coordinates): one warning naming the grid and its largest
  *   relative step deviation, then every point array of the grid resampled (trilinear within
  *   the grid's cells, as float: what vtkResampleToImage gives, without its per-point cell
@@ -176,11 +192,13 @@ public:
   /// The image to draw for `grid` (nullptr, with `problem` set, when nothing can be drawn);
   /// with `whole`, `grid` is a piece of that grid.
   vtkImageData* From(vtkRectilinearGrid* grid, const WarnFunction& warn, std::string& problem,
-    const WholeGrid* whole = nullptr);
+    const WholeGrid* whole = nullptr, bool throughCoordinates = false);
 
   /// How the last image was made: 0 none, 1 the uniform grid's arrays, 2 resampled on a lattice
   /// of the grid's own (its extent is not the grid's: a WholeExtent of the grid's pieces does not
-  /// apply to it), 3 resampled on the whole grid's lattice (GetLatticeWholeExtent()).
+  /// apply to it), 3 resampled on the whole grid's lattice (GetLatticeWholeExtent()), 4 the
+  /// non-uniform grid's own arrays on the virtual lattice over its bounds, drawn through its
+  /// coordinates (GetWarp()).
   int GetPath() const { return this->Path; }
   /// Path 3: the whole grid's lattice's extent (the piece's image lies on it).
   const int* GetLatticeWholeExtent() const { return this->LatticeWhole; }
@@ -188,6 +206,9 @@ public:
   vtkImageData* GetImage() const { return this->Image; }
   /// Lets go of the last image (the input is no longer a grid); the next From makes one again.
   void Release() { *this = vtkSpaceSkipRectilinearImage(); }
+  /// Path 4: the grid's coordinates, through which the image (the grid's points on the virtual
+  /// lattice over its bounds) is drawn; null on the other paths.
+  const std::shared_ptr<const spaceskip::AxisWarp>& GetWarp() const { return this->Warp; }
 
 private:
   vtkSmartPointer<vtkImageData> Image;
@@ -195,6 +216,8 @@ private:
   vtkMTimeType MTime = 0;
   WholeGrid KeyWhole;
   int Path = 0;
+  bool KeyThrough = false;
+  std::shared_ptr<const spaceskip::AxisWarp> Warp;
   int LatticeWhole[6] = { 0, -1, 0, -1, 0, -1 };
   std::string Problem;
 };

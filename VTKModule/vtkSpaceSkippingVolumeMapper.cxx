@@ -180,6 +180,26 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   double FrameSampleDistance(vtkRenderer* ren, vtkVolume* vol, vtkImageData* image, double still, bool piece);
   void FrameDrawn(double seconds, double distance, vtkImageData* image);
 
+  /// Whether a non-uniform rectilinear grid is drawn through its coordinates
+  /// (vtkSpaceSkipRectilinearImage path 4): drawn alone (no pieces composited across
+  /// processes), one drawn component (a component or the magnitude of several, not dependent
+  /// components), linear interpolation, no label map, no second array as the 2-D transfer
+  /// function's y axis. Else it is resampled, as before.
+  bool ThroughCoordinates(vtkVolume* vol, vtkRectilinearGrid* grid)
+  {
+    vtkSpaceSkippingVolumeMapper* self = this->Self;
+    vtkVolumeProperty* prop = vol ? vol->GetProperty() : nullptr;
+    if (!prop || this->Exchange || self->GetLabelMap() || self->GetTransfer2DYAxisArray() ||
+      prop->GetInterpolationType() != VTK_LINEAR_INTERPOLATION)
+    {
+      return false;
+    }
+    int cellFlag = 0;
+    vtkDataArray* scalars = vtkAbstractMapper::GetScalars(
+      grid, self->ScalarMode, self->ArrayAccessMode, self->ArrayId, self->ArrayName, cellFlag);
+    return scalars && cellFlag == 0 &&
+      (scalars->GetNumberOfComponents() == 1 || prop->GetIndependentComponents() != 0);
+  }
   void RenderImage(vtkRenderer* ren, vtkVolume* vol, vtkOpenGLRenderWindow* renWin, vtkOpenGLCamera* cam,
     vtkImageData* input, bool resampled);
   void RenderComposite(vtkRenderer* ren, vtkVolume* vol, vtkDataObject* input);
@@ -682,18 +702,19 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
     std::copy_n(d.WholeGridSteps, 3, whole.SmallestStep);
     std::copy_n(this->WholeExtent, 6, whole.Extent);
     std::string problem;
-    image = d.Rectilinear.From(grid, d.Warn, problem, &whole);
+    image = d.Rectilinear.From(grid, d.Warn, problem, &whole, d.ThroughCoordinates(vol, grid));
     if (!image)
     {
       d.Fail(problem);
       return;
     }
-    resampled = d.Rectilinear.GetPath() >= 2;
+    resampled = d.Rectilinear.GetPath() == 2 || d.Rectilinear.GetPath() == 3;
   }
   else if (d.Rectilinear.GetImage())
   {
     d.Rectilinear.Release(); // a grid's image (a resampled copy) is not kept for an image input
   }
+  d.Image.SetWarp(d.Rectilinear.GetImage() ? d.Rectilinear.GetWarp() : nullptr);
   d.RenderImage(ren, vol, renWin, cam, image, resampled);
 }
 

@@ -35,7 +35,7 @@ const std::set<std::string>& valueOptions() {
   return s;
 }
 const std::set<std::string>& flagOptions() {
-  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper", "--no-in-core", "--nearest", "--check"};
+  static const std::set<std::string> s = {"--perspective", "--jitter", "--paper", "--no-in-core", "--nearest", "--check", "--rectilinear"};
   return s;
 }
 

@@ -97,6 +97,8 @@ options:
                        (VolumetricScatteringBlending 0..2, GlobalIlluminationReach 0..1,
                        ScatteringAnisotropy -1..1); shades with the headlight
   --nearest          nearest-voxel sampling instead of trilinear
+  --rectilinear      the volume's points as a rectilinear grid over the same bounds (x steps
+                     growing 1:3, z steps varying ~1:2), drawn through its coordinates
   --label-map nearest|blend  8/16-bit integer voxels as label ids: every id but 0 a label of its
                      own colour, opacity 0.5 (render); blend: smooth borders, never a label that
                      is not among the 8 voxels around a sample   --hide-labels ID1,ID2,...

@@ -48,7 +48,15 @@ class CudaBackend final : public Backend {
       // The step after it (Engine::prefetchVolume) starts now, into the buffer just swapped out.
       if (prefetchedLast_ && haveNext) (void)prefetchVolume(nextVolume_);
       if (!prefetchedLast_) vol_->upload(v, stream_);
-      cls_.setVolume(*vol_, brick, stream_);
+      vol_->setWarp(v, stream_);
+      // A rectilinear grid (AxisWarp.h): the virtual lattice's ranges from the host's voxels (the
+      // grid's bricks remapped), no sub-brick masks (they read voxels by the lattice's index).
+      const RangeGrid warpRanges = v.warp ? computeRangeGrid(v, brick) : RangeGrid{};
+      if (v.warp) {
+        cls_.setRanges(v, warpRanges, stream_);
+      } else {
+        cls_.setVolume(*vol_, brick, stream_);
+      }
       SS_CUDA_CHECK(cudaStreamSynchronize(stream_));
       inCore_ = ResidencyStats{};
       inCore_.budgetBytes = budget;
@@ -56,9 +64,14 @@ class CudaBackend final : public Backend {
     }
     // Sparse residency (BrickPool.h): the value ranges from the host's voxels, and a pool of
     // the budget's size that each frame fills with the bricks it needs.
+    if (v.warp)
+      throw BackendError("a rectilinear grid is drawn through its coordinates with the whole grid on the device: " +
+                         std::to_string(v.byteSize()) + " bytes exceed the memory budget of " + std::to_string(budget) +
+                         " bytes");
     finishPrefetch();
     prefetchedLast_ = false;
     vol_->describe(v);
+    vol_->setWarp(v, stream_);
     const RangeGrid ranges = computeRangeGrid(v, brick);
     cls_.setRanges(v, ranges, stream_);
     SS_CUDA_CHECK(cudaStreamSynchronize(stream_));

@@ -167,6 +167,9 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   prepareShadowQueue(f, pixels, stream);
   SS_CUDA_CHECK(cudaEventRecord(ev0_, stream));
   const Volume& v = vol.volume();
+  const AxisWarpView warp = vol.warp();
+  if (warp.on() && (pool || f.sampling != kSampleTrilinear))
+    throw BackendError("a rectilinear grid is drawn through its coordinates in core, with trilinear sampling only");
   if (pool) {  // sparse residency: the resident bricks, exact sampling
     dispatchVoxelType(v.type, [&](auto t) {
       using T = decltype(t);
@@ -184,13 +187,13 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
       launch(f, ChannelSampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z, v.components}, grid, block, 0,
              stream);
     });
-  } else if (filter == FilterMode::Hardware) {
+  } else if (filter == FilterMode::Hardware && !warp.on()) {  // a warp reads the grid exactly
     const TextureSampler s = vol.texture(stream);
     launch(f, s, grid, block, vol.textureBytes(), stream);
   } else {
     dispatchVoxelType(v.type, [&](auto t) {
       using T = decltype(t);
-      launch(f, ArraySampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z}, grid, block, 0, stream);
+      launch(f, ArraySampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z, warp}, grid, block, 0, stream);
     });
   }
   SS_CUDA_CHECK_LAUNCH(renderKernel);

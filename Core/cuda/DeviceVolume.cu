@@ -34,6 +34,31 @@ void DeviceVolume::upload(const Volume& v, cudaStream_t stream) {
   staging_->copy(d_voxels_.get(), v.data, bytes, stream);
 }
 
+void DeviceVolume::setWarp(const Volume& v, cudaStream_t stream) {
+  warpView_ = AxisWarpView{};
+  warpHost_ = v.warp;
+  if (!v.warp) return;
+  // One buffer: the three coordinate tables (float), then the three cell tables (int32).
+  size_t n = 0;
+  for (int a = 0; a < 3; ++a) n += v.warp->c[a].size();
+  d_warp_.reserve(n * (sizeof(float) + sizeof(int32_t)));
+  unsigned char* base = d_warp_.get();
+  size_t off = 0;
+  for (int a = 0; a < 3; ++a) {
+    const size_t bytes = v.warp->c[a].size() * sizeof(float);
+    SS_CUDA_CHECK(cudaMemcpyAsync(base + off, v.warp->c[a].data(), bytes, cudaMemcpyHostToDevice, stream));
+    warpView_.c[a] = reinterpret_cast<const float*>(base + off);
+    warpView_.n[a] = int32_t(v.warp->c[a].size());
+    off += bytes;
+  }
+  for (int a = 0; a < 3; ++a) {
+    const size_t bytes = v.warp->cell[a].size() * sizeof(int32_t);
+    SS_CUDA_CHECK(cudaMemcpyAsync(base + off, v.warp->cell[a].data(), bytes, cudaMemcpyHostToDevice, stream));
+    warpView_.cell[a] = reinterpret_cast<const int32_t*>(base + off);
+    off += bytes;
+  }
+}
+
 DeviceVolume::DeviceVolume() = default;
 DeviceVolume::~DeviceVolume() { destroyTexture(); }
 

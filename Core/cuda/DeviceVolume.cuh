@@ -46,6 +46,11 @@ class DeviceVolume {
   TextureSampler texture(cudaStream_t stream);
   /// Bytes of the texture's array (0 before texture()).
   size_t textureBytes() const { return arrayBytes_; }
+  /// The device copy of `v`'s warp tables (a rectilinear grid, AxisWarp.h), queued on `stream`;
+  /// none for an image.
+  void setWarp(const Volume& v, cudaStream_t stream);
+  /// The warp as the samplers read it on the device (off for an image).
+  AxisWarpView warp() const { return warpView_; }
 
  private:
   void destroyTexture();
@@ -57,6 +62,9 @@ class DeviceVolume {
   size_t arrayBytes_ = 0;
   cudaTextureObject_t tex_ = 0;
   float texScale_ = 1.f;
+  DeviceBuffer<unsigned char> d_warp_;
+  AxisWarpView warpView_{};
+  std::shared_ptr<const AxisWarp> warpHost_;  ///< the host tables, alive while their copy is queued
 };
 
 }  // namespace spaceskip::cuda

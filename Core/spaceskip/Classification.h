@@ -80,8 +80,15 @@ decltype(auto) dispatchComponents(int components, F&& f) {
   return f(std::integral_constant<int, 1>());
 }
 
-/// Parallel (oneTBB) computation of the range grid.
+/// Parallel (oneTBB) computation of the range grid. A warped volume (AxisWarp.h): the virtual
+/// lattice's bricks, each the union of the grid's bricks its samples read (remapRangeGrid).
 RangeGrid computeRangeGrid(const Volume& v, int brick = 8);
+
+/// The range grid of warp `w`'s virtual lattice from the range grid `grid` of the grid's own
+/// index space (the same point counts and brick size): virtual brick b's range is the union of
+/// the ranges of the grid bricks holding the cells that samples in b read (AxisWarp::cellSpan),
+/// so that it bounds every sample inside b, as a brick's range does for an image.
+RangeGrid remapRangeGrid(const RangeGrid& grid, const AxisWarp& w);
 
 /// One byte per brick: 1 when some sample inside can have opacity > 0 and be drawn.
 struct OccupancyGrid {

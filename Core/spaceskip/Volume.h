@@ -1,5 +1,6 @@
 // A uniform-grid scalar volume: 64-bit dims, voxel type, spacing/origin/direction.
 #pragma once
+#include "AxisWarp.h"
 #include "Math.h"
 
 #include <cstddef>
@@ -49,6 +50,10 @@ struct Volume {
   const void* data = nullptr;
   std::shared_ptr<std::vector<unsigned char>> storage;
   int components = 1;  ///< 1, 2 or 4 (see above; validate() refuses others)
+  /// A rectilinear grid's coordinates (AxisWarp.h), or none: a uniform image. With a warp,
+  /// spacing/origin/direction describe the virtual lattice over the grid's bounds and the
+  /// voxels are the grid's points; one component.
+  std::shared_ptr<const AxisWarp> warp;
 
   int64_t voxelCount() const { return dims.x * dims.y * dims.z; }
   size_t byteSize() const { return size_t(voxelCount()) * size_t(components) * voxelSize(type); }

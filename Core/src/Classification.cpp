@@ -65,7 +65,53 @@ RangeGrid computeRangeGrid(const Volume& v, int brick) {
   dispatchVoxelType(v.type, [&](auto t) {
     dispatchComponents(v.components, [&](auto nc) { rangesOf<decltype(t), decltype(nc)::value>(v, g); });
   });
-  return g;
+  return v.warp ? remapRangeGrid(g, *v.warp) : g;
+}
+
+RangeGrid remapRangeGrid(const RangeGrid& grid, const AxisWarp& w) {
+  RangeGrid out;
+  out.brick = grid.brick;
+  out.cellDims = grid.cellDims;
+  out.dims = grid.dims;
+  out.vmin.resize(size_t(out.size()));
+  out.vmax.resize(size_t(out.size()));
+  const int B = grid.brick;
+  // Per axis, virtual brick b -> the grid bricks [lo[b], hi[b]] holding the cells it reads.
+  std::vector<int> lo[3], hi[3];
+  const int bricks[3] = {grid.dims.x, grid.dims.y, grid.dims.z};
+  const int cells[3] = {grid.cellDims.x, grid.cellDims.y, grid.cellDims.z};
+  for (int a = 0; a < 3; ++a) {
+    lo[a].resize(size_t(bricks[a]));
+    hi[a].resize(size_t(bricks[a]));
+    for (int b = 0; b < bricks[a]; ++b) {
+      if (w.points(a) < 2) {  // one point: one cell of constant value
+        lo[a][size_t(b)] = hi[a][size_t(b)] = b;
+        continue;
+      }
+      int64_t i0 = 0, i1 = 0;
+      w.cellSpan(a, int64_t(b) * B, std::min<int64_t>(int64_t(b + 1) * B, cells[a]), i0, i1);
+      lo[a][size_t(b)] = int(std::min<int64_t>(i0 / B, bricks[a] - 1));
+      hi[a][size_t(b)] = int(std::min<int64_t>(i1 / B, bricks[a] - 1));
+    }
+  }
+  tbb::parallel_for(tbb::blocked_range<int>(0, out.dims.z), [&](const tbb::blocked_range<int>& r) {
+    for (int z = r.begin(); z != r.end(); ++z)
+      for (int y = 0; y < out.dims.y; ++y)
+        for (int x = 0; x < out.dims.x; ++x) {
+          float mn = std::numeric_limits<float>::infinity(), mx = -std::numeric_limits<float>::infinity();
+          for (int gz = lo[2][size_t(z)]; gz <= hi[2][size_t(z)]; ++gz)
+            for (int gy = lo[1][size_t(y)]; gy <= hi[1][size_t(y)]; ++gy)
+              for (int gx = lo[0][size_t(x)]; gx <= hi[0][size_t(x)]; ++gx) {
+                const int64_t i = grid.index(gx, gy, gz);
+                mn = std::min(mn, grid.vmin[size_t(i)]);
+                mx = std::max(mx, grid.vmax[size_t(i)]);
+              }
+          const int64_t o = out.index(x, y, z);
+          out.vmin[size_t(o)] = mn;
+          out.vmax[size_t(o)] = mx;
+        }
+  });
+  return out;
 }
 
 OccupancyGrid classify(const RangeGrid& ranges, const TransferFunction& tf, const CropClip& cc) {
@@ -141,7 +187,9 @@ OccupancyGrid classifyWithGradientRows(const RangeGrid& ranges, const TransferFu
 
 SubMasks computeSubMasks(const Volume& v, const OccupancyGrid& occ, const TransferFunction& tf, const Tuning& t) {
   SubMasks out;
-  if (!t.subMasks || !usesSubMasks(occ.brick) || v.components != 1 || !v.data || occ.occ.empty()) return out;
+  // Not for a warped volume: the masks read voxels by the virtual lattice's index (AxisWarp.h).
+  if (!t.subMasks || !usesSubMasks(occ.brick) || v.components != 1 || !v.data || occ.occ.empty() || v.warp)
+    return out;
   out.mask.resize(size_t(occ.size()));
   out.state.resize(size_t(occ.size()));
   OpacityRangeMax rmq(tf);

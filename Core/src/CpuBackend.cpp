@@ -32,7 +32,8 @@ class CpuBackend final : public Backend {
     pool_.release();
     // Sparse residency in host memory when a budget below the volume is set (the device
     // pool's rules, checked here without a GPU); one component only, else in core.
-    if (budget_ > 0 && int64_t(v.byteSize()) > budget_ && v.components == 1)
+    // Not for a warped volume (AxisWarp.h): the pool's bricks are read by the lattice's index.
+    if (budget_ > 0 && int64_t(v.byteSize()) > budget_ && v.components == 1 && !v.warp)
       pool_.init(v, ranges_.brick, poolBrick_, budget_);
     dist_.clear();
     sub_ = SubMasks{};
@@ -179,6 +180,13 @@ class CpuBackend final : public Backend {
 
   template <class T>
   void run(const FrameView& f, Image& out) {
+    if (volume_.warp) {  // a rectilinear grid through its coordinates (AxisWarp.h): the scalar integrator
+      if (f.sampling != kSampleTrilinear)
+        throw BackendError("a rectilinear grid is drawn through its coordinates with trilinear sampling only");
+      tiles(f, out, ArraySampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y,
+                                    volume_.dims.z, volume_.warp->view()});
+      return;
+    }
     if (f.sampling != kSampleTrilinear && volume_.components == 1) {  // nearest, label maps (LabelSampler.h)
       tiles(f, out, NearestSampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y,
                                       volume_.dims.z, f.sampling});

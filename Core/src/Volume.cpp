@@ -229,6 +229,12 @@ void validate(const Volume& v) {
   for (int i = 0; i < 3; ++i)
     if (!(v.spacing[i] > 0) || !std::isfinite(v.spacing[i]))
       throw std::runtime_error("volume spacing must be positive and finite");
+  if (v.warp) {
+    if (v.warp->points(0) != v.dims.x || v.warp->points(1) != v.dims.y || v.warp->points(2) != v.dims.z)
+      throw std::runtime_error("rectilinear grid: the coordinate counts differ from the volume's dimensions");
+    if (v.components != 1)
+      throw std::runtime_error("rectilinear grid: drawn through its coordinates with one component only");
+  }
 }
 
 }  // namespace spaceskip

@@ -7,7 +7,8 @@ Usage: pvbatch parallel_scene.py OUT.png [builder] [scene]
            planes where the pieces meet), "shell" (the plugin tests' 64^3 reference scene) or
            "vtpd=PATH" (the MNI scene read from a partitioned data set file: its partitions go
            to the ranks as they are), "rect" (the MNI scene, each piece as the
-           vtkRectilinearGrid of its points), "rectnu" (the same with non-uniform coordinates), "raw16=PATH" (the MNI head as 16-bit CT-like values,
+           vtkRectilinearGrid of its points), "rectnu" (the same with non-uniform coordinates; drawn serially through
+           its coordinates, its pieces under MPI resampled on the whole grid's lattice), "raw16=PATH" (the MNI head as 16-bit CT-like values,
            v * 12 + 24, read from a little-endian raw file by ParaView's Image Reader as a new
            user would: 'unsigned short', DataByteOrder, DataExtent), "vti=PATH" (the same 16-bit
            head from a .vti file, XML Image Data Reader). With raw16 and vti the view keeps

@@ -56,8 +56,10 @@ ranks 51.03 / 49.94 dB, max 3/255, 13.7 % / 18.0 % of the pixels off by more tha
 (vtkGPUVolumeRayCastMapper's threshold), and the compositing gives a pixel whose opacity
 reached it nothing from the pieces behind (the serial ray stopped in front of them).
 With --rectilinear-nonuniform the pieces' coordinates are non-uniform (point i of an axis moved
-by 1.5 sin(0.37 i) of a step, steps 0.45..1.55; parallel_scene.py's scene "rectnu"): the mapper
-resamples the serial grid on a uniform lattice (the smallest step per axis, coarsened to at most
+by 1.5 sin(0.37 i) of a step, steps 0.45..1.55; parallel_scene.py's scene "rectnu"): serially the
+mapper draws the grid through its coordinates (printed and held to >= 40 dB against the N-rank
+images); the reference is the serial grid resampled by vtkResampleToImage on the lattice the
+mapper resamples each rank's piece on: a uniform lattice (the smallest step per axis, coarsened to at most
 4x the grid's points: 156 x 185 x 152), and each rank's piece on that same lattice (the
 representation gathers the whole grid's smallest steps; the lattice cells a piece owns start at
 the first lattice point at or after its first owned grid point), so the pieces are pieces of one
@@ -228,12 +230,6 @@ tag = ("_" + ct_reader if ct_reader else ("_" + rect_scene if rectilinear else (
     "_opaque" if opaque else "")))) + ("_shade" if shade else "")
 serial = image("parallel_serial_%s%s.png" % (builder, tag))
 serial_scene = mpi_scene if ct_reader else ([rect_scene] if rectilinear else [])
-rc, _ = run([pvbatch, scene, serial, builder] + serial_scene, 150)
-ok.check(rc == 0 and os.path.exists(serial), "serial pvbatch rendered (rc %d)" % rc)
-a = ssptest.read_png(serial) if os.path.exists(serial) else None
-if a is not None:
-    ok.check(ssptest.lit_fraction(a) > 0.1, "the serial image shows the volume (%.1f%% lit)"
-             % (100 * ssptest.lit_fraction(a)))
 env_args = []
 # What the ranks' scene script reads (parallel_scene.py); the piece bias is a Tuning field the
 # plugin sets, not an environment variable.
@@ -243,6 +239,35 @@ for name in ("DISPLAY", "PYTHONPATH", "SPACESKIP_PLUGIN", "SPACESKIP_DATA", "SPA
              "SPACESKIP_TEST_BACKEND"):
     if name in os.environ:
         env_args += ["-x", name]
+exact = None
+if nonuniform:
+    # Serially the grid is drawn through its coordinates; its pieces under MPI are resampled on
+    # the whole grid's lattice. The reference is then the first N-rank image (pieces cut
+    # elsewhere must draw it: pieces of one image, no seam), and the serial image is held to it
+    # within what the resampling changes (printed).
+    exact_png = image("parallel_serial_exact_%s%s.png" % (builder, tag))
+    rc, _ = run([pvbatch, scene, exact_png, builder, "rectnu"], 150)
+    exact = ssptest.read_png(exact_png) if rc == 0 and os.path.exists(exact_png) else None
+    ok.check(exact is not None, "serial pvbatch rendered the grid through its coordinates (rc %d)" % rc)
+    ranks = ranks[:]
+    serial = image("parallel_mpi%d_first_%s%s.png" % (ranks[0], builder, tag))
+    serial_scene = ["rectnu"]
+    pvbatch_serial = ["timeout", "150", mpiexec, "--allow-run-as-root", "--oversubscribe", "-n", str(ranks[0])] + \
+        env_args + [pvbatch]
+    ranks = ranks[1:]
+rc, _ = run((pvbatch_serial if nonuniform else [pvbatch]) + [scene, serial, builder] + serial_scene, 170)
+what = "the reference (%s)" % ("the first rank count" if nonuniform else "serial pvbatch")
+ok.check(rc == 0 and os.path.exists(serial), "%s rendered (rc %d)" % (what, rc))
+a = ssptest.read_png(serial) if os.path.exists(serial) else None
+if a is not None:
+    ok.check(ssptest.lit_fraction(a) > 0.1, "the reference image shows the volume (%.1f%% lit)"
+             % (100 * ssptest.lit_fraction(a)))
+if a is not None and exact is not None:
+    pe = ssptest.psnr(exact, a)
+    print("SPACESKIP_PARALLEL_RESULT %s serial through the coordinates vs the first rank count (resampled): "
+          "PSNR %.2f dB, max |diff| %d/255" % (builder, pe, abs(exact - a).max()))
+    ok.check(pe >= 40.0, "the first rank count (resampled) vs the serial grid through its coordinates: "
+             "PSNR %.2f dB >= 40" % pe)
 for n in ranks:
     mpi = image("parallel_mpi%d_%s%s%s.png" % (n, builder, "_partitioned" if partitioned else tag,
                                             "_second" if partitioned and second_array else ""))
@@ -264,9 +289,15 @@ for n in ranks:
     if a is None or not os.path.exists(mpi):
         continue
     b = ssptest.read_png(mpi)
+    if exact is not None:
+        pe = ssptest.psnr(exact, b)
+        print("SPACESKIP_PARALLEL_RESULT %s serial through the coordinates vs %d ranks (resampled): PSNR %.2f dB, "
+              "max |diff| %d/255" % (builder, n, pe, abs(exact - b).max()))
+        ok.check(pe >= 40.0, "%d ranks (resampled) vs the serial grid through its coordinates: PSNR %.2f dB >= 40"
+                 % (n, pe))
     p = ssptest.psnr(a, b)
     diff = abs(a - b).max(axis=2)
-    print("SPACESKIP_PARALLEL_RESULT %s%s%s serial vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
+    print("SPACESKIP_PARALLEL_RESULT %s%s%s " + ("%d ranks" % (n - 1) if nonuniform else "serial") + " vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
           "%.3f%% of pixels differ by more than 1, %.3f%% by any" % (
               builder, " partitioned" if partitioned else "", " " + ct_reader if ct_reader else "", n, p, diff.max(), 100.0 * (diff > 1).mean(), 100.0 * (diff > 0).mean()))
     if check and float_compositing and opaque:

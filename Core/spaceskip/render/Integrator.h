@@ -5,6 +5,7 @@
 #pragma once
 #include <type_traits>
 
+#include "../AxisWarp.h"
 #include "FrameShared.h"
 #include "RayGen.h"
 #include "Traversal.h"
@@ -53,11 +54,14 @@ SS_FUNC float voxelValue(double v) { return voxelValue(float(v)); }
 template <class T>
 SS_FUNC float voxelValue(T v) { return float(v); }
 
-/// Exact trilinear sampling in float from a linear voxel array (clamped at the border).
+/// Exact trilinear sampling in float from a linear voxel array (clamped at the border). With a
+/// warp (a rectilinear grid, AxisWarp.h), the position is the virtual lattice's, read through
+/// the grid's coordinates.
 template <class T>
 struct ArraySampler {
   const T* data;
   int64_t nx, ny, nz;
+  AxisWarpView warp{};
 
   SS_FUNC float fetch(int64_t i, int64_t j, int64_t k) const {
     return voxelValue(data[i + nx * (j + ny * k)]);
@@ -71,6 +75,7 @@ struct ArraySampler {
     i1 = n > 1 ? i0 + 1 : 0;
   }
   SS_FORCE_FUNC float sample(vec3f p) const {
+    if (warp.on()) p = warp.apply(p);
     int64_t x0, x1, y0, y1, z0, z1;
     float fx, fy, fz;
     axis(p.x, nx, x0, x1, fx);
