@@ -170,7 +170,10 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   const AxisWarpView warp = vol.warp();
   if (warp.on() && (pool || f.sampling != kSampleTrilinear))
     throw BackendError("a rectilinear grid is drawn through its coordinates in core, with trilinear sampling only");
-  if (pool) {  // sparse residency: the resident bricks, exact sampling
+  if (warp.on()) {  // a rectilinear grid through its coordinates (AxisWarp.h): exact sampling
+    launch(f, WarpedSampler{vol.d_voxels<unsigned char>(), v.type, v.dims.x, v.dims.y, v.dims.z, warp}, grid, block, 0,
+           stream);
+  } else if (pool) {  // sparse residency: the resident bricks, exact sampling
     dispatchVoxelType(v.type, [&](auto t) {
       using T = decltype(t);
       launch(f, pool->sampler<T>(), grid, block, 0, stream);
@@ -187,13 +190,13 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
       launch(f, ChannelSampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z, v.components}, grid, block, 0,
              stream);
     });
-  } else if (filter == FilterMode::Hardware && !warp.on()) {  // a warp reads the grid exactly
+  } else if (filter == FilterMode::Hardware) {
     const TextureSampler s = vol.texture(stream);
     launch(f, s, grid, block, vol.textureBytes(), stream);
   } else {
     dispatchVoxelType(v.type, [&](auto t) {
       using T = decltype(t);
-      launch(f, ArraySampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z, warp}, grid, block, 0, stream);
+      launch(f, ArraySampler<T>{vol.d_voxels<T>(), v.dims.x, v.dims.y, v.dims.z}, grid, block, 0, stream);
     });
   }
   SS_CUDA_CHECK_LAUNCH(renderKernel);

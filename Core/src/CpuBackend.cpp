@@ -164,6 +164,13 @@ class CpuBackend final : public Backend {
         overflow_ = true;  // the whole volume is in host memory: this frame samples it in core
       }
     }
+    if (volume_.warp) {  // a rectilinear grid through its coordinates (AxisWarp.h): the scalar integrator
+      if (f.sampling != kSampleTrilinear)
+        throw BackendError("a rectilinear grid is drawn through its coordinates with trilinear sampling only");
+      tiles(f, out, WarpedSampler{volume_.data, volume_.type, volume_.dims.x, volume_.dims.y, volume_.dims.z,
+                                  volume_.warp->view()});
+      return;
+    }
     dispatchVoxelType(volume_.type, [&](auto voxel) { run<decltype(voxel)>(f, out); });
   }
 
@@ -180,13 +187,6 @@ class CpuBackend final : public Backend {
 
   template <class T>
   void run(const FrameView& f, Image& out) {
-    if (volume_.warp) {  // a rectilinear grid through its coordinates (AxisWarp.h): the scalar integrator
-      if (f.sampling != kSampleTrilinear)
-        throw BackendError("a rectilinear grid is drawn through its coordinates with trilinear sampling only");
-      tiles(f, out, ArraySampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y,
-                                    volume_.dims.z, volume_.warp->view()});
-      return;
-    }
     if (f.sampling != kSampleTrilinear && volume_.components == 1) {  // nearest, label maps (LabelSampler.h)
       tiles(f, out, NearestSampler<T>{static_cast<const T*>(volume_.data), volume_.dims.x, volume_.dims.y,
                                       volume_.dims.z, f.sampling});

@@ -142,7 +142,7 @@ TEST(Rectilinear, VirtualBrickRangesBoundTheirSamples) {
   Volume v = warped(generateVolume("vessels", vec3l{37, 30, 41}));
   const RangeGrid r = computeRangeGrid(v, 4);
   const AxisWarpView w = v.warp->view();
-  const ArraySampler<uint8_t> s{static_cast<const uint8_t*>(v.data), v.dims.x, v.dims.y, v.dims.z, w};
+  const WarpedSampler s{v.data, v.type, v.dims.x, v.dims.y, v.dims.z, w};
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> U(0.f, 1.f);
   const vec3i cd = v.cellDims();

@@ -249,7 +249,7 @@ if nonuniform:
     rc, _ = run([pvbatch, scene, exact_png, builder, "rectnu"], 150)
     exact = ssptest.read_png(exact_png) if rc == 0 and os.path.exists(exact_png) else None
     ok.check(exact is not None, "serial pvbatch rendered the grid through its coordinates (rc %d)" % rc)
-    ranks = ranks[:]
+    ranks_first = ranks[0]
     serial = image("parallel_mpi%d_first_%s%s.png" % (ranks[0], builder, tag))
     serial_scene = ["rectnu"]
     pvbatch_serial = ["timeout", "150", mpiexec, "--allow-run-as-root", "--oversubscribe", "-n", str(ranks[0])] + \
@@ -297,9 +297,11 @@ for n in ranks:
                  % (n, pe))
     p = ssptest.psnr(a, b)
     diff = abs(a - b).max(axis=2)
-    print("SPACESKIP_PARALLEL_RESULT %s%s%s " + ("%d ranks" % (n - 1) if nonuniform else "serial") + " vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
+    reference = "%d ranks" % ranks_first if nonuniform else "serial"
+    print("SPACESKIP_PARALLEL_RESULT %s%s%s %s vs %d ranks: PSNR %.2f dB, max |diff| %d/255, "
           "%.3f%% of pixels differ by more than 1, %.3f%% by any" % (
-              builder, " partitioned" if partitioned else "", " " + ct_reader if ct_reader else "", n, p, diff.max(), 100.0 * (diff > 1).mean(), 100.0 * (diff > 0).mean()))
+              builder, " partitioned" if partitioned else "", " " + ct_reader if ct_reader else "", reference, n, p,
+              diff.max(), 100.0 * (diff > 1).mean(), 100.0 * (diff > 0).mean()))
     if check and float_compositing and opaque:
         # Where a ray stops early in a piece behind the front one, that piece alone drew on
         # past the point where the serial ray stopped: less than 1/255 more, on some pixels.
