@@ -12,7 +12,7 @@ set -euo pipefail
 out=${1:?OUTDIR}
 mkdir -p "$out"
 cases=${RECT_CASES:-"gen:nbody:1024 gen:rm:512"}
-builders=${RECT_BUILDERS:-naive,grid,distance_grid,kdtree-gpu-fast}
+builders=${RECT_BUILDERS:-naive,grid,distance-grid,kdtree-gpu-fast}
 common=(--backend cuda --builders "$builders" --frames 40 --size 1024x1024)
 run() {  # TAG CLI ARGS...
   local tag=$1 cli=$2
