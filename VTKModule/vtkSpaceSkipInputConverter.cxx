@@ -625,6 +625,31 @@ AxisSteps StepsOf(vtkDataArray* coords)
   }
   return a;
 }
+// The grid's arrays (shared, not copied) as an image whose index (i, j, k) of the grid's extent
+// `ext` lies at first + (i - ext0) * steps[a] per axis (steps > 0; a descending axis with -1 in
+// the direction matrix).
+vtkSmartPointer<vtkImageData> PointsOnLattice(
+  vtkRectilinearGrid* grid, const int ext[6], const AxisSteps axes[3], const double steps[3])
+{
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetExtent(const_cast<int*>(ext));
+  double origin[3];
+  double direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
+  for (int a = 0; a < 3; ++a)
+  {
+    const double sign = axes[a].Mean < 0 ? -1.0 : 1.0;
+    direction[4 * a] = sign;
+    origin[a] = axes[a].First - sign * steps[a] * ext[2 * a];
+  }
+  image->SetSpacing(steps[0], steps[1], steps[2]);
+  image->SetOrigin(origin);
+  image->SetDirectionMatrix(direction);
+  image->GetPointData()->ShallowCopy(grid->GetPointData());
+  image->GetCellData()->ShallowCopy(grid->GetCellData());
+  image->GetFieldData()->ShallowCopy(grid->GetFieldData());
+  return image;
+}
+
 // Where each of the `n` lattice points along an axis (first + i * step) falls in the ascending
 // `coords`: the index of its cell's lower point and the weight of the upper one, in [0, 1].
 void AxisWeights(vtkDataArray* coords, int n, double first, double step,
@@ -875,24 +900,8 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
   if (deviation <= kUniform)
   {
     // The same points as an image: index (i, j, k) at first + (i - ext0) * mean step per axis.
-    auto image = vtkSmartPointer<vtkImageData>::New();
-    image->SetExtent(ext);
-    double spacing[3], origin[3];
-    double direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
-    for (int a = 0; a < 3; ++a)
-    {
-      const double sign = axes[a].Mean < 0 ? -1.0 : 1.0;
-      spacing[a] = std::abs(axes[a].Mean);
-      direction[4 * a] = sign;
-      origin[a] = axes[a].First - sign * spacing[a] * ext[2 * a];
-    }
-    image->SetSpacing(spacing);
-    image->SetOrigin(origin);
-    image->SetDirectionMatrix(direction);
-    image->GetPointData()->ShallowCopy(grid->GetPointData());
-    image->GetCellData()->ShallowCopy(grid->GetCellData());
-    image->GetFieldData()->ShallowCopy(grid->GetFieldData());
-    this->Image = image;
+    const double steps[3] = { std::abs(axes[0].Mean), std::abs(axes[1].Mean), std::abs(axes[2].Mean) };
+    this->Image = PointsOnLattice(grid, ext, axes, steps);
     this->Path = 1;
     return this->Image;
   }
@@ -917,26 +926,9 @@ vtkImageData* vtkSpaceSkipRectilinearImage::From(vtkRectilinearGrid* grid,
     try
     {
       auto warp = spaceskip::AxisWarp::fromCoordinates(at, count);
-      // The virtual lattice: index (i, j, k) of the extent at first + (i - ext0) * step per axis,
-      // a descending axis with -1 in the direction matrix, as for a uniform grid.
-      auto image = vtkSmartPointer<vtkImageData>::New();
-      image->SetExtent(ext);
-      double spacing[3], origin[3];
-      double direction[9] = { 1, 0, 0, 0, 1, 0, 0, 0, 1 };
-      for (int a = 0; a < 3; ++a)
-      {
-        const double sign = axes[a].Mean < 0 ? -1.0 : 1.0;
-        spacing[a] = warp->spacing(a);
-        direction[4 * a] = sign;
-        origin[a] = axes[a].First - sign * spacing[a] * ext[2 * a];
-      }
-      image->SetSpacing(spacing);
-      image->SetOrigin(origin);
-      image->SetDirectionMatrix(direction);
-      image->GetPointData()->ShallowCopy(grid->GetPointData());
-      image->GetCellData()->ShallowCopy(grid->GetCellData());
-      image->GetFieldData()->ShallowCopy(grid->GetFieldData());
-      this->Image = image;
+      // The virtual lattice: the grid's points at the warp's steps, as for a uniform grid.
+      const double steps[3] = { warp->spacing(0), warp->spacing(1), warp->spacing(2) };
+      this->Image = PointsOnLattice(grid, ext, axes, steps);
       this->Warp = std::move(warp);
       this->Path = 4;
       return this->Image;
