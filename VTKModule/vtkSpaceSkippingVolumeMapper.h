@@ -24,10 +24,13 @@
  *
  * vtkRectilinearGrid input (alone or as blocks): uniformly spaced coordinates (each step within
  * a relative 1e-6 of the mean) are drawn as the image of the same points, the grid's arrays
- * shared, not copied (a descending array: a mirrored direction matrix); non-uniform ones with
- * one warning, resampled trilinearly on a uniform lattice (the smallest step per axis,
- * at most 4x the grid's points) once per change of the grid. Sampling through the coordinate
- * arrays themselves is not done (docs/limits.md).
+ * shared, not copied (a descending array: a mirrored direction matrix). A non-uniform grid
+ * drawn alone (linear interpolation, one drawn component, no label map, no second y-axis array)
+ * is drawn through its coordinates (spaceskip::AxisWarp: the grid's points on a uniform lattice
+ * over its bounds, sampled trilinearly in the grid's own cells; no copy, no warning); otherwise
+ * (blocks, pieces composited across processes, the other cases) with one warning, resampled
+ * trilinearly on a uniform lattice (the smallest step per axis, at most 4x the grid's points)
+ * once per change of the grid (docs/rendering.md, Rectilinear grids; docs/limits.md).
  *
  * Bad input (no/cell scalars, several components, unsupported type, empty extent) raises one
  * vtkErrorMacro and draws nothing; backend failures (no device, out of device memory) fall back
