@@ -346,7 +346,8 @@ void vtkSpaceSkipImageRenderer::RenderFrame(vtkOpenGLRenderWindow* renWin, Windo
 
   const int buildsBefore = engine.counters().builds;
   // GPUComposite: the CUDA backend leaves the image on the device for the interop copy.
-  engine.setImageOnDevice(!mode.Defer && this->Compositor.CanUseDeviceImage(s.GPUComposite) &&
+  // A deferred frame stays there too where the exchange takes device pieces (OnDevice).
+  engine.setImageOnDevice((!mode.Defer || mode.OnDevice) && this->Compositor.CanUseDeviceImage(s.GPUComposite) &&
     engine.backendKind() == spaceskip::BackendKind::CUDA);
   t0 = std::chrono::steady_clock::now();
   engine.render(camera, width, height, this->Image, this->FrameDepth,
@@ -483,6 +484,20 @@ vtkSpaceSkipStatistics vtkSpaceSkipImageRenderer::Statistics(bool deviceTimes) c
     s.KernelSeconds = f.deviceSeconds >= 0 ? f.deviceSeconds : f.seconds;
   }
   return s;
+}
+
+//------------------------------------------------------------------------------
+const void* vtkSpaceSkipImageRenderer::DeferredDeviceImage(int& width, int& height, void*& stream) const
+{
+  const void* image = this->Deferred && this->Engine ? this->Engine->deviceImage() : nullptr;
+  if (!image)
+  {
+    return nullptr;
+  }
+  width = this->Image.width;
+  height = this->Image.height;
+  stream = this->Engine->deviceImageStream();
+  return image;
 }
 
 //------------------------------------------------------------------------------

@@ -45,6 +45,7 @@ public:
     const int* Owned = nullptr;
     bool Defer = false;
     bool Exact = false; // no 8-bit rounding bias (composited in float)
+    bool OnDevice = false; // a deferred CUDA frame stays in device memory (DeferredDeviceImage)
     const float* IncomingAlpha = nullptr;
     vtkDataArray* Prefetch = nullptr; // the next time step's scalars (PrefetchTimeStep)
   };
@@ -61,6 +62,10 @@ public:
 
   /// The last deferred frame's premultiplied RGBA floats (row 0 at the bottom), or null.
   const float* DeferredImage(int& width, int& height) const;
+  /// The last deferred frame left in device memory (FrameMode::OnDevice, the CUDA backend):
+  /// `width` x `height` float4, premultiplied RGBA, row 0 at the bottom, written on `stream` (a
+  /// cudaStream_t), valid until the next frame; or null (it went to host memory).
+  const void* DeferredDeviceImage(int& width, int& height, void*& stream) const;
   /// The last frame (the window's copy when it was drawn through host memory).
   const spaceskip::Image& GetImage() const { return this->Image; }
   /// The piece the last frame drew (inactive: the whole input).

@@ -10,6 +10,7 @@
 #include "vtkRenderer.h"
 #include "vtkVolume.h"
 
+#include "spaceskip/PeerImages.h"
 #include "spaceskip/PieceOrder.h"
 #include "spaceskip/Types.h"
 #include "spaceskip/VolumePiece.h"
@@ -109,10 +110,9 @@ void CameraInIndexSpace(vtkRenderer* ren, vtkVolume* vol, vtkImageData* lattice,
 }
 
 //------------------------------------------------------------------------------
-void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const double dir[3],
-  bool parallel, int width, int height, spaceskip::Image& out, double stopAt)
+std::vector<const PieceImage*> FrontToBack(const std::vector<PieceImage>& pieces, const double eye[3],
+  const double dir[3], bool parallel, int width, int height)
 {
-  const float stop = static_cast<float>(stopAt);
   std::vector<spaceskip::PieceBox> boxes;
   std::vector<const PieceImage*> parts;
   for (const PieceImage& p : pieces)
@@ -120,19 +120,54 @@ void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const dou
     const int* o = p.Owned;
     if (p.Width > 0 && p.Height > 0 && o[0] < o[1] && o[2] < o[3] && o[4] < o[5] && p.X >= 0 &&
       p.Y >= 0 && p.X + p.Width <= width && p.Y + p.Height <= height &&
-      p.Pixels.size() == 4 * size_t(p.Width) * size_t(p.Height))
+      (p.Device || p.Pixels.size() == 4 * size_t(p.Width) * size_t(p.Height)))
     {
       boxes.push_back({ double(o[0]), double(o[1]), double(o[2]), double(o[3]), double(o[4]), double(o[5]) });
       parts.push_back(&p);
     }
   }
+  std::vector<const PieceImage*> ordered;
+  for (size_t i : spaceskip::visibilityOrder(boxes, eye, dir, parallel))
+  {
+    ordered.push_back(parts[i]);
+  }
+  return ordered;
+}
+
+//------------------------------------------------------------------------------
+bool ToHost(std::vector<PieceImage>& pieces, std::string& problem)
+{
+  for (PieceImage& p : pieces)
+  {
+    const size_t n = size_t(std::max(p.Width, 0)) * size_t(std::max(p.Height, 0));
+    if (p.Device && p.Pixels.size() != 4 * n)
+    {
+      p.Pixels.resize(4 * n);
+      if (n && !spaceskip::PeerImages::download(p.Device, n, p.Pixels.data(), problem))
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const double dir[3],
+  bool parallel, int width, int height, spaceskip::Image& out, double stopAt)
+{
+  const float stop = static_cast<float>(stopAt);
   out.width = width;
   out.height = height;
   out.rgba.assign(size_t(width) * size_t(height), spaceskip::vec4f{ 0, 0, 0, 0 });
-  for (size_t i : spaceskip::visibilityOrder(boxes, eye, dir, parallel))
+  for (const PieceImage* piece : FrontToBack(pieces, eye, dir, parallel, width, height))
   {
     // Pieces one after another (front to back), each one's rows in parallel.
-    const PieceImage& p = *parts[i];
+    const PieceImage& p = *piece;
+    if (p.Pixels.size() != 4 * size_t(p.Width) * size_t(p.Height))
+    {
+      continue; // left in device memory (ToHost first)
+    }
     tbb::parallel_for(tbb::blocked_range<int>(0, p.Height, 16), [&](const tbb::blocked_range<int>& r) {
       for (int y = r.begin(); y != r.end(); ++y)
       {
@@ -140,15 +175,7 @@ void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const dou
         spaceskip::vec4f* dst = out.rgba.data() + size_t(p.Y + y) * size_t(width) + size_t(p.X);
         for (int x = 0; x < p.Width; ++x, src += 4, ++dst)
         {
-          if (dst->w >= stop)
-          {
-            continue;
-          }
-          const float t = 1.f - dst->w;
-          dst->x += t * src[0];
-          dst->y += t * src[1];
-          dst->z += t * src[2];
-          dst->w += t * src[3];
+          spaceskip::addBehind(*dst, spaceskip::vec4f{ src[0], src[1], src[2], src[3] }, stop);
         }
       }
     });
@@ -156,10 +183,34 @@ void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const dou
 }
 
 //------------------------------------------------------------------------------
-PieceImage CropPiece(const float* image, int width, int height, const spaceskip::VolumePiece& p,
-  vtkImageData* input, const int wholeExtent[6])
+const void* BlendOnDevice(const std::vector<PieceImage>& pieces, const double eye[3],
+  const double dir[3], bool parallel, int width, int height, double stopAt,
+  spaceskip::PieceBlend& blend, void* stream, std::string& problem)
 {
-  int ext[6], owned[6];
+  std::vector<spaceskip::BlendSource> sources;
+  for (const PieceImage* p : FrontToBack(pieces, eye, dir, parallel, width, height))
+  {
+    spaceskip::BlendSource b;
+    b.host = !p->Device;
+    b.pixels = p->Device ? p->Device : static_cast<const void*>(p->Pixels.data());
+    b.rowPixels = size_t(p->Width);
+    b.x = p->X;
+    b.y = p->Y;
+    b.w = p->Width;
+    b.h = p->Height;
+    sources.push_back(b);
+  }
+  return blend.blend(sources, width, height, static_cast<float>(stopAt), stream, problem);
+}
+
+//------------------------------------------------------------------------------
+namespace
+{
+// The cells a piece drew (`piece`, or when inactive its whole extent) in the index space of
+// `wholeExtent` (less its first index).
+void OwnedCells(const spaceskip::VolumePiece& p, vtkImageData* input, const int wholeExtent[6], int owned[6])
+{
+  int ext[6];
   input->GetExtent(ext);
   const int shift[3] = { wholeExtent[0], wholeExtent[2], wholeExtent[4] };
   for (int a = 0; a < 3; ++a)
@@ -168,7 +219,47 @@ PieceImage CropPiece(const float* image, int width, int height, const spaceskip:
     owned[2 * a + 1] = p.active() ? static_cast<int>(p.ownedHi[a])
                                   : std::max(ext[2 * a + 1], ext[2 * a] + 1) - shift[a];
   }
+}
+}
+
+//------------------------------------------------------------------------------
+PieceImage CropPiece(const float* image, int width, int height, const spaceskip::VolumePiece& p,
+  vtkImageData* input, const int wholeExtent[6])
+{
+  int owned[6];
+  OwnedCells(p, input, wholeExtent, owned);
   return Crop(image, width, height, owned);
+}
+
+//------------------------------------------------------------------------------
+PieceImage DevicePiece(const void* image, void* stream, int width, int height,
+  const spaceskip::VolumePiece& p, vtkImageData* input, const int wholeExtent[6])
+{
+  PieceImage piece;
+  OwnedCells(p, input, wholeExtent, piece.Owned);
+  piece.Width = width;
+  piece.Height = height;
+  piece.Device = image;
+  piece.Stream = stream;
+  return piece;
+}
+
+//------------------------------------------------------------------------------
+bool MapShared(std::vector<PieceImage>& pieces, spaceskip::PeerImages& peers, std::string& problem)
+{
+  bool all = true;
+  for (PieceImage& p : pieces)
+  {
+    if (!p.Shared || p.Device)
+    {
+      continue;
+    }
+    spaceskip::PeerImages::Handle handle;
+    std::copy_n(p.Handle, handle.size(), handle.begin());
+    p.Device = peers.map(p.Source, handle, problem);
+    all = all && p.Device;
+  }
+  return all;
 }
 
 //------------------------------------------------------------------------------

@@ -16,6 +16,8 @@ class vtkRenderer;
 class vtkVolume;
 namespace spaceskip
 {
+class PeerImages;
+class PieceBlend;
 struct Image;
 struct VolumePiece;
 }
@@ -27,6 +29,16 @@ using PieceImage = vtkSpaceSkipPieceImage;
 /// The rectangle of the pixels `image` (`width` x `height` premultiplied RGBA floats, row 0 at
 /// the bottom) drew, as a piece with the cells `owned`; empty when it drew none.
 PieceImage Crop(const float* image, int width, int height, const int owned[6]);
+
+/// An image piece's frame left in device memory (`width` x `height` float4 written on `stream`,
+/// a cudaStream_t) as a piece of the whole viewport, with the cells it drew as CropPiece() says.
+PieceImage DevicePiece(const void* image, void* stream, int width, int height,
+  const spaceskip::VolumePiece& piece, vtkImageData* input, const int wholeExtent[6]);
+
+/// Maps the Shared pieces' images (another process's device memory, CUDA IPC) into this
+/// process: their Device then reads them. False with `problem` when one could not be mapped (its
+/// Device stays null: only its Pixels, if any, are drawn).
+bool MapShared(std::vector<PieceImage>& pieces, spaceskip::PeerImages& peers, std::string& problem);
 
 /// Crop() for an image piece: the cells it drew (`piece`, or when inactive its whole extent)
 /// in the index space of `wholeExtent` (less its first index).
@@ -52,6 +64,23 @@ void CameraInIndexSpace(vtkRenderer* ren, vtkVolume* vol, vtkImageData* lattice,
 /// image's ray stopped in front of them.
 void Blend(const std::vector<PieceImage>& pieces, const double eye[3], const double dir[3],
   bool parallel, int width, int height, spaceskip::Image& out, double stopAt = 2.0);
+
+/// The drawable pieces of `pieces` (cells, a rectangle inside the viewport, pixels in host or
+/// device memory), front to back in the order the rays meet their boxes.
+std::vector<const PieceImage*> FrontToBack(const std::vector<PieceImage>& pieces, const double eye[3],
+  const double dir[3], bool parallel, int width, int height);
+
+/// Copies the pixels of the pieces left in device memory (PieceImage::Device) to Pixels, for
+/// Blend(); false with `problem` when a copy fails.
+bool ToHost(std::vector<PieceImage>& pieces, std::string& problem);
+
+/// Blend() on the GPU (the calling thread's CUDA device): the pieces in device memory read where
+/// they are (this process's frame, the others' mapped through CUDA IPC), those in host memory
+/// uploaded; queued on `stream` (a cudaStream_t). The blended image in device memory (`blend`'s,
+/// valid until its next blend), or nullptr with `problem`.
+const void* BlendOnDevice(const std::vector<PieceImage>& pieces, const double eye[3],
+  const double dir[3], bool parallel, int width, int height, double stopAt,
+  spaceskip::PieceBlend& blend, void* stream, std::string& problem);
 }
 
 #endif

@@ -29,7 +29,9 @@
 #include "vtkVolumeProperty.h"
 
 #include "spaceskip/Backend.h"
+#include "spaceskip/DeviceImageCopy.h"
 #include "spaceskip/Engine.h"
+#include "spaceskip/PeerImages.h"
 #include "spaceskip/StepMemory.h"
 
 #include <algorithm>
@@ -141,6 +143,17 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   vtkSmartPointer<vtkImageData> EmptyPiece;
   std::string EmptyPieceArray;
   spaceskip::Image Exchanged;
+  // Pieces in device memory (the exchange's DevicePieces): this process's frame shared with the
+  // others of the host and theirs mapped (CUDA IPC), and their blend on this GPU.
+  spaceskip::PeerImages Peers;
+  spaceskip::PieceBlend DeviceBlend;
+  // This process's piece as the exchange takes it (DevicePieces): shared, and downloaded too.
+  void ShareDevicePiece(int how, PieceImage& piece);
+  // The exchanged pieces blended (on the GPU where this process's piece is there, else on the
+  // host) and drawn; the exchange Released() once they are read. `where`: "GPU" or "host".
+  bool DrawPieces(PieceExchange& exchange, std::vector<PieceImage>& pieces, const double eye[3],
+    const double dir[3], bool parallel, int width, int height, double stopAt,
+    vtkOpenGLRenderWindow* renWin, bool eightBit, const char*& where);
   // Image input: the engine and the window (vtkSpaceSkipImageRenderer); composite input: the
   // composite mapper that draws it with one mapper per image block (vtkBlock).
   vtkSpaceSkipImageRenderer Image;
@@ -719,6 +732,110 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
 }
 
 //------------------------------------------------------------------------------
+void vtkSpaceSkippingVolumeMapper::vtkInternals::ShareDevicePiece(int how, PieceImage& piece)
+{
+  namespace pc = vtkSpaceSkipPieceCompositing;
+  std::string problem;
+  if (how == 1 || how == 2)
+  {
+    spaceskip::PeerImages::Handle handle;
+    if (this->Peers.share(piece.Device, size_t(piece.Width) * size_t(piece.Height), piece.Stream, handle, problem))
+    {
+      piece.Shared = true;
+      std::copy(handle.begin(), handle.end(), piece.Handle);
+    }
+    else
+    {
+      this->Warn("could not share this process's frame with the other processes of the host "
+                 "through CUDA IPC (" + problem + "): it goes through host memory");
+    }
+  }
+  if (how != 3 && (how == 2 || !piece.Shared))
+  {
+    std::vector<PieceImage> one(1);
+    std::swap(one[0], piece);
+    if (!pc::ToHost(one, problem))
+    {
+      this->Warn("could not read this process's frame back from the GPU (" + problem + ")");
+      one[0].Width = one[0].Height = 0;
+    }
+    std::swap(one[0], piece);
+    if (!piece.Shared)
+    {
+      piece.Device = nullptr; // host pixels only
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkippingVolumeMapper::vtkInternals::DrawPieces(PieceExchange& exchange,
+  std::vector<PieceImage>& pieces, const double eye[3], const double dir[3], bool parallel,
+  int width, int height, double stopAt, vtkOpenGLRenderWindow* renWin, bool eightBit,
+  const char*& where)
+{
+  namespace pc = vtkSpaceSkipPieceCompositing;
+  vtkSpaceSkipCompositor& compositor = this->Image.GetCompositor();
+  std::string problem;
+  bool mapped = true;
+  if (std::any_of(pieces.begin(), pieces.end(), [](const PieceImage& p) { return p.Shared; }))
+  {
+    mapped = pc::MapShared(pieces, this->Peers, problem);
+    if (!mapped)
+    {
+      this->Warn("could not map another process's frame through CUDA IPC (" + problem +
+        "): the pieces go through host memory from the next frame on");
+    }
+  }
+  // This process's piece in device memory (its own frame, not another's): blend on this GPU.
+  void* stream = nullptr;
+  for (const PieceImage& p : pieces)
+  {
+    stream = p.Device && !p.Shared ? p.Stream : stream;
+  }
+  where = "host";
+  if (stream)
+  {
+    const void* sum = pc::BlendOnDevice(
+      pieces, eye, dir, parallel, width, height, stopAt, this->DeviceBlend, stream, problem);
+    if (sum && spaceskip::PeerImages::wait(stream, problem))
+    {
+      exchange.Released(mapped); // the others' images are read: they may draw the next frame
+      where = "GPU";
+      const int whole[4] = { 0, 0, width, height };
+      const spaceskip::DeviceImageView view{ sum, {} };
+      if (compositor.CopyDeviceImage(renWin, view, [sum]() { return sum; }, stream, width, height, whole, eightBit))
+      {
+        return compositor.Draw(renWin, this->Exchanged, width, height, eightBit);
+      }
+      // The interop is off (another GPU, Mesa): the sum through host memory.
+      PieceImage sumPiece;
+      sumPiece.Width = width;
+      sumPiece.Height = height;
+      sumPiece.Device = sum;
+      std::vector<PieceImage> one(1, sumPiece);
+      if (pc::ToHost(one, problem))
+      {
+        this->Exchanged.width = width;
+        this->Exchanged.height = height;
+        this->Exchanged.rgba.resize(size_t(width) * size_t(height));
+        std::copy(one[0].Pixels.begin(), one[0].Pixels.end(), &this->Exchanged.rgba[0].x);
+        return compositor.Draw(renWin, this->Exchanged, width, height, eightBit);
+      }
+      this->Warn("could not read the blended pieces back from the GPU (" + problem + "): not drawn");
+      return true;
+    }
+    this->Warn("could not blend the pieces on the GPU (" + problem + "): blended on the host");
+  }
+  if (!pc::ToHost(pieces, problem))
+  {
+    this->Warn("could not read a piece back from the GPU (" + problem + "): left out");
+  }
+  pc::Blend(pieces, eye, dir, parallel, width, height, this->Exchanged, stopAt);
+  exchange.Released(mapped);
+  return compositor.Draw(renWin, this->Exchanged, width, height, eightBit);
+}
+
+//------------------------------------------------------------------------------
 // With a piece exchange (MPI): every process draws its piece (or each of its blocks) exactly
 // into a float image, the exchange composites them all in float on one process, which draws the
 // sum; the others draw nothing. Every call reaches Finish(), whatever the piece drew (the
@@ -731,7 +848,9 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   // The frame's phases, logged at verbosity 5 (pvbatch -v 5): where a composited frame goes.
   const auto t0 = std::chrono::steady_clock::now();
   exchange->Begin();
+  const int devicePieces = exchange->DevicePieces();
   std::vector<PieceImage> mine;
+  const void* deviceImage = nullptr; // the same, left in device memory
   double eye[3] = { 0, 0, 0 }, dir[3] = { 0, 0, 1 };
   bool parallel = false;
   const float* image = nullptr; // an image piece's own frame (drawn if the exchange is off)
@@ -748,6 +867,8 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   {
     const vtkSpaceSkipImageRenderer::FrameMode mode = d.Mode;
     d.Mode.Defer = d.Mode.Exact = true;
+    // A CUDA frame stays on the GPU where the exchange takes it there (one host, CUDA IPC).
+    d.Mode.OnDevice = devicePieces != 0;
     auto* data = vtkDataSet::SafeDownCast(this->GetInputDataObject(0, 0));
     d.Image.ResetFrameTimes();
     if (data && data->GetNumberOfPoints() > 0)
@@ -757,6 +878,8 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     d.Mode = mode;
     int w = 0, h = 0;
     image = d.Image.DeferredImage(w, h);
+    void* stream = nullptr;
+    deviceImage = image ? nullptr : d.Image.DeferredDeviceImage(w, h, stream);
     auto* input = vtkImageData::SafeDownCast(this->GetInput());
     if (!input && vtkRectilinearGrid::SafeDownCast(this->GetInputDataObject(0, 0)))
     {
@@ -773,18 +896,27 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
                        "them)");
       }
     }
-    if (image && input && ren->GetActiveCamera())
+    if ((image || deviceImage) && input && ren->GetActiveCamera())
     {
       const int* whole = vtkImageData::SafeDownCast(this->GetInput()) || d.Rectilinear.GetPath() != 3
         ? this->WholeExtent
         : d.Rectilinear.GetLatticeWholeExtent();
       const int shift[3] = { whole[0], whole[2], whole[4] };
-      mine.push_back(pc::CropPiece(image, w, h, d.Image.LastPiece(), input, whole));
+      if (image)
+      {
+        mine.push_back(pc::CropPiece(image, w, h, d.Image.LastPiece(), input, whole));
+      }
+      else
+      {
+        mine.push_back(pc::DevicePiece(deviceImage, stream, w, h, d.Image.LastPiece(), input, whole));
+        d.ShareDevicePiece(devicePieces, mine.back());
+      }
       pc::CameraInIndexSpace(ren, vol, input, shift, eye, dir, parallel);
     }
     else
     {
       image = nullptr;
+      deviceImage = nullptr;
     }
   }
   int width = 0, height = 0, x0 = 0, y0 = 0;
@@ -809,6 +941,10 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   auto* renWin = vtkOpenGLRenderWindow::SafeDownCast(ren->GetRenderWindow());
   if (draw == 0 || !renWin || width <= 0 || height <= 0)
   {
+    if (draw == 1)
+    {
+      exchange->Released(true);
+    }
     phases("nothing drawn");
     return;
   }
@@ -818,6 +954,26 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   if (draw == -1 && blocks) // the exchange is off: this process's own blocks
   {
     drawn = !d.Composite || d.Composite->DrawSum(ren, eightBit);
+  }
+  else if (draw == -1 && deviceImage) // the exchange is off: this process's frame, from the GPU
+  {
+    std::string problem;
+    drawn = pc::ToHost(mine, problem) && !mine.empty() &&
+      mine[0].Pixels.size() == 4 * size_t(width) * size_t(height);
+    if (drawn)
+    {
+      const std::vector<float>& px = mine[0].Pixels;
+      d.Exchanged.width = width;
+      d.Exchanged.height = height;
+      d.Exchanged.rgba.resize(px.size() / 4);
+      std::copy(px.begin(), px.end(), &d.Exchanged.rgba[0].x);
+      drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
+    }
+    else
+    {
+      d.Warn("could not read this process's frame back from the GPU (" + problem + "): not drawn");
+      drawn = true;
+    }
   }
   else if (draw == -1) // the exchange is off: this process's own frame, as without it
   {
@@ -833,13 +989,12 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     const vtkSpaceSkipSettings s = vtkSpaceSkipSettings::From(this);
     const double stopAt =
       s.AccumulatesOpacity() ? vtkSpaceSkipPropertyTranslator::EarlyTerminationOpacity(s) : 2.0;
-    pc::Blend(others, eye, dir, parallel, width, height, d.Exchanged, stopAt);
-    const double blendedAt = SecondsSince(t0);
-    drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
+    const char* where = "host";
+    drawn = d.DrawPieces(*exchange, others, eye, dir, parallel, width, height, stopAt, renWin, eightBit, where);
     if (logPhases)
     {
-      vtkVLogF(vtkLogger::VERBOSITY_5, "exchanged frame: blend of %d pieces %.3f ms",
-        static_cast<int>(others.size()), 1e3 * (blendedAt - exchangedAt));
+      vtkVLogF(vtkLogger::VERBOSITY_5, "exchanged frame: blend of %d pieces on the %s",
+        static_cast<int>(others.size()), where);
     }
   }
   phases("blend + draw");

@@ -1,6 +1,7 @@
 // The oneTBB backend: tiles of pixels run the shared per-ray integrator.
 #include "spaceskip/Backend.h"
 #include "spaceskip/DeviceImageCopy.h"
+#include "spaceskip/PeerImages.h"
 #include "spaceskip/BrickPool.h"
 #include "spaceskip/Builders.h"
 #include "spaceskip/DistanceField.h"
@@ -318,6 +319,36 @@ int DeviceImageCopy::blendOver(const void*, int, int, void*, int, int, int, int,
   return 1;
 }
 void DeviceImageCopy::releaseSurface() {}
+
+namespace {
+const char* const kNoCuda = "this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)";
+}
+struct PeerImages::Impl {};
+PeerImages::PeerImages() = default;
+PeerImages::~PeerImages() = default;
+bool PeerImages::share(const void*, size_t, void*, Handle&, std::string& problem) {
+  problem = kNoCuda;
+  return false;
+}
+const void* PeerImages::map(int, const Handle&, std::string& problem) {
+  problem = kNoCuda;
+  return nullptr;
+}
+bool PeerImages::download(const void*, size_t, float*, std::string& problem) {
+  problem = kNoCuda;
+  return false;
+}
+bool PeerImages::wait(void*, std::string& problem) {
+  problem = kNoCuda;
+  return false;
+}
+struct PieceBlend::Impl {};
+PieceBlend::PieceBlend() = default;
+PieceBlend::~PieceBlend() = default;
+const void* PieceBlend::blend(const std::vector<BlendSource>&, int, int, float, void*, std::string& problem) {
+  problem = kNoCuda;
+  return nullptr;
+}
 #endif
 
 }  // namespace spaceskip

@@ -5,17 +5,23 @@
 #include "vtkMPI.h"
 
 #include <algorithm>
+#include <cstring>
 #include <thread>
 
 namespace
 {
 // Tags on the exchange's own communicator.
 constexpr int kBeginTag = 11;   // {frame}: a rank began drawing the frame
-constexpr int kHeaderTag = 12;  // {frame, width, height, pieces}
+constexpr int kHeaderTag = 12;  // {frame, width, height, pieces, how, handle (16 ints)}
 constexpr int kBoxesTag = 15;   // per piece {x, y, w, h, owned[6]}: its rectangle and cells
 constexpr int kDataTag = 13;    // the rectangles' RGBA floats, rows bottom up, piece after piece
-constexpr int kVerdictTag = 14; // {frame, 1: composited | 0: gave up}, rank 0 to the others
-constexpr int kHeaderInts = 4;
+// {frame, 1: composited | 0: gave up, 1: the rank's shared image was mapped}, rank 0 to the others
+constexpr int kVerdictTag = 14;
+constexpr int kVerdictInts = 3;
+// how: 0 the pixels follow (kDataTag); 1 one piece shared through CUDA IPC (the handle), no
+// pixels; 2 shared, and the pixels follow too (until rank 0 has mapped it once).
+constexpr int kHandleInts = 16;
+constexpr int kHeaderInts = 5 + kHandleInts;
 constexpr int kBoxInts = 10;
 constexpr int kMaxPieces = 1 << 16;
 
@@ -71,7 +77,7 @@ struct vtkSpaceSkipMPIExchange::Pending
 
 //------------------------------------------------------------------------------
 std::shared_ptr<vtkSpaceSkipMPIExchange> vtkSpaceSkipMPIExchange::New(
-  vtkMultiProcessController* controller, WarnFunction warn)
+  vtkMultiProcessController* controller, WarnFunction warn, bool oneHost)
 {
   auto* mpi = vtkMPIController::SafeDownCast(controller);
   if (!mpi || mpi->GetNumberOfProcesses() < 2)
@@ -88,6 +94,7 @@ std::shared_ptr<vtkSpaceSkipMPIExchange> vtkSpaceSkipMPIExchange::New(
   ex->Rank = ex->Controller->GetLocalProcessId();
   ex->Size = ex->Controller->GetNumberOfProcesses();
   ex->Warn = std::move(warn);
+  ex->OneHost = oneHost;
   return ex;
 }
 
@@ -140,11 +147,12 @@ void vtkSpaceSkipMPIExchange::GiveUp(const std::string& why)
     }
   }
   this->Sends.clear();
+  this->VerdictsDue = false;
   if (this->Rank == 0)
   {
     for (int r = 1; r < this->Size; ++r)
     {
-      this->Send({ static_cast<int>(this->Frame), 0 }, {}, r, kVerdictTag);
+      this->Send({ static_cast<int>(this->Frame), 0, 0 }, {}, r, kVerdictTag);
     }
   }
   if (this->Warn)
@@ -188,6 +196,7 @@ void vtkSpaceSkipMPIExchange::Begin()
   }
   if (this->Rank == 0)
   {
+    this->Released(true); // the verdicts of a frame the mapper did not draw
     ++this->Frame;
     this->BeginTime = Clock::now();
     return;
@@ -196,9 +205,9 @@ void vtkSpaceSkipMPIExchange::Begin()
   {
     // Rank 0's word on the previous frame: it normally arrived while IceT composited it.
     auto* comm = vtkMPICommunicator::SafeDownCast(this->Controller->GetCommunicator());
-    int verdict[2] = { -1, 0 };
+    int verdict[kVerdictInts] = { -1, 0, 0 };
     std::vector<Request> req(1);
-    comm->NoBlockReceive(verdict, 2, 0, kVerdictTag, req[0]);
+    comm->NoBlockReceive(verdict, kVerdictInts, 0, kVerdictTag, req[0]);
     if (!WaitAll(req, After(this->BeginSeconds)))
     {
       this->GiveUp("rank 0 did not answer for " + std::to_string(this->BeginSeconds) + " s");
@@ -209,6 +218,11 @@ void vtkSpaceSkipMPIExchange::Begin()
     {
       this->GiveUp(verdict[1] != 1 ? "rank 0 gave up" : "the ranks are on different frames");
       return;
+    }
+    if (this->SentShared)
+    {
+      // Rank 0 mapped the shared image (or could not: host memory from now on).
+      this->Device = verdict[2] == 1 ? DeviceState::On : DeviceState::Off;
     }
   }
   ++this->Frame;
@@ -229,14 +243,30 @@ int vtkSpaceSkipMPIExchange::Finish(
   }
   std::vector<int> boxes;
   std::vector<float> pixels;
+  // One piece shared through CUDA IPC: its handle instead of (or, until rank 0 mapped it once,
+  // beside) its pixels.
+  const bool shared = mine.size() == 1 && mine[0].Shared;
+  const bool withPixels = !shared ||
+    mine[0].Pixels.size() == 4 * size_t(std::max(mine[0].Width, 0)) * size_t(std::max(mine[0].Height, 0));
+  std::vector<int> header = { static_cast<int>(this->Frame), width, height,
+    static_cast<int>(mine.size()), shared ? (withPixels ? 2 : 1) : 0 };
+  header.resize(kHeaderInts, 0);
+  if (shared)
+  {
+    static_assert(sizeof(mine[0].Handle) == kHandleInts * sizeof(int), "a handle is 16 ints");
+    std::memcpy(&header[5], mine[0].Handle, sizeof(mine[0].Handle));
+  }
+  this->SentShared = shared;
   for (PieceImage& p : mine)
   {
     boxes.insert(boxes.end(), { p.X, p.Y, p.Width, p.Height });
     boxes.insert(boxes.end(), p.Owned, p.Owned + 6);
-    pixels.insert(pixels.end(), p.Pixels.begin(), p.Pixels.end());
+    if (withPixels)
+    {
+      pixels.insert(pixels.end(), p.Pixels.begin(), p.Pixels.end());
+    }
   }
-  this->Send({ static_cast<int>(this->Frame), width, height, static_cast<int>(mine.size()) }, {}, 0,
-    kHeaderTag);
+  this->Send(std::move(header), {}, 0, kHeaderTag);
   if (!boxes.empty())
   {
     this->Send(std::move(boxes), {}, 0, kBoxesTag);
@@ -301,11 +331,12 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
   for (int r = 1; r < this->Size; ++r)
   {
     const int* h = &headers[size_t(r - 1) * kHeaderInts];
-    if (h[0] != this->Frame || h[1] != width || h[2] != height || h[3] < 0 || h[3] > kMaxPieces)
+    if (h[0] != this->Frame || h[1] != width || h[2] != height || h[3] < 0 || h[3] > kMaxPieces ||
+      h[4] < 0 || h[4] > 2 || (h[4] != 0 && h[3] != 1))
     {
       this->GiveUp(h[0] != this->Frame ? "the ranks are on different frames"
-          : h[3] < 0 || h[3] > kMaxPieces ? "a rank sent a bad piece count"
-                                          : "the ranks' viewports differ");
+          : h[1] != width || h[2] != height ? "the ranks' viewports differ"
+                                            : "a rank sent a bad piece count");
       return -1;
     }
     if (h[3] > 0)
@@ -324,6 +355,7 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
   reqs.clear();
   for (int r = 1; r < this->Size; ++r)
   {
+    const bool pixelsFollow = headers[size_t(r - 1) * kHeaderInts + 4] != 1;
     size_t total = 0;
     for (size_t k = 0; k < boxes[r - 1].size(); k += kBoxInts)
     {
@@ -334,7 +366,7 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
         this->GiveUp("a rank sent a rectangle outside the viewport");
         return -1;
       }
-      total += 4 * size_t(b[2]) * size_t(b[3]);
+      total += pixelsFollow ? 4 * size_t(b[2]) * size_t(b[3]) : 0;
     }
     if (total > 0)
     {
@@ -348,8 +380,10 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
     return -1;
   }
   others.clear();
+  this->SharedBy.assign(size_t(this->Size), 0);
   for (int r = 1; r < this->Size; ++r)
   {
+    const int* h = &headers[size_t(r - 1) * kHeaderInts];
     const float* px = pixels[r - 1].data();
     for (size_t k = 0; k < boxes[r - 1].size(); k += kBoxInts)
     {
@@ -361,14 +395,52 @@ int vtkSpaceSkipMPIExchange::FinishRoot(int width, int height, std::vector<Piece
       p.Height = b[3];
       std::copy(b + 4, b + 10, p.Owned);
       const size_t count = 4 * size_t(std::max(p.Width, 0)) * size_t(std::max(p.Height, 0));
-      p.Pixels.assign(px, px + count);
-      px += count;
+      if (h[4] != 1)
+      {
+        p.Pixels.assign(px, px + count);
+        px += count;
+      }
+      if (h[4] != 0)
+      {
+        p.Shared = true;
+        p.Source = r;
+        std::memcpy(p.Handle, h + 5, sizeof(p.Handle));
+        this->SharedBy[size_t(r)] = 1;
+      }
       others.push_back(std::move(p));
     }
   }
+  // The verdicts go once the mapper has read the pieces (Released): a rank draws its next frame
+  // into its shared image only then.
+  this->VerdictsDue = true;
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkSpaceSkipMPIExchange::DevicePieces() const
+{
+  if (this->Failed || !this->OneHost || this->Device == DeviceState::Off)
+  {
+    return 0;
+  }
+  return this->Rank == 0 ? 3 : this->Device == DeviceState::On ? 1 : 2;
+}
+
+//------------------------------------------------------------------------------
+void vtkSpaceSkipMPIExchange::Released(bool mapped)
+{
+  if (this->Rank != 0 || !this->VerdictsDue || this->Failed)
+  {
+    return;
+  }
+  this->VerdictsDue = false;
   for (int r = 1; r < this->Size; ++r)
   {
-    this->Send({ static_cast<int>(this->Frame), 1 }, {}, r, kVerdictTag);
+    const int sharedMapped = mapped && r < static_cast<int>(this->SharedBy.size()) && this->SharedBy[size_t(r)];
+    this->Send({ static_cast<int>(this->Frame), 1, sharedMapped }, {}, r, kVerdictTag);
   }
-  return 1;
+  if (!mapped)
+  {
+    this->Device = DeviceState::Off;
+  }
 }

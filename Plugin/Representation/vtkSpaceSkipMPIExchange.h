@@ -19,8 +19,16 @@ class vtkMultiProcessController;
 /**
  * Every rank draws its piece exactly into a float image; rank 0 receives the others' images (the
  * rectangle of pixels they drew, and their cells), its mapper blends all of them front to back in
- * the order the rays meet the pieces and draws the sum; the other ranks draw nothing. IceT then composites one exact image with empty ones, which its 8-bit
- * blend leaves unchanged: N ranks give the serial image (within one rounding).
+ * the order the rays meet the pieces and draws the sum; the other ranks draw nothing. IceT then
+ * composites one exact image with empty ones, which its 8-bit blend leaves unchanged: N ranks
+ * give the serial image (within one rounding).
+ *
+ * On one host (`oneHost`) a CUDA frame stays on its GPU: each rank copies it into an image the
+ * others map through CUDA IPC and sends only its handle; rank 0's mapper blends the pieces on its
+ * GPU, reading the others' memory where it lies (NVLink or PCIe), and draws the sum through
+ * CUDA-GL interop. Until rank 0 has mapped a rank's image once, that rank sends its pixels too;
+ * a failure to map turns it off (host memory from then on, said once). Rank 0 sends the verdict
+ * only after the blend (Released), so no rank draws over an image still being read.
  *
  * It never waits forever. The messages travel on a communicator of its own. Other ranks send
  * without waiting (non-blocking sends). Rank 0 waits for every rank's "frame begun" message for
@@ -38,8 +46,10 @@ public:
 
   /// Collective over `controller`'s ranks (it duplicates the communicator); null when
   /// `controller` is not an MPI controller of more than one rank.
+  /// `oneHost`: every rank runs on one host (their GPUs may map each other's frames: the pieces
+  /// then stay on the GPUs, DevicePieces()).
   static std::shared_ptr<vtkSpaceSkipMPIExchange> New(
-    vtkMultiProcessController* controller, WarnFunction warn);
+    vtkMultiProcessController* controller, WarnFunction warn, bool oneHost = false);
   ~vtkSpaceSkipMPIExchange() override;
 
   /**
@@ -54,6 +64,8 @@ public:
   void Begin() override;
   int Finish(int width, int height, std::vector<PieceImage>& mine,
     std::vector<PieceImage>& others) override;
+  int DevicePieces() const override;
+  void Released(bool mapped) override;
 
   /// Whether it gave up (the ranks draw their own pieces).
   bool GaveUp() const { return this->Failed; }
@@ -74,6 +86,19 @@ private:
   long long Frame = 0;
   bool Failed = false;
   bool VerdictPending = false; // a non-root rank: the verdict of frame Frame is due
+  bool VerdictsDue = false;    // rank 0: the verdicts of frame Frame wait for Released()
+  // Pieces on the GPUs (CUDA IPC): On once rank 0 mapped this rank's shared image, Off after a
+  // failure (host memory from then on).
+  enum class DeviceState
+  {
+    Unknown,
+    On,
+    Off
+  };
+  DeviceState Device = DeviceState::Unknown;
+  bool OneHost = false;
+  bool SentShared = false;   // a non-root rank: its last piece was shared
+  std::vector<char> SharedBy; // rank 0: which ranks shared their piece this frame
   std::chrono::steady_clock::time_point BeginTime;
   std::list<Pending> Sends;
   WarnFunction Warn;

@@ -518,8 +518,9 @@ void vtkSpaceSkipVolumeRepresentation::UpdateExchange(vtkMultiProcessController*
   {
     // Collective (a communicator of its own): every rank runs RequestData. One that gave up
     // stays off until the property is turned off and on (the same on every rank).
-    this->Exchange = vtkSpaceSkipMPIExchange::New(
-      controller, [](const std::string& m) { vtkGenericWarningMacro(<< "SpaceSkip: " << m); });
+    this->Exchange = vtkSpaceSkipMPIExchange::New(controller,
+      [](const std::string& m) { vtkGenericWarningMacro(<< "SpaceSkip: " << m); },
+      this->RanksOnNode == controller->GetNumberOfProcesses());
   }
   else if (!want)
   {

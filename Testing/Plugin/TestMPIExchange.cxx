@@ -1,11 +1,15 @@
 // vtkSpaceSkipMPIExchange under mpiexec -n 2: the pieces travel whole (frame 1), and a rank that
 // does not draw a frame (frame 2: its volume culled, hidden, or an exception) makes both ranks
 // give up within the time limit and draw their own pieces, instead of waiting forever.
+// Then, on one host, pieces shared through CUDA IPC: the handle travels with the pixels until
+// rank 0 has mapped it, then alone; rank 1 draws its next frame only after rank 0 has read the
+// last one (Released); a failure to map sends the pixels through host memory again.
 #include "vtkSpaceSkipMPIExchange.h"
 
 #include "vtkMPIController.h"
 #include "vtkNew.h"
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <string>
@@ -39,6 +43,82 @@ vtkSpaceSkippingVolumeMapper::PieceImage Piece(int rank)
   }
   return p;
 }
+}
+
+// A piece left on the GPU and shared (the mapper's part: PieceImage::Shared and Handle).
+vtkSpaceSkippingVolumeMapper::PieceImage SharedPiece(bool withPixels)
+{
+  auto p = Piece(1);
+  p.X = p.Y = 0;
+  p.Width = 300;
+  p.Height = 200;
+  p.Pixels.assign(withPixels ? 4 * 300 * 200 : 0, 0.25f);
+  p.Shared = true;
+  for (int i = 0; i < 64; ++i)
+  {
+    p.Handle[i] = static_cast<char>(i * 3 + 1);
+  }
+  return p;
+}
+
+void SharedPieces(vtkMPIController* controller, int rank)
+{
+  int warnings = 0;
+  auto ex = vtkSpaceSkipMPIExchange::New(
+    controller, [&](const std::string&) { ++warnings; }, /*oneHost=*/true);
+  ex->BeginSeconds = 5.0;
+  ex->ImageSeconds = 5.0;
+  using Clock = std::chrono::steady_clock;
+  const auto expected = SharedPiece(true);
+  // `how` the rank expects to be asked for; rank 0 checks what came and releases (mapped or not)
+  // after `hold` seconds.
+  auto frame = [&](const char* name, int how, bool send, bool withPixels, bool mapped, double hold) {
+    const auto t0 = Clock::now();
+    ex->Begin();
+    const double began = std::chrono::duration<double>(Clock::now() - t0).count();
+    const int asked = ex->DevicePieces();
+    std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> mine;
+    if (rank == 0)
+    {
+      mine.push_back(Piece(0));
+    }
+    else
+    {
+      mine.push_back(send ? SharedPiece(withPixels) : Piece(1));
+    }
+    std::vector<vtkSpaceSkippingVolumeMapper::PieceImage> others;
+    const int r = ex->Finish(300, 200, mine, others);
+    if (rank == 0)
+    {
+      const bool shared = others.size() == 1 && others[0].Shared == send &&
+        (!send || (others[0].Source == 1 && std::equal(expected.Handle, expected.Handle + 64, others[0].Handle)));
+      const bool pixels = others.size() == 1 &&
+        others[0].Pixels.size() == (withPixels ? 4 * size_t(others[0].Width) * size_t(others[0].Height) : 0);
+      Check(r == 1 && asked == how && shared && pixels, rank,
+        std::string(name) + ": asked " + std::to_string(asked) + ", rank 1's piece as sent");
+      std::this_thread::sleep_for(std::chrono::duration<double>(hold));
+      ex->Released(mapped);
+    }
+    else
+    {
+      Check(r == 0 && asked == how, rank, std::string(name) + ": asked " + std::to_string(asked));
+    }
+    return began;
+  };
+  // Rank 1 shares, rank 0 has not mapped it yet: the pixels come too. Rank 0 holds the pieces
+  // 0.3 s before it releases them.
+  frame("shared 1", rank == 0 ? 3 : 2, true, true, true, 0.3);
+  // Mapped: the handle alone. Rank 1's Begin waited for rank 0's release.
+  const double began = frame("shared 2", rank == 0 ? 3 : 1, true, false, false, 0.0);
+  if (rank == 1)
+  {
+    Check(began >= 0.25, rank, "rank 1 began frame 'shared 2' after rank 0 released frame 'shared 1' (" +
+        std::to_string(began) + " s)");
+  }
+  // Rank 0 could not map it: host memory again, on both ranks.
+  frame("host again", 0, false, true, true, 0.0);
+  Check(!ex->GaveUp(), rank, "the exchange goes on after a failed map");
+  ex.reset();
 }
 
 int main(int argc, char* argv[])
@@ -131,6 +211,7 @@ int main(int argc, char* argv[])
     Check(r == -1 && waited < 0.5, rank, "after giving up: no wait, own piece drawn");
   }
   ex.reset();
+  SharedPieces(controller, rank);
   controller->Barrier();
   controller->Finalize();
   return failures == 0 ? 0 : 1;

@@ -1,16 +1,17 @@
 // The multi-GPU driver's blend of the ranks' images, one function for the host path
 // (mpi_pieces.cpp) and the GPU path's kernel (gpu_composite.cu); no CUDA types.
 #pragma once
-#include "spaceskip/Math.h"
+#include "spaceskip/PeerImages.h"
 
 #include <cstddef>
 
 namespace spaceskip::mpi {
 
-/// Premultiplied front-to-back "over": `back` added where `front` still lets light through.
+/// Premultiplied front-to-back "over" (spaceskip::addBehind, the product's piece blend):
+/// `back` added where `front` still lets light through.
 SS_FUNC vec4f behind(vec4f front, vec4f back) {
-  const float t = 1.f - front.w;
-  return vec4f{front.x + t * back.x, front.y + t * back.y, front.z + t * back.z, front.w + t * back.w};
+  addBehind(front, back, 2.f);
+  return front;
 }
 
 constexpr int kMaxRanks = 16;
