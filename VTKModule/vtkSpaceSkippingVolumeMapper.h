@@ -304,6 +304,9 @@ public:
    * image is not copied at all: CUDA blends it into that framebuffer's colour texture as GL's
    * blend would, and GL draws nothing for it. GetCompositeBlendUsed(): "cuda" (that path), "gl"
    * (a texture drawn by GL) or "none".
+   * With a PieceExchange that takes device pieces (MPI ranks on one host), a piece's float
+   * frame stays on the GPU too: the ranks share their frames through CUDA IPC and the process
+   * that composites blends them on its GPU (off: through host memory).
    */
   vtkSetMacro(GPUComposite, vtkTypeBool);
   vtkGetMacro(GPUComposite, vtkTypeBool);

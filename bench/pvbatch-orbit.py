@@ -32,7 +32,11 @@ parser.add_argument("--turn", type=float, default=6.0)
 parser.add_argument("--backend", default="Auto")
 parser.add_argument("--builder", default="Auto")
 parser.add_argument("--stock", action="store_true", help="ParaView's own Volume instead of ours")
+parser.add_argument("--outline", action="store_true",
+                    help="ParaView's Outline instead of a volume: the floor of ParaView's own frame (passes, IceT)")
 parser.add_argument("--shade", action="store_true", help="shaded (under MPI the pieces then take a ghost layer)")
+parser.add_argument("--host-composite", action="store_true",
+                    help="ours with Keep Image On GPU off: frames and MPI pieces through host memory")
 parser.add_argument("--png", default="", help="save the first frame here")
 parser.add_argument("--reference", default="", help="compare the first frame with this image")
 parser.add_argument("--result", default="", help="append the result lines to this file too (pvbatch -v N "
@@ -72,7 +76,7 @@ view.ViewSize = [args.view, args.view]
 view.OrientationAxesVisibility = 0
 view.UseFXAA = 0
 disp = simple.Show(reader, view)
-disp.SetRepresentationType("Volume" if args.stock else "Space Skipping Volume")
+disp.SetRepresentationType("Outline" if args.outline else "Volume" if args.stock else "Space Skipping Volume")
 simple.ColorBy(disp, ("POINTS", "ImageFile"))
 # The paper's ramp: transparent at the lowest value, opacity rising linearly to the top.
 lo, hi = reader.PointData["ImageFile"].GetRange()
@@ -82,9 +86,11 @@ lut.RescaleTransferFunction(lo, hi)
 pwf = simple.GetOpacityTransferFunction("ImageFile")
 pwf.Points = [lo, 0.0, 0.5, 0.0, hi, 1.0, 0.5, 0.0]
 disp.Shade = 1 if args.shade else 0
-if not args.stock:
+if not args.stock and not args.outline:
     disp.Backend = args.backend
     disp.Builder = args.builder
+    if args.host_composite:
+        disp.GPUComposite = 0
 view.ResetCamera()
 cam = view.GetActiveCamera()
 cam.Elevation(20.0)
@@ -108,11 +114,12 @@ for _ in range(args.frames):
     times.append(frame())
 med = statistics.median(times)
 used = ""
-if not args.stock:
+if not args.stock and not args.outline:
     disp.UpdatePropertyInformation()
     used = " backend=%s builder=%s" % (disp.GetPropertyValue("BackendUsed"), disp.GetPropertyValue("BuilderUsed"))
-report("PVBATCH_ORBIT ranks=%d rep=%s%s volume=%dx%dx%d %s view=%d frames=%d fps=%.1f median_ms=%.3f "
-       "first_s=%.3f to_first_s=%.3f%s" % (ranks, "Volume" if args.stock else "SpaceSkip", " shaded" if args.shade else "",
+report("PVBATCH_ORBIT ranks=%d rep=%s%s%s volume=%dx%dx%d %s view=%d frames=%d fps=%.1f median_ms=%.3f "
+       "first_s=%.3f to_first_s=%.3f%s" % (ranks, "Outline" if args.outline else "Volume" if args.stock else "SpaceSkip", " shaded" if args.shade else "",
+                                            " host-composite" if args.host_composite else "",
                                             dims[0], dims[1], dims[2], m.group(4), args.view, args.frames, 1.0 / med,
                                             1e3 * med, first, to_first, used))
 

@@ -770,6 +770,7 @@ vtkSpaceSkipForwardGet(FrameCount, int)
 
 vtkSpaceSkipForwardBool(EarlyRayTermination)
 vtkSpaceSkipForwardBool(UseJittering)
+vtkSpaceSkipForwardBool(GPUComposite)
 vtkSpaceSkipForwardBool(InteractiveAdjustSampleDistances)
 
 bool vtkSpaceSkipVolumeRepresentation::NeedsNeighbourPoints()

@@ -57,6 +57,8 @@ public:
   void SetEarlyRayTermination(int on);
   int GetEarlyRayTermination();
   void SetUseJittering(int on);
+  void SetGPUComposite(int on);
+  int GetGPUComposite();
   void SetInteractiveAdjustSampleDistances(int on);
   int GetInteractiveAdjustSampleDistances();
   ///@{

@@ -18,7 +18,8 @@
 #                PVB_STOCK=1: ParaView's Volume too (PVB_BACKEND CUDA, PVB_VIEW 1024)
 #                PVB_SMP: VTK's SMP backend for ParaView's own passes (default STDThread);
 #                PVB_VERBOSITY 5: each composited frame's phases in logs/pvbatch-N.log;
-#                PVB_ARGS: more options of pvbatch-orbit.py (e.g. --shade)
+#                PVB_ARGS: more options of pvbatch-orbit.py (e.g. --shade);
+#                PVB_HOST_AB=1: each run of ours again with --host-composite (A/B in one hold)
 #   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
 #                --raw; TS_WORKDIR keeps the written steps for a later run; TS_ARGS more options,
 #                e.g. "--cache 4000" for ParaView's animation cache)
@@ -26,6 +27,9 @@
 #   bench/device/run-pv.sh OUTDIR [PHASE...]     (default: probe tests parallel bench-stock bench-ts)
 #   env: BUNDLE (default /tmp/bun), DEADLINE (epoch seconds: later phases are skipped),
 #        PLUGIN_LIBS (a folder of libraries to load before the bundle's)
+#        PLUGIN_DIR (a folder with a newer SpaceSkip.so and libvtkSpaceSkipRepresentation.so: the
+#        plugin's XML and representation without repacking the bundle; also put first in the
+#        library path)
 # OUTDIR receives env.txt, pv.log (everything printed) and logs.tgz (each test's output).
 set -uo pipefail
 out=${1:?usage: run-pv.sh OUTDIR [PHASE...]}
@@ -74,12 +78,14 @@ else
 fi
 # PLUGIN_LIBS: a folder of libraries loaded before the bundle's (e.g. a newer libvtkSpaceSkip.so:
 # an A/B of a VTK-module change without repacking the bundle).
+PLUGIN_LIBS=${PLUGIN_LIBS:-${PLUGIN_DIR:+$(cd "$PLUGIN_DIR" && pwd)}}
 export LD_LIBRARY_PATH=${PLUGIN_LIBS:+$PLUGIN_LIBS:}$P/lib${mpilib:+:$mpilib}:$B/x/lib${nvdir:+:$nvdir}${sys_ldpath:+:$sys_ldpath}
 export __GLX_VENDOR_LIBRARY_NAME=nvidia
 export PYTHONHOME=$P/python PYTHONPATH=$P/python/dist-packages:$src/Testing/Plugin
 # The plugin's tests ask for the CPU backend (CI has no GPU): here CUDA (TEST_BACKEND) instead.
 export SPACESKIP_TEST_BACKEND=${TEST_BACKEND:-CUDA}
-export SPACESKIP_PLUGIN=$P/plugin/SpaceSkip.so SPACESKIP_DATA=$src/Data \
+plugin_so=${PLUGIN_DIR:+$(cd "$PLUGIN_DIR" && pwd)/SpaceSkip.so}
+export SPACESKIP_PLUGIN=${plugin_so:-$P/plugin/SpaceSkip.so} SPACESKIP_DATA=$src/Data \
   SPACESKIP_BASELINES=$src/Testing/Plugin/Baseline SPACESKIP_TEMP=$work/tmp
 mkdir -p "$SPACESKIP_TEMP" "$work/logs"
 pvbatch=$P/bin/pvbatch
@@ -148,9 +154,12 @@ if has bench-pvbatch; then
   [ -f "$raw" ] || run "generate-$shape-$n" 600 "$P/bin/spaceskip" generate "$shape" --dims "$n" "$n" "$n" -o "$raw"
   for stock in "" ${PVB_STOCK:+--stock}; do
     for r in ${PVB_RANKS:-1 2}; do
+     # PVB_HOST_AB=1: ours also with Keep Image On GPU off (frames and pieces through host memory).
+     for comp in "" ${PVB_HOST_AB:+--host-composite}; do
+      [ -z "$comp" ] || [ -z "$stock" ] || continue
       # Several ranks need the machine's mpirun (as the parallel phase does).
       [ "$r" = 1 ] || [ -z "$mpilib" ] || { log "pvbatch-$r: skipped (no mpirun here)"; continue; }
-      tag=pvbatch-$r${stock:+-stock}
+      tag=pvbatch-$r${stock:+-stock}${comp:+-host}
       launch=("$pvbatch")
       [ "$r" = 1 ] || launch=(mpirun --allow-run-as-root --oversubscribe --bind-to none -n "$r" "$pvbatch")
       # PVB_VERBOSITY 5: the mapper logs each composited frame's phases (logs/pvbatch-N.log).
@@ -159,7 +168,8 @@ if has bench-pvbatch; then
       [ "$r" = 1 ] || ref=(--reference "$work/logs/pvbatch-1${stock:+-stock}.png")
       TAIL=3 run "$tag" 600 "${launch[@]}" "$src/bench/pvbatch-orbit.py" --plugin "$SPACESKIP_PLUGIN" \
         --raw "$raw" --frames "${PVB_FRAMES:-60}" --backend "${PVB_BACKEND:-CUDA}" --view "${PVB_VIEW:-1024}" $stock \
-        ${PVB_ARGS:-} --png "$work/logs/$tag.png" --result "$work/logs/$tag.result" "${ref[@]}"
+        ${PVB_ARGS:-} $comp --png "$work/logs/$tag.png" --result "$work/logs/$tag.result" "${ref[@]}"
+     done
     done
   done
   cat "$work"/logs/pvbatch-*.result >> "$out/pv.log" 2>/dev/null
