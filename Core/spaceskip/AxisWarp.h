@@ -41,7 +41,7 @@ struct AxisWarpView {
   SS_FUNC static float axis(float u, const float* c, const int32_t* cell, int32_t n) {
     if (!(u > 0.f) || !(u < float(n - 1))) return u;
     const int32_t j = int32_t(u);
-    int32_t lo = cell[j], hi = cell[j + 1 < n ? j + 1 : n - 1];
+    int32_t lo = cell[j], hi = cell[j + 1];  // j <= n - 2: u < n - 1
     while (lo < hi) {  // the last i in [lo, hi] with c[i] <= u
       const int32_t mid = (lo + hi + 1) >> 1;
       if (c[mid] <= u) {

@@ -136,13 +136,7 @@ struct PoolSampler {
     const int64_t ly0 = y0 - Py * brick, ly1 = ly0 + (y1 - y0);
     const int64_t lz0 = z0 - Pz * brick, lz1 = lz0 + (z1 - z0);
     auto fetch = [&](int64_t i, int64_t j, int64_t k) { return voxelValue(d[i + e * (j + e * k)]); };
-    float c00 = fetch(lx0, ly0, lz0) + (fetch(lx1, ly0, lz0) - fetch(lx0, ly0, lz0)) * fx;
-    float c10 = fetch(lx0, ly1, lz0) + (fetch(lx1, ly1, lz0) - fetch(lx0, ly1, lz0)) * fx;
-    float c01 = fetch(lx0, ly0, lz1) + (fetch(lx1, ly0, lz1) - fetch(lx0, ly0, lz1)) * fx;
-    float c11 = fetch(lx0, ly1, lz1) + (fetch(lx1, ly1, lz1) - fetch(lx0, ly1, lz1)) * fx;
-    float c0 = c00 + (c10 - c00) * fy;
-    float c1 = c01 + (c11 - c01) * fy;
-    return c0 + (c1 - c0) * fz;
+    return trilinear(fetch, lx0, lx1, ly0, ly1, lz0, lz1, fx, fy, fz);
   }
 };
 

@@ -4,8 +4,8 @@
 #   - each volume as the image it is and as a rectilinear grid of the same points (--rectilinear:
 #     x steps growing 1:3, z steps varying ~1:2), the same builders, alternated twice: what sampling
 #     through the coordinates costs;
-#   - with CLI_OLD (an earlier CLI), the image with the old and the new CLI alternated: what the
-#     warp's branch in the exact sampler costs a volume without one.
+#   - with CLI_OLD (an earlier CLI), the image and the grid with the old and the new CLI
+#     alternated: what a change to the samplers costs (new/old for each).
 # Usage: CLI=... [CLI_OLD=...] [RECT_CASES="gen:nbody:1024 gen:rm:512"] [RECT_BUILDERS=...]
 #        bash bench/device/rectilinear.sh OUTDIR
 set -euo pipefail
@@ -24,7 +24,10 @@ for spec in $cases; do
   for rep in 1 2; do
     run "${name}_image_$rep" "$CLI" "$spec"
     run "${name}_rect_$rep" "$CLI" "$spec" --rectilinear
-    if [ -n "${CLI_OLD:-}" ]; then run "${name}_old_$rep" "$CLI_OLD" "$spec"; fi
+    if [ -n "${CLI_OLD:-}" ]; then
+      run "${name}_old_$rep" "$CLI_OLD" "$spec"
+      run "${name}_oldrect_$rep" "$CLI_OLD" "$spec" --rectilinear
+    fi
   done
 done
 # One line per case and builder: fps of each run (the CSV's fps column).
@@ -37,10 +40,13 @@ for f in sorted(glob.glob(os.path.join(out, "*.csv"))):
     for r in csv.DictReader(open(f)):
         case, kind, rep = tag.rsplit("_", 2)
         rows.setdefault((case, r["builder"]), {}).setdefault(kind, []).append(float(r["fps"]))
-print("case builder | image fps | rectilinear fps | rect/image | old image fps | new/old")
+print("case builder | image fps | rectilinear fps | rect/image | old image fps | new/old | old rect fps | new/old rect")
 for (case, b), k in sorted(rows.items()):
     med = lambda xs: sorted(xs)[len(xs) // 2] if xs else float("nan")
     img, rect, old = med(k.get("image", [])), med(k.get("rect", [])), med(k.get("old", []))
-    print("%s %s | %.1f | %.1f | %.3f | %.1f | %.3f" % (case, b, img, rect, rect / img, old, img / old if old else float("nan")))
+    oldr = med(k.get("oldrect", []))
+    nan = float("nan")
+    print("%s %s | %.1f | %.1f | %.3f | %.1f | %.3f | %.1f | %.3f" % (case, b, img, rect, rect / img, old,
+          img / old if old else nan, oldr, rect / oldr if oldr else nan))
 EOF
 cat "$out/summary.txt"

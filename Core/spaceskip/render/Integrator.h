@@ -5,7 +5,6 @@
 #pragma once
 #include <type_traits>
 
-#include "../AxisWarp.h"
 #include "../Volume.h"  // VoxelType
 #include "FrameShared.h"
 #include "RayGen.h"
@@ -55,6 +54,21 @@ SS_FUNC float voxelValue(double v) { return voxelValue(float(v)); }
 template <class T>
 SS_FUNC float voxelValue(T v) { return float(v); }
 
+/// Trilinear interpolation in the cell [x0, x1] x [y0, y1] x [z0, z1] at the fractions fx, fy, fz,
+/// the corners read by `fetch(i, j, k)`: one body for every sampler (voxel arrays, grids read
+/// through their coordinates, the sparse pool's bricks).
+template <class Fetch>
+SS_FORCE_FUNC float trilinear(const Fetch& fetch, int64_t x0, int64_t x1, int64_t y0, int64_t y1, int64_t z0,
+                              int64_t z1, float fx, float fy, float fz) {
+  const float c00 = fetch(x0, y0, z0) + (fetch(x1, y0, z0) - fetch(x0, y0, z0)) * fx;
+  const float c10 = fetch(x0, y1, z0) + (fetch(x1, y1, z0) - fetch(x0, y1, z0)) * fx;
+  const float c01 = fetch(x0, y0, z1) + (fetch(x1, y0, z1) - fetch(x0, y0, z1)) * fx;
+  const float c11 = fetch(x0, y1, z1) + (fetch(x1, y1, z1) - fetch(x0, y1, z1)) * fx;
+  const float c0 = c00 + (c10 - c00) * fy;
+  const float c1 = c01 + (c11 - c01) * fy;
+  return c0 + (c1 - c0) * fz;
+}
+
 /// Exact trilinear sampling in float from a linear voxel array (clamped at the border).
 template <class T>
 struct ArraySampler {
@@ -78,13 +92,8 @@ struct ArraySampler {
     axis(p.x, nx, x0, x1, fx);
     axis(p.y, ny, y0, y1, fy);
     axis(p.z, nz, z0, z1, fz);
-    float c00 = fetch(x0, y0, z0) + (fetch(x1, y0, z0) - fetch(x0, y0, z0)) * fx;
-    float c10 = fetch(x0, y1, z0) + (fetch(x1, y1, z0) - fetch(x0, y1, z0)) * fx;
-    float c01 = fetch(x0, y0, z1) + (fetch(x1, y0, z1) - fetch(x0, y0, z1)) * fx;
-    float c11 = fetch(x0, y1, z1) + (fetch(x1, y1, z1) - fetch(x0, y1, z1)) * fx;
-    float c0 = c00 + (c10 - c00) * fy;
-    float c1 = c01 + (c11 - c01) * fy;
-    return c0 + (c1 - c0) * fz;
+    return trilinear([this](int64_t i, int64_t j, int64_t k) { return fetch(i, j, k); }, x0, x1, y0, y1, z0, z1, fx,
+                     fy, fz);
   }
 };
 
@@ -118,13 +127,8 @@ struct WarpedSampler {
     ArraySampler<float>::axis(p.x, nx, x0, x1, fx);
     ArraySampler<float>::axis(p.y, ny, y0, y1, fy);
     ArraySampler<float>::axis(p.z, nz, z0, z1, fz);
-    float c00 = fetch(x0, y0, z0) + (fetch(x1, y0, z0) - fetch(x0, y0, z0)) * fx;
-    float c10 = fetch(x0, y1, z0) + (fetch(x1, y1, z0) - fetch(x0, y1, z0)) * fx;
-    float c01 = fetch(x0, y0, z1) + (fetch(x1, y0, z1) - fetch(x0, y0, z1)) * fx;
-    float c11 = fetch(x0, y1, z1) + (fetch(x1, y1, z1) - fetch(x0, y1, z1)) * fx;
-    float c0 = c00 + (c10 - c00) * fy;
-    float c1 = c01 + (c11 - c01) * fy;
-    return c0 + (c1 - c0) * fz;
+    return trilinear([this](int64_t i, int64_t j, int64_t k) { return fetch(i, j, k); }, x0, x1, y0, y1, z0, z1, fx,
+                     fy, fz);
   }
 };
 
