@@ -149,6 +149,10 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   spaceskip::PieceBlend DeviceBlend;
   // This process's piece as the exchange takes it (DevicePieces): shared, and downloaded too.
   void ShareDevicePiece(int how, PieceImage& piece);
+  // A `width` x `height` float4 image in device memory into Exchanged (host memory) and drawn;
+  // when it cannot be read back, said and nothing drawn (true: no shader failure).
+  bool DrawFromDevice(const void* image, int width, int height, vtkOpenGLRenderWindow* renWin,
+    bool eightBit, const char* what);
   // The exchanged pieces blended (on the GPU where this process's piece is there, else on the
   // host) and drawn; the exchange Released() once they are read. `where`: "GPU" or "host".
   bool DrawPieces(PieceExchange& exchange, std::vector<PieceImage>& pieces, const double eye[3],
@@ -734,7 +738,6 @@ void vtkSpaceSkippingVolumeMapper::RenderLocal(vtkRenderer* ren, vtkVolume* vol)
 //------------------------------------------------------------------------------
 void vtkSpaceSkippingVolumeMapper::vtkInternals::ShareDevicePiece(int how, PieceImage& piece)
 {
-  namespace pc = vtkSpaceSkipPieceCompositing;
   std::string problem;
   if (how == 1 || how == 2)
   {
@@ -752,19 +755,35 @@ void vtkSpaceSkippingVolumeMapper::vtkInternals::ShareDevicePiece(int how, Piece
   }
   if (how != 3 && (how == 2 || !piece.Shared))
   {
-    std::vector<PieceImage> one(1);
-    std::swap(one[0], piece);
-    if (!pc::ToHost(one, problem))
+    const size_t n = size_t(piece.Width) * size_t(piece.Height);
+    piece.Pixels.resize(4 * n);
+    if (!spaceskip::PeerImages::download(piece.Device, n, piece.Pixels.data(), problem))
     {
       this->Warn("could not read this process's frame back from the GPU (" + problem + ")");
-      one[0].Width = one[0].Height = 0;
+      piece.Pixels.clear();
+      piece.Width = piece.Height = 0;
     }
-    std::swap(one[0], piece);
     if (!piece.Shared)
     {
       piece.Device = nullptr; // host pixels only
     }
   }
+}
+
+//------------------------------------------------------------------------------
+bool vtkSpaceSkippingVolumeMapper::vtkInternals::DrawFromDevice(const void* image, int width,
+  int height, vtkOpenGLRenderWindow* renWin, bool eightBit, const char* what)
+{
+  std::string problem;
+  this->Exchanged.width = width;
+  this->Exchanged.height = height;
+  this->Exchanged.rgba.resize(size_t(width) * size_t(height));
+  if (!spaceskip::PeerImages::download(image, this->Exchanged.rgba.size(), &this->Exchanged.rgba[0].x, problem))
+  {
+    this->Warn(std::string("could not read ") + what + " back from the GPU (" + problem + "): not drawn");
+    return true;
+  }
+  return this->Image.GetCompositor().Draw(renWin, this->Exchanged, width, height, eightBit);
 }
 
 //------------------------------------------------------------------------------
@@ -808,21 +827,7 @@ bool vtkSpaceSkippingVolumeMapper::vtkInternals::DrawPieces(PieceExchange& excha
         return compositor.Draw(renWin, this->Exchanged, width, height, eightBit);
       }
       // The interop is off (another GPU, Mesa): the sum through host memory.
-      PieceImage sumPiece;
-      sumPiece.Width = width;
-      sumPiece.Height = height;
-      sumPiece.Device = sum;
-      std::vector<PieceImage> one(1, sumPiece);
-      if (pc::ToHost(one, problem))
-      {
-        this->Exchanged.width = width;
-        this->Exchanged.height = height;
-        this->Exchanged.rgba.resize(size_t(width) * size_t(height));
-        std::copy(one[0].Pixels.begin(), one[0].Pixels.end(), &this->Exchanged.rgba[0].x);
-        return compositor.Draw(renWin, this->Exchanged, width, height, eightBit);
-      }
-      this->Warn("could not read the blended pieces back from the GPU (" + problem + "): not drawn");
-      return true;
+      return this->DrawFromDevice(sum, width, height, renWin, eightBit, "the blended pieces");
     }
     this->Warn("could not blend the pieces on the GPU (" + problem + "): blended on the host");
   }
@@ -957,23 +962,8 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   }
   else if (draw == -1 && deviceImage) // the exchange is off: this process's frame, from the GPU
   {
-    std::string problem;
-    drawn = pc::ToHost(mine, problem) && !mine.empty() &&
-      mine[0].Pixels.size() == 4 * size_t(width) * size_t(height);
-    if (drawn)
-    {
-      const std::vector<float>& px = mine[0].Pixels;
-      d.Exchanged.width = width;
-      d.Exchanged.height = height;
-      d.Exchanged.rgba.resize(px.size() / 4);
-      std::copy(px.begin(), px.end(), &d.Exchanged.rgba[0].x);
-      drawn = compositor.Draw(renWin, d.Exchanged, width, height, eightBit);
-    }
-    else
-    {
-      d.Warn("could not read this process's frame back from the GPU (" + problem + "): not drawn");
-      drawn = true;
-    }
+    drawn = mine.empty() || mine[0].Width != width || mine[0].Height != height ||
+      d.DrawFromDevice(deviceImage, width, height, renWin, eightBit, "this process's frame");
   }
   else if (draw == -1) // the exchange is off: this process's own frame, as without it
   {

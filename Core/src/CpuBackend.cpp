@@ -293,8 +293,11 @@ void parallelCopy(void* dst, const void* src, size_t bytes) {
 }
 
 #ifndef SPACESKIP_HAVE_CUDA
+namespace {
+const char* const kNoCuda = "this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)";
+}
 std::unique_ptr<Backend> makeCudaBackend() {
-  throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
+  throw BackendError(kNoCuda);
 }
 bool cudaAvailable(std::string* why) {
   if (why) *why = "built without CUDA";
@@ -305,10 +308,10 @@ std::shared_ptr<unsigned char> allocatePageLocked(size_t) { return nullptr; }
 void* allocatePageLockedRaw(size_t) { return nullptr; }
 void freePageLocked(void*) {}
 std::vector<uint8_t> computeDistanceFieldCuda(const OccupancyGrid&, int) {
-  throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
+  throw BackendError(kNoCuda);
 }
 SubMasks computeSubMasksCuda(const Volume&, const TransferFunction&, int, int, size_t*) {
-  throw BackendError("this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)");
+  throw BackendError(kNoCuda);
 }
 
 struct DeviceImageCopy::Impl {};
@@ -320,9 +323,6 @@ int DeviceImageCopy::blendOver(const void*, int, int, void*, int, int, int, int,
 }
 void DeviceImageCopy::releaseSurface() {}
 
-namespace {
-const char* const kNoCuda = "this build of SpaceSkip has no CUDA backend (configured with SPACESKIP_ENABLE_CUDA=OFF)";
-}
 struct PeerImages::Impl {};
 PeerImages::PeerImages() = default;
 PeerImages::~PeerImages() = default;
