@@ -81,6 +81,7 @@ void vtkSpaceSkipStatistics::Print(std::ostream& os, vtkIndent indent) const
   os << indent << "CompositeBlendUsed: " << this->CompositeBlend << "\n";
   os << indent << "BackendUsed: " << this->BackendUsed << "\n";
   os << indent << "CudaDeviceUsed: " << this->CudaDevice << "\n";
+  os << indent << "PieceCompositingUsed: " << this->PieceCompositing << "\n";
   os << indent << "BuilderUsed: " << this->BuilderUsed << "\n";
   os << indent << "LastBuildSeconds: " << this->BuildSeconds << "\n";
   os << indent << "LastRenderSeconds: " << this->RenderSeconds << "\n";

@@ -41,6 +41,8 @@ struct vtkSpaceSkipStatistics
   std::string CompositePath = "none";
   std::string CompositeBlend = "none";
   std::string CudaDevice = "none"; // "device N of M" when the CUDA backend drew
+  // How the processes' pieces met (a PieceExchange, e.g. MPI ranks): "none" without one.
+  std::string PieceCompositing = "none";
 
   // How often each stage ran since the mapper was created.
   int Builds = 0;

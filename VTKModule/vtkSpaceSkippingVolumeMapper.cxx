@@ -175,6 +175,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   int BoundDevice = -1;
   int AskedDevice = -1;
   std::string DeviceReport;
+  std::string PieceReport = "none"; // vtkSpaceSkipStatistics::PieceCompositing of the last frame
   void BindDevice(int asked, int backend);
 
   // Reports a problem once (until the next different one); the caller then draws nothing.
@@ -238,6 +239,13 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
         }
       }
       this->Asked.CudaDevice = cuda && !this->DeviceReport.empty() ? this->DeviceReport : "none";
+    }
+    this->Asked.PieceCompositing = this->PieceReport;
+    if (this->Composite && this->PieceReport.find(" blended on the ") != std::string::npos)
+    {
+      // The blocks' pieces were drawn as one sum, through this mapper's compositor.
+      this->Asked.CompositePath = this->Image.GetCompositor().GetCompositePath();
+      this->Asked.CompositeBlend = this->Image.GetCompositor().GetBlendPath();
     }
     return this->Asked;
   }
@@ -478,6 +486,7 @@ vtkStatisticGetterMacro(const char*, BackendUsed, BackendUsed.c_str(), false);
 vtkStatisticGetterMacro(const char*, BuilderUsed, BuilderUsed.c_str(), false);
 vtkStatisticGetterMacro(const char*, CompositePathUsed, CompositePath.c_str(), false);
 vtkStatisticGetterMacro(const char*, CompositeBlendUsed, CompositeBlend.c_str(), false);
+vtkStatisticGetterMacro(const char*, PieceCompositingUsed, PieceCompositing.c_str(), false);
 vtkStatisticGetterMacro(const char*, BuilderChoice, BuilderChoice.c_str(), false);
 vtkStatisticGetterMacro(double, SampleDistanceUsed, SampleDistanceUsed, false);
 vtkStatisticGetterMacro(const char*, Residency, Residency.c_str(), false);
@@ -932,6 +941,10 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   const vtkSpaceSkipStatistics piece = logPhases ? d.Image.Statistics(true) : vtkSpaceSkipStatistics();
   const int draw = exchange->Finish(width, height, mine, others);
   const double exchangedAt = SecondsSince(t0);
+  d.PieceReport = draw == -1 ? "own frame only"
+    : draw == 1              ? "pieces received, not drawn"
+    : devicePieces != 0      ? "piece shared through CUDA IPC"
+                             : "piece sent as pixels";
   auto phases = [&](const char* end) {
     if (!logPhases)
     {
@@ -980,7 +993,10 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     const double stopAt =
       s.AccumulatesOpacity() ? vtkSpaceSkipPropertyTranslator::EarlyTerminationOpacity(s) : 2.0;
     const char* where = "host";
+    const auto shared = std::count_if(others.begin(), others.end(), [](const PieceImage& p) { return p.Shared; });
     drawn = d.DrawPieces(*exchange, others, eye, dir, parallel, width, height, stopAt, renWin, eightBit, where);
+    d.PieceReport = std::to_string(others.size()) + " pieces blended on the " + where + ", " +
+      std::to_string(shared) + " shared through CUDA IPC";
     if (logPhases)
     {
       vtkVLogF(vtkLogger::VERBOSITY_5, "exchanged frame: blend of %d pieces on the %s",

@@ -313,6 +313,14 @@ public:
   vtkBooleanMacro(GPUComposite, vtkTypeBool);
   const char* GetCompositePathUsed();
   const char* GetCompositeBlendUsed();
+  /**
+   * With a PieceExchange (MPI ranks), how the last frame's pieces met: on the process that
+   * draws, "N pieces blended on the GPU" or "... on the host", and how many of them came
+   * through CUDA IPC ("K shared through CUDA IPC") or as pixels over the exchange; on the
+   * others, "piece shared through CUDA IPC" or "piece sent as pixels"; "own frame only" where
+   * the exchange is off; "none" without an exchange.
+   */
+  const char* GetPieceCompositingUsed();
   ///@}
 
   ///@{

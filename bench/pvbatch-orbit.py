@@ -116,7 +116,10 @@ med = statistics.median(times)
 used = ""
 if not args.stock and not args.outline:
     disp.UpdatePropertyInformation()
-    used = " backend=%s builder=%s" % (disp.GetPropertyValue("BackendUsed"), disp.GetPropertyValue("BuilderUsed"))
+    used = " backend=%s builder=%s device='%s' composite='%s' pieces='%s'" % (
+        disp.GetPropertyValue("BackendUsed"), disp.GetPropertyValue("BuilderUsed"),
+        disp.GetPropertyValue("CudaDeviceUsed"), disp.GetPropertyValue("CompositePathUsed"),
+        disp.GetPropertyValue("PieceCompositingUsed"))
 report("PVBATCH_ORBIT ranks=%d rep=%s%s%s volume=%dx%dx%d %s view=%d frames=%d fps=%.1f median_ms=%.3f "
        "first_s=%.3f to_first_s=%.3f%s" % (ranks, "Outline" if args.outline else "Volume" if args.stock else "SpaceSkip", " shaded" if args.shade else "",
                                             " host-composite" if args.host_composite else "",

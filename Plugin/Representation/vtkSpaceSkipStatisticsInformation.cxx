@@ -16,7 +16,7 @@ const char* const kNumberNames[vtkSpaceSkipStatisticsInformation::NumberCount] =
   "ColorUpdateCount", "FrameCount", "LabelMapUsed"
 };
 const char* const kTextNames[vtkSpaceSkipStatisticsInformation::TextCount] = { "BackendUsed",
-  "BuilderUsed", "BuilderChoice", "Residency" };
+  "BuilderUsed", "BuilderChoice", "Residency", "CudaDeviceUsed", "CompositePathUsed", "PieceCompositingUsed" };
 constexpr int kFrameCount = 11; // index of FrameCount in kNumberNames
 }
 
@@ -59,7 +59,8 @@ void vtkSpaceSkipStatisticsInformation::CopyFromObject(vtkObject* object)
     static_cast<double>(rep->GetColorUpdateCount()), static_cast<double>(rep->GetFrameCount()),
     static_cast<double>(rep->GetLabelMapUsed()) };
   this->Texts = { rep->GetBackendUsed(), rep->GetBuilderUsed(), rep->GetBuilderChoice(),
-    rep->GetResidency() };
+    rep->GetResidency(), rep->GetCudaDeviceUsed(), rep->GetCompositePathUsed(),
+    rep->GetPieceCompositingUsed() };
 }
 
 //------------------------------------------------------------------------------

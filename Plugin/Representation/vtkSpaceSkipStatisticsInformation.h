@@ -38,7 +38,7 @@ public:
   static const char* GetNumberName(int i);
   double GetNumber(int i) const { return this->Numbers[i]; }
   /// String statistics, by the names of their properties.
-  static constexpr int TextCount = 4;
+  static constexpr int TextCount = 7;
   static const char* GetTextName(int i);
   const char* GetText(int i) const { return this->Texts[i].c_str(); }
   /// Whether a vtkSpaceSkipVolumeRepresentation was read.

@@ -876,6 +876,23 @@ const char* vtkSpaceSkipVolumeRepresentation::GetCudaDeviceUsed()
 }
 
 //------------------------------------------------------------------------------
+const char* vtkSpaceSkipVolumeRepresentation::GetCompositePathUsed()
+{
+  std::string path = this->SpaceSkipMapper->GetCompositePathUsed();
+  if (path != "none")
+  {
+    path += std::string(" (blend ") + this->SpaceSkipMapper->GetCompositeBlendUsed() + ")";
+  }
+  return CopyText(path.c_str(), this->CompositePathText);
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSpaceSkipVolumeRepresentation::GetPieceCompositingUsed()
+{
+  return CopyText(this->SpaceSkipMapper->GetPieceCompositingUsed(), this->PieceCompositingText);
+}
+
+//------------------------------------------------------------------------------
 void vtkSpaceSkipVolumeRepresentation::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);

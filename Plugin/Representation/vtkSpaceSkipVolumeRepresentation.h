@@ -123,6 +123,11 @@ public:
   /// The CUDA device the mapper drew with ("none" when not the CUDA backend): "device N of M",
   /// under MPI followed by "(node rank r of k)" (one rank per GPU).
   const char* GetCudaDeviceUsed();
+  /// How the last frame reached the window: "gpu (blend B)" (CUDA-GL interop; B "cuda" or
+  /// "gl"), "host (blend gl)" (through host memory) or "none".
+  const char* GetCompositePathUsed();
+  /// Under MPI, how the ranks' pieces met (the mapper's GetPieceCompositingUsed): "none" alone.
+  const char* GetPieceCompositingUsed();
   const char* GetBuilderUsed();
   const char* GetBuilderChoice();
   const char* GetResidency();
@@ -214,6 +219,8 @@ protected:
   vtkSpaceSkippingVolumeMapper* SpaceSkipMapper = nullptr;
   std::string BackendUsedName;
   std::string CudaDeviceUsedName;
+  std::string CompositePathText;
+  std::string PieceCompositingText;
   std::string BuilderUsedName;
   std::string BuilderChoiceText;
   std::string ResidencyText;

@@ -193,7 +193,8 @@ def stats(disp):
     names = ["BuilderUsed", "BackendUsed", "LastBuildSeconds", "LastClassifySeconds",
              "LastRenderSeconds", "NodeCount", "LeafCount", "TreeHeight", "Occupancy",
              "BuildCount", "ClassifyCount", "ColorUpdateCount", "FrameCount",
-             "SampleDistanceUsed", "BuilderChoice"]
+             "SampleDistanceUsed", "BuilderChoice", "CudaDeviceUsed", "CompositePathUsed",
+             "PieceCompositingUsed"]
     return {n: disp.GetPropertyValue(n) for n in names}
 
 

@@ -280,6 +280,19 @@ for n in ranks:
     ok.check(m is not None and m.group(1) == str(n) and float(m.group(2)) == 0.0
              and float(m.group(3)) == holders - 1, "the volume was split over %d of %d ranks (%s)"
              % (holders, n, m.group(0) if m else "no report"))
+    # The statistics say how the pieces met (rank 0's): here, where no GPU is, as pixels over
+    # MPI, blended on the host; one piece a rank (a block for partitioned input).
+    if check and float_compositing:
+        s = re.search(r"'PieceCompositingUsed': '([^']*)'", info)
+        want = "%d pieces blended on the host, 0 shared through CUDA IPC" % holders if not partitioned else None
+        got = s.group(1) if s else "no report"
+        ok.check(s is not None and (got == want if want else
+                                    re.fullmatch(r"\d+ pieces blended on the host, 0 shared through CUDA IPC", got)),
+                 "%d ranks: the statistics say how the pieces met (%s)" % (n, got))
+        c = re.search(r"'CompositePathUsed': '([^']*)'", info)
+        ok.check(c is not None and c.group(1).startswith("host"),
+                 "%d ranks: the sum reached the window through host memory, as the statistics say (%s)"
+                 % (n, c.group(1) if c else "no report"))
     g = re.search(r"drawn_points=(\d+) ghost_array=(\w+)", info)
     if check and not partitioned and not rectilinear:
         # An image piece: a ghost layer only where a gradient is read (a grid always takes three).
