@@ -20,6 +20,9 @@
 #                PVB_VERBOSITY 5: each composited frame's phases in logs/pvbatch-N.log;
 #                PVB_ARGS: more options of pvbatch-orbit.py (e.g. --shade);
 #                PVB_HOST_AB=1: each run of ours again with --host-composite (A/B in one hold)
+#                PVB_LOG=1: ParaView's rendering log (PARAVIEW_LOG_RENDERING_VERBOSITY=INFO) in
+#                logs/pvbatch-N.log, summed up per rank by bench/pv-frame-phases.py (IceT's pass
+#                against the rest of ParaView's frame)
 #   bench-ts     bench/time-series-vs-stock.py --backend CUDA (TS_DIMS 512, TS_STEPS 10, TS_ROUNDS 2,
 #                --raw; TS_WORKDIR keeps the written steps for a later run; TS_ARGS more options,
 #                e.g. "--cache 4000" for ParaView's animation cache)
@@ -166,9 +169,12 @@ if has bench-pvbatch; then
       [ -z "${PVB_VERBOSITY:-}" ] || launch+=(-v "$PVB_VERBOSITY")
       ref=()
       [ "$r" = 1 ] || ref=(--reference "$work/logs/pvbatch-1${stock:+-stock}.png")
+      [ -z "${PVB_LOG:-}" ] || launch=(env PARAVIEW_LOG_RENDERING_VERBOSITY=INFO "${launch[@]}")
       TAIL=3 run "$tag" 600 "${launch[@]}" "$src/bench/pvbatch-orbit.py" --plugin "$SPACESKIP_PLUGIN" \
         --raw "$raw" --frames "${PVB_FRAMES:-60}" --backend "${PVB_BACKEND:-CUDA}" --view "${PVB_VIEW:-1024}" $stock \
         ${PVB_ARGS:-} $comp --png "$work/logs/$tag.png" --result "$work/logs/$tag.result" "${ref[@]}"
+      [ -z "${PVB_LOG:-}" ] || "$(command -v python3 || echo "$pvpython")" "$src/bench/pv-frame-phases.py" "$work/logs/$tag.log" \
+        >> "$work/logs/$tag.result" 2>&1
      done
     done
   done
