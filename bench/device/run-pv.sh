@@ -173,7 +173,7 @@ if has bench-pvbatch; then
       TAIL=3 run "$tag" 600 "${launch[@]}" "$src/bench/pvbatch-orbit.py" --plugin "$SPACESKIP_PLUGIN" \
         --raw "$raw" --frames "${PVB_FRAMES:-60}" --backend "${PVB_BACKEND:-CUDA}" --view "${PVB_VIEW:-1024}" $stock \
         ${PVB_ARGS:-} $comp --png "$work/logs/$tag.png" --result "$work/logs/$tag.result" "${ref[@]}"
-      [ -z "${PVB_LOG:-}" ] || "$(command -v python3 || echo "$pvpython")" "$src/bench/pv-frame-phases.py" "$work/logs/$tag.log" \
+      [ -z "${PVB_LOG:-}" ] || env -u PYTHONHOME -u PYTHONPATH python3 "$src/bench/pv-frame-phases.py" "$work/logs/$tag.log" \
         >> "$work/logs/$tag.result" 2>&1
      done
     done
