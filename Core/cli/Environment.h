@@ -25,6 +25,7 @@ inline const char* environmentValue(const char* name) {
 ///   SPACESKIP_CUDA_BLOCK=WxH        blockX, blockY (32..256 threads)
 ///   SPACESKIP_CUDA_RESIDENT=N       resident (persistent launch, N blocks per SM; 0: plain)
 ///   SPACESKIP_RAY_SEGMENTS=N        raySegments (1..16; 0: automatic)
+///   SPACESKIP_HEAVIEST_FIRST=0      heaviestFirst off (blocks in row-major order)
 ///   SPACESKIP_CUDA_PARTS_SHARE=X    partsShare
 ///   SPACESKIP_SUB_MASKS=0           subMasks off
 ///   SPACESKIP_DEFER_SHADOWS=0       deferShadows off
@@ -45,6 +46,7 @@ inline Tuning tuningFromEnvironment(Tuning t = Tuning{}) {
   }
   if (const char* r = environmentValue("SPACESKIP_CUDA_RESIDENT")) t.resident = std::max(0, std::atoi(r));
   if (const char* s = environmentValue("SPACESKIP_RAY_SEGMENTS")) t.raySegments = std::clamp(std::atoi(s), 0, 16);
+  if (const char* s = environmentValue("SPACESKIP_HEAVIEST_FIRST")) t.heaviestFirst = s[0] != '0';
   if (const char* s = environmentValue("SPACESKIP_CUDA_PARTS_SHARE")) t.partsShare = std::atof(s);
   if (const char* s = environmentValue("SPACESKIP_SUB_MASKS")) t.subMasks = s[0] != '0';
   if (const char* s = environmentValue("SPACESKIP_DEFER_SHADOWS")) t.deferShadows = s[0] != '0';

@@ -16,6 +16,22 @@ namespace spaceskip::cuda {
 /// Threads in a render block at most (Tuning::blockX x blockY; the kernels' launch bounds).
 constexpr int kMaxRenderThreads = 256;
 
+/// A plain launch's blocks in the order they start (Tuning::heaviestFirst): block b (linear
+/// index, x fastest, then y, then the segment z) renders unit order[b] of the same grid; each
+/// unit's SM clock cycles go to cost, indexed by its tile on the whole frame's tile grid
+/// (originX/Y: the launch's first tile there; wholeX x wholeY tiles a segment), so that the next
+/// frame, whose box may project onto other tiles, finds them. order and cost nullptr: row-major.
+struct TileOrder {
+  const unsigned* order = nullptr;
+  unsigned* cost = nullptr;
+  int originX = 0, originY = 0, wholeX = 0, wholeY = 0;
+};
+/// Where the cycles of tile (x, y) of the whole frame and its segment go: rows of wholeX tiles,
+/// the segments of a tile side by side (the index does not depend on the frame's height).
+__host__ __device__ inline size_t tileCostIndex(unsigned x, unsigned y, unsigned segment, int wholeX, unsigned segments) {
+  return (size_t(y) * size_t(wholeX) + x) * segments + segment;
+}
+
 class CudaExecutor {
  public:
   /// Reads the SM count.
@@ -55,6 +71,11 @@ class CudaExecutor {
   void compositeLayers() const;
   template <class Sampler>
   void launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes, cudaStream_t stream);
+  /// The order of a plain launch of `grid` (z: segments) whose first tile is (originX, originY)
+  /// of the whole frame's wholeX x wholeY tiles: the units by the cycles they took in the last
+  /// frame, longest first (a gather and a CUB radix sort on `stream`), and where this frame's
+  /// cycles go. Without a last frame of this shape (or with Tuning::heaviestFirst off): no order.
+  TileOrder tileOrder(dim3 grid, int originX, int originY, int wholeX, int wholeY, cudaStream_t stream);
   /// The frame's queued shadow rays (f.scatter.queue), marched into d_image_ after its kernel.
   template <class Sampler>
   void drainShadowQueue(const FrameView& f, const Sampler& s, cudaStream_t stream);
@@ -83,6 +104,12 @@ class CudaExecutor {
   size_t shadowNeed_ = 0;                     ///< rays the last counted frame offered
   unsigned lastQueueCapacity_ = 0;            ///< the last frame's queue (0: none)
   DeviceBuffer<unsigned> d_tileCounter_;
+  DeviceBuffer<unsigned> d_tileCost_;     ///< cycles per unit of the whole frame's tiles (TileOrder)
+  DeviceBuffer<unsigned> d_orderKeys_;    ///< tileOrder: the units' costs, then sorted
+  DeviceBuffer<unsigned> d_orderUnits_;   ///< tileOrder: the units, then in order
+  TempStorage orderTemp_;
+  int costShape_[2] = {0, 0};             ///< wholeX, segments of d_tileCost_'s frames
+  bool costKept_ = false;                 ///< d_tileCost_ holds a frame of costShape_
   DeviceBuffer<vec4f> d_layers_;  ///< a segmented frame's layers (raySegments)
   DeviceBuffer<unsigned char> d_layerFlags_;  ///< which layers a segment coloured (1) or left empty (0)
   mutable SegmentLayersView layers_;  ///< the last frame's layers while not yet composited into d_image_

@@ -55,12 +55,15 @@ struct RenderMinBlocks<TextureSampler> {
 // cover only the pixels of `rect` (x0, y0, x1, y1; boxPixelRect: the others render 0); with
 // `flags` a segment writes its layer only where it coloured the pixel and says so in flags
 // (SegmentLayers): most segments of a sparse volume colour nothing.
+// `order` (plain launches, Tuning::heaviestFirst): block b renders unit order.order[b] and
+// writes its cycles to order.cost (TileOrder).
 template <class Sampler, int Traversal, bool Plain>
 __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::value)
     renderKernel(const __grid_constant__ FrameView f, const __grid_constant__ Sampler s, vec4f* out,
-                 unsigned* tileCounter, int4 rect, unsigned char* flags) {
+                 unsigned* tileCounter, int4 rect, unsigned char* flags, const __grid_constant__ TileOrder order) {
   const unsigned tilesX = (unsigned(rect.z - rect.x) + blockDim.x - 1) / blockDim.x;
-  const int segment = int(blockIdx.z), segments = int(gridDim.z);
+  int segment = int(blockIdx.z);
+  const int segments = int(gridDim.z);
   auto tile = [&](unsigned tx, unsigned ty) {
     const int x = rect.x + int(tx * blockDim.x + threadIdx.x), y = rect.y + int(ty * blockDim.y + threadIdx.y);
     if (x < rect.z && y < rect.w) {
@@ -75,6 +78,22 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
       }
     }
   };
+  if (!tileCounter && order.cost) {
+    const unsigned perSegment = gridDim.x * gridDim.y;
+    const unsigned b = blockIdx.x + gridDim.x * (blockIdx.y + gridDim.y * blockIdx.z);
+    const unsigned u = order.order ? order.order[b] : b;
+    const unsigned tx = (u % perSegment) % gridDim.x, ty = (u % perSegment) / gridDim.x;
+    segment = int(u / perSegment);
+    const long long t0 = clock64();
+    tile(tx, ty);
+    __syncthreads();  // the block's time is its slowest ray's
+    if (threadIdx.x == 0 && threadIdx.y == 0) {
+      const long long dt = clock64() - t0;
+      order.cost[tileCostIndex(tx + unsigned(order.originX), ty + unsigned(order.originY), unsigned(segment),
+                               order.wholeX, gridDim.z)] = unsigned(dt < 0 ? 0 : dt > 0xffffffffll ? 0xffffffffll : dt);
+    }
+    return;
+  }
   if (!tileCounter) {
     tile(blockIdx.x, blockIdx.y);
     return;
@@ -113,7 +132,7 @@ template <class T>
 struct IsPoolSampler<PoolSampler<T>> : std::true_type {};
 
 template <class Sampler>
-using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*, int4, unsigned char*);
+using RenderKernelPtr = void (*)(const FrameView, const Sampler, vec4f*, unsigned*, int4, unsigned char*, const TileOrder);
 
 template <class Sampler, bool Plain>
 RenderKernelPtr<Sampler> renderKernelFor(TraversalKind t) {
@@ -190,7 +209,10 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
       if (r.z > r.x && r.w > r.y) {
         const dim3 rectGrid(unsigned((r.z - r.x + int(block.x) - 1) / int(block.x)),
                             unsigned((r.w - r.y + int(block.y) - 1) / int(block.y)), unsigned(segments));
-        k<<<rectGrid, block, 0, stream>>>(f, s, d_layers_.get(), nullptr, r, flags);
+        const TileOrder order = tileOrder(rectGrid, r.x / int(block.x), r.y / int(block.y),
+                                          int((unsigned(f.width) + block.x - 1) / block.x),
+                                          int((unsigned(f.height) + block.y - 1) / block.y), stream);
+        k<<<rectGrid, block, 0, stream>>>(f, s, d_layers_.get(), nullptr, r, flags, order);
       }
       layers_.layers = d_layers_.get();
       layers_.flags = flags;
@@ -200,7 +222,8 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
       std::copy(rect, rect + 4, layers_.rect);
       return;
     }
-    k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr, make_int4(0, 0, f.width, f.height), nullptr);
+    const TileOrder order = tileOrder(grid, 0, 0, int(grid.x), int(grid.y), stream);
+    k<<<grid, block, 0, stream>>>(f, s, d_image_.get(), nullptr, make_int4(0, 0, f.width, f.height), nullptr, order);
     drainShadowQueue(f, s, stream);
     return;
   }
@@ -209,7 +232,7 @@ void CudaExecutor::launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 
   const unsigned tiles = grid.x * grid.y;
   const unsigned blocks = std::min(tiles, unsigned(residentBlocks) * unsigned(numSMs_));
   k<<<blocks, block, 0, stream>>>(f, s, d_image_.get(), d_tileCounter_.get(), make_int4(0, 0, f.width, f.height),
-                                  nullptr);
+                                  nullptr, TileOrder{});
   drainShadowQueue(f, s, stream);
 }
 

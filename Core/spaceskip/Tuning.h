@@ -19,6 +19,10 @@ struct Tuning {
   /// Rays cut into this many segments marched by separate threads (1..16; 1: whole rays); 0:
   /// automatic (up to 4, by the box's length in samples; CudaExecutor.cu raySegments).
   int raySegments = 0;
+  /// Plain launches start the blocks that took longest in the last frame first (their tiles and
+  /// ray segments, by the SM clock; CudaExecutor::tileOrder): the frame no longer waits for its
+  /// slowest tiles started last. Off: blocks in row-major order. The image is the same.
+  bool heaviestFirst = true;
   /// Samples a hardware-filtered GPU march fetches before compositing the first (1..4; 0: 4,
   /// kMaxSampleBatch). 1 (one at a time) stays for the test that batches give the same image.
   int sampleBatch = 0;

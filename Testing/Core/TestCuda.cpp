@@ -963,6 +963,56 @@ TEST(CudaBackend, SegmentLayersRenderTheSameImage) {
   }
 }
 
+TEST(CudaBackend, HeaviestFirstRendersTheSameImage) {
+  // Tuning::heaviestFirst starts a plain launch's blocks by the cycles their tile and segment took
+  // in the last frame, longest first: only which block draws which pixels changes, so every frame
+  // must equal row-major order's bit for bit. An orbit of five views moves the box's pixel
+  // rectangle (the segmented launch's origin on the whole frame's tiles) and zooms in past the
+  // frame's edges, so the costs kept from one frame are found again at other launch positions;
+  // then a new image size (the costs start again). Whole rays and 4 segments, sparse and dense
+  // data, an odd-sized image (partial tiles), a 32x4 block.
+  REQUIRE_CUDA();
+  const Volume volumes[] = {generateVolume("nbody", vec3l{96, 96, 96}), generateVolume("menger", vec3l{54, 54, 54})};
+  const TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
+  for (const Volume& v : volumes) {
+    double b[6];
+    v.worldBounds(b);
+    for (BuilderKind k : {BuilderKind::Naive, BuilderKind::DistanceGrid}) {
+      for (int segments : {1, 4}) {
+        for (int block : {0, 1}) {
+          Engine rowMajor(BackendKind::CUDA), heaviest(BackendKind::CUDA);
+          Engine* e[2] = {&rowMajor, &heaviest};
+          for (int i = 0; i < 2; ++i) {
+            Tuning t;
+            t.raySegments = segments;
+            t.heaviestFirst = i == 1;
+            if (block) {
+              t.blockX = 32;
+              t.blockY = 4;
+            }
+            e[i]->setTuning(t);
+            loadFrame(*e[i], v, tf, k, FilterMode::Exact);
+          }
+          for (int frame = 0; frame < 6; ++frame) {
+            const int w = frame < 5 ? 101 : 64, h = frame < 5 ? 73 : 80;
+            const double zoom = frame == 3 ? 2.5 : 1.0 + 0.1 * frame;
+            const Camera cam = orbitCamera(b, 25.0 * frame, 15, zoom, false, double(w) / h);
+            Image img[2];
+            for (int i = 0; i < 2; ++i) {
+              e[i]->render(cam, w, h, img[i]);
+              ASSERT_EQ(e[i]->backendKind(), BackendKind::CUDA);
+            }
+            SCOPED_TRACE(std::string(builderName(k)) + " segments " + std::to_string(segments) + " block " +
+                         std::to_string(block) + " frame " + std::to_string(frame));
+            ASSERT_GT(test::coverage(img[0]), 0.001);
+            EXPECT_EQ(compareImages(img[0], img[1]).maxAbs, 0.f);
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(CudaBackend, SegmentedRaysRenderTheSameImage) {
   // Tuning::raySegments = K (default: up to 4 by the ray's length) cuts each ray's samples into K runs marched by separate threads and
   // composites their colours front to back: the same samples, the sums associated differently,

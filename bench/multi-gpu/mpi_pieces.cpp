@@ -25,7 +25,7 @@
 //   mpiexec -n N spaceskip_mpi_pieces [--shape nbody] [--dims 2048] [--size 1024] [--frames 30]
 //       [--builder Auto] [--backend auto|cpu|cuda] [--tf ramp] [--check] [--png out.png]
 //       [--composite gpu|host] [--split slabs|image] [--balance occupancy|equal|frame-time]
-//       [--ray-segments N] [--resident N]
+//       [--ray-segments N] [--resident N] [--heaviest-first 0|1]
 // --check: rank 0 also renders the whole volume alone and prints the largest difference of
 // the composited image from it (8-bit units). --slabs: each rank makes only its slab (volumes
 // larger than one host's share or one GPU: no rank holds the whole; with --check rank 0 makes
@@ -70,6 +70,7 @@ struct Args {
   int64_t dims = 256;
   int size = 512, frames = 20;
   int raySegments = 0;  // Tuning::raySegments (0: the engine's choice)
+  int heaviestFirst = -1;  // Tuning::heaviestFirst (-1: the engine's default)
   int resident = -1;    // Tuning::resident (-1: the engine's choice)
   bool check = false, slabs = false;
 };
@@ -97,6 +98,7 @@ Args parse(int argc, char** argv) {
     else if (k == "--balance") a.balance = next();
     else if (k == "--split") a.split = next();
     else if (k == "--ray-segments") a.raySegments = std::atoi(next().c_str());
+    else if (k == "--heaviest-first") a.heaviestFirst = std::atoi(next().c_str());
     else if (k == "--resident") a.resident = std::atoi(next().c_str());
     else if (k == "--check") a.check = true;
     else if (k == "--slabs") a.slabs = true;
@@ -393,9 +395,10 @@ int main(int argc, char** argv) {
     MPI_Abort(MPI_COMM_WORLD, 2);
   }
   engine.setBuildParams(bp);
-  if (a.raySegments > 0 || a.resident >= 0) {  // the GPU launch's knobs (Tuning.h)
+  if (a.raySegments > 0 || a.resident >= 0 || a.heaviestFirst >= 0) {  // the GPU launch's knobs (Tuning.h)
     Tuning tu = engine.tuning();
     if (a.raySegments > 0) tu.raySegments = a.raySegments;
+    if (a.heaviestFirst >= 0) tu.heaviestFirst = a.heaviestFirst != 0;
     if (a.resident >= 0) tu.resident = a.resident;
     engine.setTuning(tu);
   }

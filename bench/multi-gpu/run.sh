@@ -16,7 +16,8 @@
 # image": both), BALANCE (default: slabs of equal visible voxels, bands by the last frame's render
 # times; equal: equal cells or rows; SLABS=1 always cuts equal cells), RAY_SEGMENTS (segments a
 # ray is cut into on the GPU; default: the engine's choice), RESIDENT (blocks per SM of a
-# persistent launch; default: the engine's choice).
+# persistent launch; default: the engine's choice), HEAVIEST_FIRST (0: the blocks start in
+# row-major order instead of the last frame's longest first; default: the engine's choice).
 # The machine's own mpirun is used when it loads the carried binary's libmpi.so.40 (Open MPI 4.x
 # ABI); otherwise the carried Debian Open MPI (orterun, OPAL_PREFIX).
 set -u
@@ -64,6 +65,7 @@ for scene in $scenes; do
     [ -n "${BALANCE:-}" ] && check+=(--balance "$BALANCE")
     [ -n "${RAY_SEGMENTS:-}" ] && check+=(--ray-segments "$RAY_SEGMENTS")
     [ -n "${RESIDENT:-}" ] && check+=(--resident "$RESIDENT")
+    [ -n "${HEAVIEST_FIRST:-}" ] && check+=(--heaviest-first "$HEAVIEST_FIRST")
     log="$out/$shape$dims-n$n-$split-$comp.log"
     echo "== $shape $dims^3, $n ranks, --split $split --composite $comp" | tee -a "$out/summary.txt"
     # NVLink multicast stays off (the machine's NCCL_NVLS_ENABLE=0 and friends, passed on).
