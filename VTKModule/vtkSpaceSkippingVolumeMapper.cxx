@@ -176,6 +176,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
   int AskedDevice = -1;
   std::string DeviceReport;
   std::string PieceReport = "none"; // vtkSpaceSkipStatistics::PieceCompositing of the last frame
+  bool DrewPieces = false;           // the last frame drew the exchanged pieces' sum (DrawPieces)
   void BindDevice(int asked, int backend);
 
   // Reports a problem once (until the next different one); the caller then draws nothing.
@@ -241,7 +242,7 @@ struct vtkSpaceSkippingVolumeMapper::vtkInternals
       this->Asked.CudaDevice = cuda && !this->DeviceReport.empty() ? this->DeviceReport : "none";
     }
     this->Asked.PieceCompositing = this->PieceReport;
-    if (this->Composite && this->PieceReport.find(" blended on the ") != std::string::npos)
+    if (this->Composite && this->DrewPieces)
     {
       // The blocks' pieces were drawn as one sum, through this mapper's compositor.
       this->Asked.CompositePath = this->Image.GetCompositor().GetCompositePath();
@@ -941,6 +942,7 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
   const vtkSpaceSkipStatistics piece = logPhases ? d.Image.Statistics(true) : vtkSpaceSkipStatistics();
   const int draw = exchange->Finish(width, height, mine, others);
   const double exchangedAt = SecondsSince(t0);
+  d.DrewPieces = false;
   d.PieceReport = draw == -1 ? "own frame only"
     : draw == 1              ? "pieces received, not drawn"
     : devicePieces != 0      ? "piece shared through CUDA IPC"
@@ -995,6 +997,7 @@ void vtkSpaceSkippingVolumeMapper::RenderExchanged(vtkRenderer* ren, vtkVolume* 
     const char* where = "host";
     const auto shared = std::count_if(others.begin(), others.end(), [](const PieceImage& p) { return p.Shared; });
     drawn = d.DrawPieces(*exchange, others, eye, dir, parallel, width, height, stopAt, renWin, eightBit, where);
+    d.DrewPieces = true;
     d.PieceReport = std::to_string(others.size()) + " pieces blended on the " + where + ", " +
       std::to_string(shared) + " shared through CUDA IPC";
     if (logPhases)

@@ -52,8 +52,7 @@ for rank in sorted(values):
     for name, v in values[rank].items():
         v = v[args.skip:] or v
         med[name] = statistics.median(v)
-        parts.append("%s %.3f" % (name.lower().replace("icet_", "").replace("_time", ""),
-                                  1e3 * statistics.median(v)))
+        parts.append("%s %.3f" % (name.lower().replace("icet_", "").replace("_time", ""), 1e3 * med[name]))
     if "frame" in med:
         # What the view spends outside IceT's pass: the ranks' synchronisation, the composited
         # image pasted into the window, the passes around it.

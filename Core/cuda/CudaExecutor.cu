@@ -26,13 +26,11 @@ __global__ void compositeSegmentsKernel(const SegmentLayersView v, vec4f* out) {
 
 // tileOrder: each unit of a launch of `grid` (x fastest, then y, then the segment) with the
 // cycles its tile and segment took in the last frame (0 where it was not drawn).
-__global__ void gatherTileCostKernel(const unsigned* cost, dim3 grid, int originX, int originY, int wholeX,
-                                     unsigned* keys, unsigned* units) {
+__global__ void gatherTileCostKernel(const TileOrder o, dim3 grid, unsigned* keys, unsigned* units) {
   const unsigned n = grid.x * grid.y * grid.z;
   const unsigned u = blockIdx.x * blockDim.x + threadIdx.x;
   if (u >= n) return;
-  const unsigned perSegment = grid.x * grid.y, r = u % perSegment;
-  keys[u] = cost[tileCostIndex(r % grid.x + originX, r / grid.x + originY, u / perSegment, wholeX, grid.z)];
+  keys[u] = o.cost[o.costIndex(u, grid)];
   units[u] = u;
 }
 
@@ -78,7 +76,6 @@ TileOrder CudaExecutor::tileOrder(dim3 grid, int originX, int originY, int whole
   o.originX = originX;
   o.originY = originY;
   o.wholeX = wholeX;
-  o.wholeY = wholeY;
   const int segments = int(grid.z);
   const size_t whole = size_t(wholeX) * size_t(wholeY) * size_t(segments);
   if (costShape_[0] != wholeX || costShape_[1] != segments || whole > d_tileCost_.capacity()) {
@@ -101,8 +98,7 @@ TileOrder CudaExecutor::tileOrder(dim3 grid, int originX, int originY, int whole
   d_orderKeys_.reserve(size_t(n) * 2);
   d_orderUnits_.reserve(size_t(n) * 2);
   unsigned *keys = d_orderKeys_.get(), *units = d_orderUnits_.get();
-  gatherTileCostKernel<<<(n + 255) / 256, 256, 0, stream>>>(d_tileCost_.get(), grid, originX, originY, wholeX, keys,
-                                                            units);
+  gatherTileCostKernel<<<(n + 255) / 256, 256, 0, stream>>>(o, grid, keys, units);
   SS_CUDA_CHECK_LAUNCH(gatherTileCostKernel);
   // Longest first; the sort is stable, so equal costs (a first frame's zeros) stay in row-major
   // order. Measured on 2 x H200 (docs/results/multi-gpu, heaviest first): N-body 2048^3 at

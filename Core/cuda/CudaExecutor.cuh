@@ -19,18 +19,28 @@ constexpr int kMaxRenderThreads = 256;
 /// A plain launch's blocks in the order they start (Tuning::heaviestFirst): block b (linear
 /// index, x fastest, then y, then the segment z) renders unit order[b] of the same grid; each
 /// unit's SM clock cycles go to cost, indexed by its tile on the whole frame's tile grid
-/// (originX/Y: the launch's first tile there; wholeX x wholeY tiles a segment), so that the next
-/// frame, whose box may project onto other tiles, finds them. order and cost nullptr: row-major.
+/// (originX/Y: the launch's first tile there; wholeX tiles a row), so that the next frame, whose
+/// box may project onto other tiles, finds them. order and cost nullptr: row-major.
 struct TileOrder {
   const unsigned* order = nullptr;
   unsigned* cost = nullptr;
-  int originX = 0, originY = 0, wholeX = 0, wholeY = 0;
+  int originX = 0, originY = 0, wholeX = 0;
+
+  /// Unit u of a launch of `grid`: its tile (tx, ty) in the launch and its segment.
+  __host__ __device__ static void unit(unsigned u, dim3 grid, unsigned& tx, unsigned& ty, unsigned& segment) {
+    const unsigned perSegment = grid.x * grid.y, r = u % perSegment;
+    tx = r % grid.x;
+    ty = r / grid.x;
+    segment = u / perSegment;
+  }
+  /// Where the cycles of unit u of a launch of `grid` go: rows of wholeX tiles of the whole
+  /// frame, the segments of a tile side by side (the index does not depend on the frame's height).
+  __host__ __device__ size_t costIndex(unsigned u, dim3 grid) const {
+    unsigned tx, ty, segment;
+    unit(u, grid, tx, ty, segment);
+    return (size_t(ty + unsigned(originY)) * size_t(wholeX) + (tx + unsigned(originX))) * grid.z + segment;
+  }
 };
-/// Where the cycles of tile (x, y) of the whole frame and its segment go: rows of wholeX tiles,
-/// the segments of a tile side by side (the index does not depend on the frame's height).
-__host__ __device__ inline size_t tileCostIndex(unsigned x, unsigned y, unsigned segment, int wholeX, unsigned segments) {
-  return (size_t(y) * size_t(wholeX) + x) * segments + segment;
-}
 
 class CudaExecutor {
  public:

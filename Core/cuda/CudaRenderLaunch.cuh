@@ -79,18 +79,17 @@ __global__ void __launch_bounds__(kMaxRenderThreads, RenderMinBlocks<Sampler>::v
     }
   };
   if (!tileCounter && order.cost) {
-    const unsigned perSegment = gridDim.x * gridDim.y;
     const unsigned b = blockIdx.x + gridDim.x * (blockIdx.y + gridDim.y * blockIdx.z);
     const unsigned u = order.order ? order.order[b] : b;
-    const unsigned tx = (u % perSegment) % gridDim.x, ty = (u % perSegment) / gridDim.x;
-    segment = int(u / perSegment);
+    unsigned tx, ty, seg;
+    TileOrder::unit(u, gridDim, tx, ty, seg);
+    segment = int(seg);
     const long long t0 = clock64();
     tile(tx, ty);
     __syncthreads();  // the block's time is its slowest ray's
     if (threadIdx.x == 0 && threadIdx.y == 0) {
       const long long dt = clock64() - t0;
-      order.cost[tileCostIndex(tx + unsigned(order.originX), ty + unsigned(order.originY), unsigned(segment),
-                               order.wholeX, gridDim.z)] = unsigned(dt < 0 ? 0 : dt > 0xffffffffll ? 0xffffffffll : dt);
+      order.cost[order.costIndex(u, gridDim)] = unsigned(dt < 0 ? 0 : dt > 0xffffffffll ? 0xffffffffll : dt);
     }
     return;
   }
