@@ -287,6 +287,7 @@ class CudaBackend final : public Backend {
   }
   double lastFrameDeviceSeconds() const override { return exec_.lastFrameDeviceSeconds(); }
   int64_t lastFrameQueuedShadowRays() const override { return exec_.lastFrameQueuedShadowRays(); }
+  double lastFrameLongestBlockSeconds() const override { return exec_.lastFrameLongestBlockSeconds(); }
   bool brickValueRange(double& lo, double& hi) override {
     return !pool_.active() && cls_.valueRange(lo, hi, stream_);
   }

@@ -24,13 +24,35 @@ __global__ void compositeSegmentsKernel(const SegmentLayersView v, vec4f* out) {
   out[i] = compositeLayers(v, int(i % v.width), int(i / v.width));
 }
 
+// The sort key of a unit's cycles: 16 bits that keep their order, the position of the leading
+// one (5 bits) and the 11 bits after it (a float's exponent and mantissa; 1/2048 apart at most).
+// Sorting 16 bits takes two of the radix sort's passes instead of four. Measured on H200s: with
+// 32-bit keys the gather and the sort took 57 us a frame at N-body 2048^3, 1024^2, beside a
+// 1.07 ms render kernel (Nsight Compute, bench/device/ncu-ray-scaling.sh); with 16-bit keys the
+// frame ran 1.024x faster on one GPU and 1.021x on two (docs/results/multi-gpu, ray scaling).
+constexpr int kOrderKeyBits = 16;
+SS_FUNC unsigned orderKey(unsigned cycles) {
+  if (cycles == 0) return 0;
+  int lead = 31;
+  while (!(cycles >> lead)) --lead;
+  if (lead == 31) return 0xffffu;  // a second and more at once: the top key
+  const unsigned mantissa = lead >= 11 ? (cycles >> (lead - 11)) & 0x7ffu : (cycles << (11 - lead)) & 0x7ffu;
+  return (unsigned(lead + 1) << 11) | mantissa;  // lead + 1: a key of 0 is "no cycles" alone
+}
+/// The cycles of a key (the 11 bits after the leading one; the rest 0).
+double orderKeyCycles(unsigned key) {
+  if (key == 0) return 0;
+  const int lead = int(key >> 11) - 1;
+  return std::ldexp(double(2048 + (key & 0x7ffu)), lead - 11);
+}
+
 // tileOrder: each unit of a launch of `grid` (x fastest, then y, then the segment) with the
-// cycles its tile and segment took in the last frame (0 where it was not drawn).
+// key of the cycles its tile and segment took in the last frame (0 where it was not drawn).
 __global__ void gatherTileCostKernel(const TileOrder o, dim3 grid, unsigned* keys, unsigned* units) {
   const unsigned n = grid.x * grid.y * grid.z;
   const unsigned u = blockIdx.x * blockDim.x + threadIdx.x;
   if (u >= n) return;
-  keys[u] = o.cost[o.costIndex(u, grid)];
+  keys[u] = orderKey(o.cost[o.costIndex(u, grid)]);
   units[u] = u;
 }
 
@@ -68,6 +90,9 @@ CudaExecutor::CudaExecutor() {
     (void)cudaGetLastError();
     numSMs_ = 1;
   }
+  int kHz = 0;
+  if (cudaDeviceGetAttribute(&kHz, cudaDevAttrClockRate, dev) == cudaSuccess) clockHz_ = 1e3 * double(kHz);
+  else (void)cudaGetLastError();
 }
 
 TileOrder CudaExecutor::tileOrder(dim3 grid, int originX, int originY, int wholeX, int wholeY, cudaStream_t stream) {
@@ -108,11 +133,18 @@ TileOrder CudaExecutor::tileOrder(dim3 grid, int originX, int originY, int whole
   // sort on "at least 1/8 of the slowest", the rest in row-major order) was worse: 0.94x.
   size_t bytes = 0;
   SS_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(nullptr, bytes, keys, keys + n, units, units + n, int(n), 0,
-                                                          32, stream));
+                                                          kOrderKeyBits, stream));
   void* temp = orderTemp_.ensure(bytes);
-  SS_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(temp, bytes, keys, keys + n, units, units + n, int(n), 0, 32,
-                                                          stream));
+  SS_CUDA_CHECK(cub::DeviceRadixSort::SortPairsDescending(temp, bytes, keys, keys + n, units, units + n, int(n), 0,
+                                                          kOrderKeyBits, stream));
   o.order = units + n;
+  // The longest block, for the frame's statistics (FrameStats::longestBlockSeconds). Measured
+  // on 2 x H200, N-body 2048^3 at 1024^2: 0.068 ms in a 0.99 ms kernel on one GPU and a 0.64 ms
+  // kernel on two (docs/results/multi-gpu): no slow block bounds the scaling.
+  if (!h_longest_.get()) h_longest_.reserve(sizeof(unsigned));
+  SS_CUDA_CHECK(cudaMemcpyAsync(h_longest_.get(), keys + n, sizeof(unsigned), cudaMemcpyDeviceToHost, stream));
+  SS_CUDA_CHECK(cudaEventRecord(longestCopied_, stream));
+  longestPending_ = true;
   return o;
 }
 
@@ -148,6 +180,12 @@ int64_t CudaExecutor::lastFrameQueuedShadowRays() const {
   if (!lastQueueCapacity_) return 0;
   SS_CUDA_CHECK(cudaEventSynchronize(shadowCounted_));
   return std::min<int64_t>(*static_cast<const unsigned*>(h_shadowCount_.get()), lastQueueCapacity_);
+}
+
+double CudaExecutor::lastFrameLongestBlockSeconds() const {
+  if (!longestPending_ || !(clockHz_ > 0)) return -1;
+  SS_CUDA_CHECK(cudaEventSynchronize(longestCopied_));
+  return orderKeyCycles(*static_cast<const unsigned*>(h_longest_.get())) / clockHz_;
 }
 
 void CudaExecutor::prepareShadowQueue(FrameView& f, size_t pixels, cudaStream_t stream) {
@@ -199,6 +237,7 @@ void CudaExecutor::render(FrameView f, FilterMode filter, const float* depth, De
   // at a time: docs/results/HISTORY.md, batches of samples).
   f.sampleBatch = tuning_.sampleBatch > 0 ? std::min(tuning_.sampleBatch, kMaxSampleBatch) : kMaxSampleBatch;
   layers_ = SegmentLayersView{};  // launch() sets it for a segmented frame
+  longestPending_ = false;        // tileOrder() sets it for a frame in order
   deviceImageValid_ = false;
   f.depth = nullptr;
   if (depth) {

@@ -75,6 +75,10 @@ class CudaExecutor {
   double lastFrameDeviceSeconds() const;
   /// Shadow rays the last frame queued (those its queue held), waiting for the frame.
   int64_t lastFrameQueuedShadowRays() const;
+  /// The longest block of the frame before the last (the first of tileOrder's sorted costs), by
+  /// the SM clock, in seconds; -1 where the last frame had no order (heaviestFirst off, or no
+  /// frame of its shape before). Waits for the frame.
+  double lastFrameLongestBlockSeconds() const;
 
  private:
   /// Queues the composite of layers_ (a segmented frame's, when set) into d_image_ on stream_.
@@ -97,6 +101,7 @@ class CudaExecutor {
   Event ev0_, ev1_;
   Tuning tuning_;
   int numSMs_ = 1;
+  double clockHz_ = 0;  ///< the SM clock (cudaDevAttrClockRate), for lastFrameLongestBlockSeconds
   DeviceBuffer<vec4f> d_table_;
   PinnedBuffer h_table_;  ///< the table on its way to d_table_
   Event tableCopied_;     ///< h_table_ may be written again once this has passed
@@ -118,6 +123,9 @@ class CudaExecutor {
   DeviceBuffer<unsigned> d_orderKeys_;    ///< tileOrder: the units' costs, then sorted
   DeviceBuffer<unsigned> d_orderUnits_;   ///< tileOrder: the units, then in order
   TempStorage orderTemp_;
+  PinnedBuffer h_longest_;                ///< tileOrder: the longest cost, copied back without a wait
+  Event longestCopied_;
+  bool longestPending_ = false;           ///< the last frame sorted: h_longest_ is its longest
   int costShape_[2] = {0, 0};             ///< wholeX, segments of d_tileCost_'s frames
   bool costKept_ = false;                 ///< d_tileCost_ holds a frame of costShape_
   DeviceBuffer<vec4f> d_layers_;  ///< a segmented frame's layers (raySegments)

@@ -78,6 +78,9 @@ class Backend {
   /// Shadow rays the last render() queued for its second pass (FrameStats::queuedShadowRays);
   /// waits for the frame as lastFrameDeviceSeconds does.
   virtual int64_t lastFrameQueuedShadowRays() const { return 0; }
+  /// The longest block of the frame before the last render() (FrameStats::longestBlockSeconds);
+  /// waits for the frame.
+  virtual double lastFrameLongestBlockSeconds() const { return -1; }
   /// Measures the host-to-device copy rates with buffers of `bytes` (best of 3 each); zeros
   /// without a device.
   virtual UploadRates measureUpload(size_t /*bytes*/) { return UploadRates{}; }

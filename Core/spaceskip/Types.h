@@ -244,6 +244,10 @@ struct FrameStats {
   double deviceSeconds = -1;  ///< render kernel time on the GPU (CUDA events), -1 on the CPU
   /// Scattering on the GPU: shadow rays the frame queued for its second pass (Tuning::deferShadows).
   int64_t queuedShadowRays = 0;
+  /// CUDA, Tuning::heaviestFirst: the longest block (a tile's ray segment) of the frame before,
+  /// by the SM clock, in seconds (-1: not measured). With the slowest blocks started first, a
+  /// frame is longer than this only by what its other blocks add.
+  double longestBlockSeconds = -1;
   std::string backend;
   ResidencyStats residency;
 };

@@ -185,6 +185,7 @@ struct Engine::Impl {
       deviceSecondsPending = false;
       frame.deviceSeconds = backend->lastFrameDeviceSeconds();
       frame.queuedShadowRays = backend->lastFrameQueuedShadowRays();
+      frame.longestBlockSeconds = backend->lastFrameLongestBlockSeconds();
     }
     return frame.deviceSeconds;
   }

@@ -970,7 +970,9 @@ TEST(CudaBackend, HeaviestFirstRendersTheSameImage) {
   // rectangle (the segmented launch's origin on the whole frame's tiles) and zooms in past the
   // frame's edges, so the costs kept from one frame are found again at other launch positions;
   // then a new image size (the costs start again). Whole rays and 4 segments, sparse and dense
-  // data, an odd-sized image (partial tiles), a 32x4 block.
+  // data, an odd-sized image (partial tiles), a 32x4 block. The frame's statistics give the
+  // longest block of the frame before: a frame in order has one, no longer than that frame's
+  // kernel; row-major frames and the first frame of a size have none (-1).
   REQUIRE_CUDA();
   const Volume volumes[] = {generateVolume("nbody", vec3l{96, 96, 96}), generateVolume("menger", vec3l{54, 54, 54})};
   const TransferFunction tf = TransferFunction::preset("ramp", 0, 255);
@@ -993,6 +995,7 @@ TEST(CudaBackend, HeaviestFirstRendersTheSameImage) {
             e[i]->setTuning(t);
             loadFrame(*e[i], v, tf, k, FilterMode::Exact);
           }
+          double lastKernel = 0;
           for (int frame = 0; frame < 6; ++frame) {
             const int w = frame < 5 ? 101 : 64, h = frame < 5 ? 73 : 80;
             const double zoom = frame == 3 ? 2.5 : 1.0 + 0.1 * frame;
@@ -1006,6 +1009,15 @@ TEST(CudaBackend, HeaviestFirstRendersTheSameImage) {
                          std::to_string(block) + " frame " + std::to_string(frame));
             ASSERT_GT(test::coverage(img[0]), 0.001);
             EXPECT_EQ(compareImages(img[0], img[1]).maxAbs, 0.f);
+            EXPECT_EQ(rowMajor.frameStats().longestBlockSeconds, -1.0);
+            const double longest = heaviest.frameStats().longestBlockSeconds;
+            if (frame == 0 || frame == 5) {
+              EXPECT_EQ(longest, -1.0);
+            } else {
+              EXPECT_GT(longest, 0.0);
+              EXPECT_LE(longest, lastKernel);  // cycles at the top clock: never more than the time it ran
+            }
+            lastKernel = heaviest.frameStats().deviceSeconds;
           }
         }
       }

@@ -627,6 +627,7 @@ int main(int argc, char** argv) {
   MPI_Reduce(&t.render, &renderMax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
   MPI_Reduce(&t.render, &renderMin, 1, MPI_DOUBLE, MPI_MIN, 0, MPI_COMM_WORLD);
   const double kernel = engine.frameStats().deviceSeconds;
+  const double longestBlock = engine.frameStats().longestBlockSeconds;  // the frame before's longest block
 
   // Each rank's device and builder, in rank order.
   char line[256];
@@ -666,7 +667,8 @@ int main(int argc, char** argv) {
                 1e3 * t.frame / n, n / t.frame, 1e3 * t.render / n, 1e3 * renderMax / n, 1e3 * renderMin / n,
                 1e3 * t.exchange / n, 1e3 * t.blend / n, 1e3 * t.gather / n, 1e3 * kernel);
     // Where rank 0's render goes: the render() call's return on the host, and the kernel.
-    std::printf("rank0 render_call_ms %.3f kernel_ms %.3f\n", 1e3 * t.call / n, 1e3 * t.kernel / n);
+    std::printf("rank0 render_call_ms %.3f kernel_ms %.3f longest_block_ms %.3f\n", 1e3 * t.call / n,
+                1e3 * t.kernel / n, 1e3 * longestBlock);
     if (!a.png.empty()) savePng(final, a.png);
   }
 
