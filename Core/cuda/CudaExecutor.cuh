@@ -120,7 +120,7 @@ class CudaExecutor {
   unsigned lastQueueCapacity_ = 0;            ///< the last frame's queue (0: none)
   DeviceBuffer<unsigned> d_tileCounter_;
   DeviceBuffer<unsigned> d_tileCost_;     ///< cycles per unit of the whole frame's tiles (TileOrder)
-  DeviceBuffer<unsigned> d_orderKeys_;    ///< tileOrder: the units' costs, then sorted
+  DeviceBuffer<unsigned> d_orderKeys_;    ///< tileOrder: the units' cost keys (orderKey), then sorted
   DeviceBuffer<unsigned> d_orderUnits_;   ///< tileOrder: the units, then in order
   TempStorage orderTemp_;
   PinnedBuffer h_longest_;                ///< tileOrder: the longest cost, copied back without a wait
