@@ -3,6 +3,7 @@
 // composite and the image's copy.
 #include "CudaExecutor.cuh"
 #include "spaceskip/Backend.h"
+#include "spaceskip/Math.h"
 
 #include <cub/device/device_radix_sort.cuh>
 
@@ -33,8 +34,7 @@ __global__ void compositeSegmentsKernel(const SegmentLayersView v, vec4f* out) {
 constexpr int kOrderKeyBits = 16;
 SS_FUNC unsigned orderKey(unsigned cycles) {
   if (cycles == 0) return 0;
-  int lead = 31;
-  while (!(cycles >> lead)) --lead;
+  const int lead = 63 - clz64(cycles);  // the leading one's position, 0..31
   if (lead == 31) return 0xffffu;  // a second and more at once: the top key
   const unsigned mantissa = lead >= 11 ? (cycles >> (lead - 11)) & 0x7ffu : (cycles << (11 - lead)) & 0x7ffu;
   return (unsigned(lead + 1) << 11) | mantissa;  // lead + 1: a key of 0 is "no cycles" alone

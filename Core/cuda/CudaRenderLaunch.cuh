@@ -46,6 +46,18 @@ template <>
 struct RenderMinBlocks<TextureSampler> {
   static constexpr int value = SPACESKIP_CUDA_HW_MIN_BLOCKS;
 };
+// The exact-sampling kernels (ArraySampler: FilterMode::Exact, the default) held up to 130
+// registers uncapped, 3 blocks of 128 threads an SM (Nsight Compute, N-body 2048^3, DistanceGrid). Measured on 2 x H200
+// (docs/results/multi-gpu, register cap), alternated in one hold: 2 (128 registers) made N-body
+// 2048^3 at 1024^2 1.14x faster on one GPU; 3 (85 registers) another 1.06x, and 1.13x at 2048^2,
+// 1.10x on the dense Richtmyer-Meshkov 1536^3; 4 (64 registers) spills, 0.63x on the dense one.
+#ifndef SPACESKIP_CUDA_EXACT_MIN_BLOCKS
+#define SPACESKIP_CUDA_EXACT_MIN_BLOCKS 3  // CMake: SPACESKIP_CUDA_EXACT_MIN_BLOCKS (1 = no register cap)
+#endif
+template <class T>
+struct RenderMinBlocks<ArraySampler<T>> {
+  static constexpr int value = SPACESKIP_CUDA_EXACT_MIN_BLOCKS;
+};
 
 // Tiles of blockDim pixels. Without `tileCounter` block (i, j) renders tile (i, j). With it the
 // launch is persistent: a fixed number of resident blocks take tiles in row-major order from the

@@ -4,6 +4,7 @@
 #pragma once
 #include "Classification.h"
 #include "Macros.h"
+#include "Math.h"
 #include "Tree.h"
 #include "Types.h"
 
@@ -41,15 +42,6 @@ struct KarrasNode {
   int left, right;
   bool leftLeaf, rightLeaf;
 };
-
-/// Leading zeros of a 64-bit word (64 for 0).
-SS_FUNC int clz64(uint64_t v) {
-#if defined(__CUDA_ARCH__)
-  return __clzll(static_cast<long long>(v));
-#else
-  return v ? __builtin_clzll(v) : 64;
-#endif
-}
 
 /// Karras 2012, sec. 4: length of the common prefix of keys i and j; -1 outside [0, n).
 SS_FUNC int karrasDelta(const uint64_t* keys, int n, int i, int j) {

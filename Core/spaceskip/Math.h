@@ -55,6 +55,14 @@ SS_FUNC vec3f normalize(vec3f a) {
   float l = length(a);
   return l > 0.f ? a * (1.f / l) : a;
 }
+/// Leading zeros of a 64-bit word (64 for 0).
+SS_FUNC int clz64(uint64_t v) {
+#if defined(__CUDA_ARCH__)
+  return __clzll(static_cast<long long>(v));
+#else
+  return v ? __builtin_clzll(v) : 64;
+#endif
+}
 SS_FUNC float ss_min(float a, float b) { return a < b ? a : b; }
 SS_FUNC float ss_max(float a, float b) { return a > b ? a : b; }
 SS_FUNC int ss_mini(int a, int b) { return a < b ? a : b; }
