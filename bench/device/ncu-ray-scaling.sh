@@ -16,8 +16,10 @@ for s in $sizes; do
   # Every kernel's duration, one line each (the last frames' are the file's last lines).
   timeout 200 ncu --metrics gpu__time_duration.sum --csv --page raw \
     "$bin" "${common[@]}" --size "$s" --frames 12 > "$out/kernels-$s.csv" 2>&1
+  # 60 frames: the orbit turns 6 degrees a frame, as in bench/multi-gpu (with 10 it turned 36, and
+  # the launch order, the last frame's costs, no longer matched the frame).
   timeout 200 ncu -k regex:renderKernel --launch-skip 6 --launch-count 1 \
     --section LaunchStats --section Occupancy --section WarpStateStats \
     --metrics gpu__time_duration.sum,sm__cycles_active.avg,sm__cycles_active.max,sm__cycles_active.min,sm__cycles_elapsed.max,sm__warps_active.avg.pct_of_peak_sustained_active,sm__throughput.avg.pct_of_peak_sustained_elapsed,l1tex__t_sector_hit_rate.pct,lts__t_sector_hit_rate.pct \
-    "$bin" "${common[@]}" --size "$s" --frames 10 > "$out/render-$s.txt" 2>&1
+    "$bin" "${common[@]}" --size "$s" --frames 60 > "$out/render-$s.txt" 2>&1
 done
