@@ -47,10 +47,11 @@ struct RenderMinBlocks<TextureSampler> {
   static constexpr int value = SPACESKIP_CUDA_HW_MIN_BLOCKS;
 };
 // The exact-sampling kernels (ArraySampler: FilterMode::Exact, the default) held up to 130
-// registers uncapped, 3 blocks of 128 threads an SM (Nsight Compute, N-body 2048^3, DistanceGrid). Measured on 2 x H200
-// (docs/results/multi-gpu, register cap), alternated in one hold: 2 (128 registers) made N-body
-// 2048^3 at 1024^2 1.14x faster on one GPU; 3 (85 registers) another 1.06x, and 1.13x at 2048^2,
-// 1.10x on the dense Richtmyer-Meshkov 1536^3; 4 (64 registers) spills, 0.63x on the dense one.
+// registers uncapped: 3 blocks of 128 threads an SM (Nsight Compute, N-body 2048^3, DistanceGrid).
+// 3 (blocks of 256 threads) leaves 76-80 registers and 6 blocks of 128. Measured on H200s, builds
+// alternated in one hold (docs/results/multi-gpu, register cap): against no cap, N-body 2048^3 on
+// one GPU 1.22x at 1024^2 and 1.37x at 2048^2, N-body 512^3 1.09x, the dense Richtmyer-Meshkov
+// 1024^3 1.11x. 2 (128 registers) gained less; 4 (64 registers) ran the dense one at 0.63x.
 #ifndef SPACESKIP_CUDA_EXACT_MIN_BLOCKS
 #define SPACESKIP_CUDA_EXACT_MIN_BLOCKS 3  // CMake: SPACESKIP_CUDA_EXACT_MIN_BLOCKS (1 = no register cap)
 #endif
