@@ -47,12 +47,28 @@ double orderKeyCycles(unsigned key) {
 }
 
 // tileOrder: each unit of a launch of `grid` (x fastest, then y, then the segment) with the
-// key of the cycles its tile and segment took in the last frame (0 where it was not drawn).
-__global__ void gatherTileCostKernel(const TileOrder o, dim3 grid, unsigned* keys, unsigned* units) {
+// key of the most cycles that its segment took in the last frame on its tile or one of the 8
+// around it (0 where none was drawn), on the whole frame's wholeX x wholeY tiles. A tile that a
+// dense cluster moves onto as the view turns starts early. Traced block by block
+// (bench/device/block-trace.patch) at N-body 2048^3, 1024^2, 6 degrees a frame, the block that
+// ended the frame had taken 1/9 of its cycles on its own tile the frame before, so it started
+// late. Against the tile's own cycles, on 2 x H200 (docs/results/multi-gpu, the slowest block):
+// N-body 2048^3 1.02-1.07x on one GPU, 1.02x on two; the dense Richtmyer-Meshkov 1024^3 1.01x.
+__global__ void gatherTileCostKernel(const TileOrder o, dim3 grid, int wholeY, unsigned* keys, unsigned* units) {
   const unsigned n = grid.x * grid.y * grid.z;
   const unsigned u = blockIdx.x * blockDim.x + threadIdx.x;
   if (u >= n) return;
-  keys[u] = orderKey(o.cost[o.costIndex(u, grid)]);
+  unsigned tx, ty, segment;
+  TileOrder::unit(u, grid, tx, ty, segment);
+  const int wx = int(tx) + o.originX, wy = int(ty) + o.originY;
+  unsigned c = 0;
+  for (int y = wy - 1; y <= wy + 1; ++y)
+    for (int x = wx - 1; x <= wx + 1; ++x)
+      if (x >= 0 && y >= 0 && x < o.wholeX && y < wholeY) {
+        const unsigned v = o.cost[(size_t(y) * size_t(o.wholeX) + size_t(x)) * grid.z + segment];
+        c = v > c ? v : c;
+      }
+  keys[u] = orderKey(c);
   units[u] = u;
 }
 
@@ -123,7 +139,7 @@ TileOrder CudaExecutor::tileOrder(dim3 grid, int originX, int originY, int whole
   d_orderKeys_.reserve(size_t(n) * 2);
   d_orderUnits_.reserve(size_t(n) * 2);
   unsigned *keys = d_orderKeys_.get(), *units = d_orderUnits_.get();
-  gatherTileCostKernel<<<(n + 255) / 256, 256, 0, stream>>>(o, grid, keys, units);
+  gatherTileCostKernel<<<(n + 255) / 256, 256, 0, stream>>>(o, grid, wholeY, keys, units);
   SS_CUDA_CHECK_LAUNCH(gatherTileCostKernel);
   // Longest first; the sort is stable, so equal costs (a first frame's zeros) stay in row-major
   // order. Measured on 2 x H200 (docs/results/multi-gpu, heaviest first): N-body 2048^3 at

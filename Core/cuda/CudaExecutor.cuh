@@ -75,8 +75,9 @@ class CudaExecutor {
   double lastFrameDeviceSeconds() const;
   /// Shadow rays the last frame queued (those its queue held), waiting for the frame.
   int64_t lastFrameQueuedShadowRays() const;
-  /// The longest block of the frame before the last (the first of tileOrder's sorted costs), by
-  /// the SM clock, in seconds; -1 where the last frame had no order (heaviestFirst off, or no
+  /// The longest block of the frame before the last (the first of tileOrder's sorted keys: the
+  /// most cycles among the last frame's units of this launch and their neighbours), by the SM
+  /// clock, in seconds; -1 where the last frame had no order (heaviestFirst off, or no
   /// frame of its shape before). Waits for the frame.
   double lastFrameLongestBlockSeconds() const;
 
@@ -86,8 +87,8 @@ class CudaExecutor {
   template <class Sampler>
   void launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes, cudaStream_t stream);
   /// The order of a plain launch of `grid` (z: segments) whose first tile is (originX, originY)
-  /// of the whole frame's wholeX x wholeY tiles: the units by the cycles they took in the last
-  /// frame, longest first (a gather and a CUB radix sort on `stream`), and where this frame's
+  /// of the whole frame's wholeX x wholeY tiles: the units by the most cycles they or their 8
+  /// neighbouring tiles took in the last frame, longest first (a gather and a CUB radix sort on `stream`), and where this frame's
   /// cycles go. Without a last frame of this shape (or with Tuning::heaviestFirst off): no order.
   TileOrder tileOrder(dim3 grid, int originX, int originY, int wholeX, int wholeY, cudaStream_t stream);
   /// The frame's queued shadow rays (f.scatter.queue), marched into d_image_ after its kernel.

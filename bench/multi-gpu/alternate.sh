@@ -2,7 +2,7 @@
 # A/B of one run.sh setting in one hold: runs bench/multi-gpu/run.sh once per value of VAR, in
 # turn, REPEATS times (v1, v2, ..., v1, v2, ...), so that a drift of the machine falls on every
 # value alike, and prints one line per run: the value, the repeat, the ranks, fps, the frame, rank
-# 0's kernel and its longest block of the frame before (run.sh's other settings come from the
+# 0's kernel and its longest block over the orbit (run.sh's other settings come from the
 # caller's environment: RANKS, SPLITS, CHECK, FRAMES, SIZE, ...).
 #
 #   VAR=RAY_SEGMENTS VALUES="4 8" REPEATS=2 RANKS="1 2" SPLITS=image CHECK=0 \

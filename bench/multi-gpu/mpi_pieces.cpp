@@ -606,7 +606,13 @@ int main(int argc, char** argv) {
     for (int i = 0; i < 10; ++i) frame(0, warm);
   }
   Times t;
-  for (int f = 0; f < a.frames; ++f) frame(f, t);
+  // The orbit's longest block (each frame's statistic is the frame before's; after the orbit
+  // come the transfer-function edits, whose frames are not the orbit's).
+  double longestBlock = -1;
+  for (int f = 0; f < a.frames; ++f) {
+    frame(f, t);
+    longestBlock = std::max(longestBlock, engine.frameStats().longestBlockSeconds);
+  }
   // Device memory in use on this rank's GPU after the orbit (the volume in core, the structure).
   double deviceGiB = 0;
 #ifdef SPACESKIP_MPI_PIECES_CUDA
@@ -627,7 +633,6 @@ int main(int argc, char** argv) {
   MPI_Reduce(&t.render, &renderMax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
   MPI_Reduce(&t.render, &renderMin, 1, MPI_DOUBLE, MPI_MIN, 0, MPI_COMM_WORLD);
   const double kernel = engine.frameStats().deviceSeconds;
-  const double longestBlock = engine.frameStats().longestBlockSeconds;  // the frame before's longest block
 
   // Each rank's device and builder, in rank order.
   char line[256];
