@@ -81,10 +81,20 @@ bool validBlock(const Tuning& p) {
 
 /// Segments for a frame's rays: one per kSamplesPerSegment samples along the volume's diagonal
 /// (its world length: the index box's corners through the inverse of worldToIndex, over dt), at
-/// most kRaySegments; 1 (whole rays) below 2 x kSamplesPerSegment.
+/// most kRaySegments; 1 (whole rays) below 2 x kSamplesPerSegment. A frame of long rays and at
+/// most kFewRaysPixels pixels (a small window, one GPU's band of an image) takes
+/// kRaySegmentsFewRays: with few tiles its slowest ray segments are the frame (traced block by
+/// block: at N-body 2048^3 in 724^2 one 0.52 ms block was the whole kernel). The frame's size,
+/// not the box's pixels: those change as the view turns, and each change of the count starts the
+/// launch order again (tileOrder), which cost 0.97x at 1024^2. Measured on H200s
+/// (docs/results/multi-gpu, ray segments), 8 against 4 segments: N-body 2048^3 1.13x on 2 GPUs'
+/// bands of 1024^2, 1.17x at 512^2, 1.01x at 724^2; N-body 512^3 1.00x / 1.05x / 0.99x; the dense
+/// Richtmyer-Meshkov 1024^3 1.00x / 1.02x / 1.00x. At 1024^2 on one GPU 8 lost: 0.87-0.98x.
 namespace {
 constexpr int kRaySegments = 4;
+constexpr int kRaySegmentsFewRays = 8;
 constexpr double kSamplesPerSegment = 512;
+constexpr int64_t kFewRaysPixels = (int64_t(3) << 20) / 4;  // 3/4 of 1024^2: layers of 96 MiB at most
 }  // namespace
 int raySegments(const FrameView& f) {
   mat4 w2i = identity4(), i2w;
@@ -97,7 +107,8 @@ int raySegments(const FrameView& f) {
   transformPoint(i2w, hi, b);
   const double samples = std::sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
                                    (b[2] - a[2]) * (b[2] - a[2])) / double(f.dt);
-  return int(std::max(1.0, std::min(double(kRaySegments), std::floor(samples / kSamplesPerSegment))));
+  const int n = int(std::max(1.0, std::min(double(kRaySegments), std::floor(samples / kSamplesPerSegment))));
+  return n == kRaySegments && int64_t(f.width) * f.height <= kFewRaysPixels ? kRaySegmentsFewRays : n;
 }
 CudaExecutor::CudaExecutor() {
   int dev = 0;
