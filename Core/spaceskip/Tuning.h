@@ -17,11 +17,13 @@ struct Tuning {
   /// (the plain launch); -1: automatic (persistent for hardware-filtered volumes above 2 GiB).
   int resident = -1;
   /// Rays cut into this many segments marched by separate threads (1..16; 1: whole rays); 0:
-  /// automatic (up to 4, by the box's length in samples; CudaExecutor.cu raySegments).
+  /// automatic (up to 4, by the box's length in samples; 8 for long rays in frames of at most
+  /// 3/4 of 1024^2 pixels; CudaExecutor.cu raySegments).
   int raySegments = 0;
   /// Plain launches start the blocks that took longest in the last frame first (their tiles and
-  /// ray segments, by the SM clock; CudaExecutor::tileOrder): the frame no longer waits for its
-  /// slowest tiles started last. Off: blocks in row-major order. The image is the same.
+  /// ray segments, by the SM clock, the most of the 3 x 3 tiles around; CudaExecutor::tileOrder):
+  /// the frame no longer waits for its slowest tiles started last. Off: blocks in row-major
+  /// order. The image is the same.
   bool heaviestFirst = true;
   /// Samples a hardware-filtered GPU march fetches before compositing the first (1..4; 0: 4,
   /// kMaxSampleBatch). 1 (one at a time) stays for the test that batches give the same image.
