@@ -88,8 +88,9 @@ class CudaExecutor {
   void launch(const FrameView& f, const Sampler& s, dim3 grid, dim3 block, size_t textureBytes, cudaStream_t stream);
   /// The order of a plain launch of `grid` (z: segments) whose first tile is (originX, originY)
   /// of the whole frame's wholeX x wholeY tiles: the units by the most cycles they or their 8
-  /// neighbouring tiles took in the last frame, longest first (a gather and a CUB radix sort on `stream`), and where this frame's
-  /// cycles go. Without a last frame of this shape (or with Tuning::heaviestFirst off): no order.
+  /// neighbouring tiles took in the last frame, longest first (a gather and a CUB radix sort on
+  /// `stream`), and where this frame's cycles go. Without a last frame of this shape (or with
+  /// Tuning::heaviestFirst off): no order.
   TileOrder tileOrder(dim3 grid, int originX, int originY, int wholeX, int wholeY, cudaStream_t stream);
   /// The frame's queued shadow rays (f.scatter.queue), marched into d_image_ after its kernel.
   template <class Sampler>
