@@ -88,8 +88,9 @@ bool validBlock(const Tuning& p) {
 /// not the box's pixels: those change as the view turns, and each change of the count starts the
 /// launch order again (tileOrder), which cost 0.97x at 1024^2. Measured on H200s
 /// (docs/results/multi-gpu, ray segments), 8 against 4 segments: N-body 2048^3 1.13x on 2 GPUs'
-/// bands of 1024^2, 1.17x at 512^2, 1.01x at 724^2; N-body 512^3 1.00x / 1.05x / 0.99x; the dense
-/// Richtmyer-Meshkov 1024^3 1.00x / 1.02x / 1.00x. At 1024^2 on one GPU 8 lost: 0.87-0.98x.
+/// bands of 1024^2, 1.17x at 512^2, 1.01x at 724^2, 1.04x at 1000 x 700; N-body 512^3 1.00x /
+/// 1.05x / 0.99x / 1.00x; the dense Richtmyer-Meshkov 1024^3 1.00x / 1.02x / 1.00x / 1.00x. At
+/// 1024^2 on one GPU 8 lost: 0.87-0.98x.
 namespace {
 constexpr int kRaySegments = 4;
 constexpr int kRaySegmentsFewRays = 8;
