@@ -65,7 +65,7 @@ __global__ void gatherTileCostKernel(const TileOrder o, dim3 grid, int wholeY, u
   for (int y = wy - 1; y <= wy + 1; ++y)
     for (int x = wx - 1; x <= wx + 1; ++x)
       if (x >= 0 && y >= 0 && x < o.wholeX && y < wholeY) {
-        const unsigned v = o.cost[(size_t(y) * size_t(o.wholeX) + size_t(x)) * grid.z + segment];
+        const unsigned v = o.cost[o.wholeCostIndex(unsigned(x), unsigned(y), segment, grid.z)];
         c = v > c ? v : c;
       }
   keys[u] = orderKey(c);

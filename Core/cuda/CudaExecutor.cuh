@@ -38,7 +38,11 @@ struct TileOrder {
   __host__ __device__ size_t costIndex(unsigned u, dim3 grid) const {
     unsigned tx, ty, segment;
     unit(u, grid, tx, ty, segment);
-    return (size_t(ty + unsigned(originY)) * size_t(wholeX) + (tx + unsigned(originX))) * grid.z + segment;
+    return wholeCostIndex(tx + unsigned(originX), ty + unsigned(originY), segment, grid.z);
+  }
+  /// Where the cycles of tile (x, y) of the whole frame and its segment go.
+  __host__ __device__ size_t wholeCostIndex(unsigned x, unsigned y, unsigned segment, unsigned segments) const {
+    return (size_t(y) * size_t(wholeX) + x) * segments + segment;
   }
 };
 
