@@ -95,6 +95,44 @@ def main(paths):
         }
         for name, order in orders.items():
             print(f"  scheduled, {name:27s} {schedule(order, took, slots):7.1f} us")
+        counts(path, t, took)
+
+
+def counts(path, t, took):
+    """With TRACE.counts (each pixel's samples and march iterations in each segment): what the
+    slowest blocks' rays did against the median block's. A warp is two rows of a 16 x 8 tile."""
+    try:
+        c = np.fromfile(path + ".counts", np.uint32)
+    except OSError:
+        return
+    w, h = (int(v) for v in path.rsplit("trace-", 1)[1].split(".")[0].split("x"))
+    gx, gy, gz = t["grid"]
+    ox, oy = t["origin"]
+    layers = gz * h * w
+    samples = c[:layers].reshape(gz, h, w).astype(float)
+    iters = c[layers:2 * layers].reshape(gz, h, w).astype(float)
+
+    def block(u):
+        r = u % (gx * gy)
+        x0, y0, z = (r % gx + ox) * 16, (r // gx + oy) * 8, u // (gx * gy)
+        s = np.zeros((8, 16))
+        i = np.zeros((8, 16))
+        ss, ii = samples[z, y0:y0 + 8, x0:x0 + 16], iters[z, y0:y0 + 8, x0:x0 + 16]
+        s[:ss.shape[0], :ss.shape[1]] = ss
+        i[:ii.shape[0], :ii.shape[1]] = ii
+        return s, i
+
+    order = np.argsort(-took)
+    rows = [("slowest", int(order[k])) for k in range(5)] + [("median", int(order[len(order) // 2]))]
+    print("  block         us  segment  samples max/mean  iterations max/mean  warp max iterations  cycles per warp iteration")
+    for name, u in rows:
+        s, i = block(u)
+        warp = i.reshape(4, 32).max(axis=1)
+        print(f"  {name:8s} {took[u]:8.1f}  {u // (gx * gy):7d}  {s.max():8.0f} / {s.mean():7.1f}  {i.max():9.0f} / {i.mean():7.1f}"
+              f"  {' '.join(f'{v:.0f}' for v in warp):>20s}  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}")
+    total_s, total_i = samples.sum(), iters.sum()
+    print(f"  frame: {total_s:.0f} samples, {total_i:.0f} iterations; "
+          f"{(samples > 0).sum()} pixel segments with samples of {layers}")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # On the GPU machine: a block trace of one frame of the CLI's kernel benchmark (each render
-# block's SM, start, end and cycles, the launch order's keys, the last frame's cycles), at N-body
+# block's SM, start, end and cycles, the launch order's keys, the last frame's cycles; in
+# TRACE.counts each pixel's samples and march iterations in each ray segment), at N-body
 # 2048^3 in a 1024^2 window and at 724^2 (half the pixels: one rank's share on 2 GPUs), frame 40
 # of a 60-frame orbit (6 degrees a frame, as bench/multi-gpu), then block-trace.py on both.
 # BIN is a CLI built with bench/device/block-trace.patch (a measurement build, never main):
