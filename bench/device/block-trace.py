@@ -124,12 +124,14 @@ def counts(path, t, took):
 
     order = np.argsort(-took)
     rows = [("slowest", int(order[k])) for k in range(5)] + [("median", int(order[len(order) // 2]))]
-    print("  block         us  segment  samples max/mean  iterations max/mean  warp max iterations  cycles per warp iteration")
+    print("  block         us  segment  samples max/mean  iterations max/mean  warp max iterations"
+          "  cycles per warp iteration")
     for name, u in rows:
         s, i = block(u)
         warp = i.reshape(4, 32).max(axis=1)
-        print(f"  {name:8s} {took[u]:8.1f}  {u // (gx * gy):7d}  {s.max():8.0f} / {s.mean():7.1f}  {i.max():9.0f} / {i.mean():7.1f}"
-              f"  {' '.join(f'{v:.0f}' for v in warp):>20s}  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}")
+        print(f"  {name:8s} {took[u]:8.1f}  {u // (gx * gy):7d}  {s.max():8.0f} / {s.mean():7.1f}"
+              f"  {i.max():9.0f} / {i.mean():7.1f}  {' '.join(f'{v:.0f}' for v in warp):>20s}"
+              f"  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}")
     total_s, total_i = samples.sum(), iters.sum()
     print(f"  frame: {total_s:.0f} samples, {total_i:.0f} iterations; "
           f"{(samples > 0).sum()} pixel segments with samples of {layers}")
