@@ -115,12 +115,14 @@ def counts(path, t, took):
     def block(u):
         r = u % (gx * gy)
         x0, y0, z = (r % gx + ox) * 16, (r // gx + oy) * 8, u // (gx * gy)
-        s = np.zeros((8, 16))
-        i = np.zeros((8, 16))
-        ss, ii = samples[z, y0:y0 + 8, x0:x0 + 16], iters[z, y0:y0 + 8, x0:x0 + 16]
-        s[:ss.shape[0], :ss.shape[1]] = ss
-        i[:ii.shape[0], :ii.shape[1]] = ii
-        return s, i
+
+        def tile(a):  # the unit's 16 x 8 pixels, zeros beyond the frame's edge
+            t = np.zeros((8, 16))
+            v = a[z, y0:y0 + 8, x0:x0 + 16]
+            t[:v.shape[0], :v.shape[1]] = v
+            return t
+
+        return tile(samples), tile(iters)
 
     order = np.argsort(-took)
     rows = [("slowest", int(order[k])) for k in range(5)] + [("median", int(order[len(order) // 2]))]

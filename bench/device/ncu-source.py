@@ -17,9 +17,10 @@ def main(path, top=40):
             current = r[1]
         elif r[0] == "Line No":
             header = r
+            column = header.index("Warp Stall Sampling (All Samples)")
         elif header and current and r[0].isdigit():
             try:
-                samples = float(r[4].replace(",", "") or 0)
+                samples = float(r[column].replace(",", "") or 0)
             except ValueError:
                 continue
             lines.append((samples, current.rsplit("/", 1)[-1], int(r[0]), r[1].strip()[:90]))
