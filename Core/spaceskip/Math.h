@@ -63,6 +63,22 @@ SS_FUNC int clz64(uint64_t v) {
   return v ? __builtin_clzll(v) : 64;
 #endif
 }
+/// Trailing zeros of a non-zero 32-bit word.
+SS_FUNC int ctz32(uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  return __ffs(static_cast<int>(v)) - 1;
+#else
+  return __builtin_ctz(v);
+#endif
+}
+/// Index of the highest set bit of a non-zero 32-bit word.
+SS_FUNC int msb32(uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  return 31 - __clz(static_cast<int>(v));
+#else
+  return 31 - __builtin_clz(v);
+#endif
+}
 SS_FUNC float ss_min(float a, float b) { return a < b ? a : b; }
 SS_FUNC float ss_max(float a, float b) { return a > b ? a : b; }
 SS_FUNC int ss_mini(int a, int b) { return a < b ? a : b; }

@@ -513,7 +513,7 @@ struct IntervalMarcher {
     float ra = 0.f, rb = 0.f;
     bool have = false;
     for (;;) {
-      float a, b;
+      float a = 0.f, b = 0.f;
       const Step st = it.next(*this, a, b);
       if (st == Step::Done) break;
       if (st != Step::Interval) continue;

@@ -14,6 +14,21 @@ namespace spaceskip {
 /// What one traversal step produced.
 enum class Step : int { Skip, Interval, Done };
 
+/// The box of the set parts of a sub-brick mask m != 0 (x fastest, Classification.h): per axis
+/// the first and the last part index that holds a set part.
+SS_FUNC void setPartBox(uint64_t m, vec3i& lo, vec3i& hi) {
+  static_assert(kSubPerAxis == 4, "the folds below are for 4 x 4 x 4 parts");
+  const uint32_t z0 = uint32_t(m) & 0xffffu, z1 = uint32_t(m) >> 16;
+  const uint32_t z2 = uint32_t(m >> 32) & 0xffffu, z3 = uint32_t(m >> 48);
+  const uint32_t zs = uint32_t(z0 != 0) | uint32_t(z1 != 0) << 1 | uint32_t(z2 != 0) << 2 | uint32_t(z3 != 0) << 3;
+  const uint32_t xy = z0 | z1 | z2 | z3;  // bit x + 4y: a part of that column is set
+  const uint32_t ys = uint32_t((xy & 0xfu) != 0) | uint32_t((xy & 0xf0u) != 0) << 1 |
+                      uint32_t((xy & 0xf00u) != 0) << 2 | uint32_t((xy & 0xf000u) != 0) << 3;
+  const uint32_t xs = (xy | xy >> 4 | xy >> 8 | xy >> 12) & 0xfu;
+  lo = vec3i{ctz32(xs), ctz32(ys), ctz32(zs)};
+  hi = vec3i{msb32(xs), msb32(ys), msb32(zs)};
+}
+
 /// 3-D DDA (Amanatides & Woo 1987) over the bricks of `g`, restricted to t in [tmin, tmax):
 /// each step visits one brick and yields it as an interval when it is occupied. With a distance
 /// field, an empty brick at distance d >= 2 is left together with the (2d-1)^3 empty bricks
@@ -21,8 +36,8 @@ enum class Step : int { Skip, Interval, Done };
 /// restarts there. With value ranges (GridView::vmin) a brick is occupied when
 /// `m.active(vmin, vmax)` says so, decided when the previous interval's samples are taken.
 /// With sub-brick masks (GridView::sub) an occupied brick whose byte says so (bit 7,
-/// kBrickPartsBit) is walked by a second DDA over its 4^3 parts, which yields the runs of set
-/// parts only (no memory reads beyond the mask).
+/// kBrickPartsBit) is walked by a second DDA over its 4^3 parts, inside the box of its set
+/// parts, which yields the runs of set parts only (no memory reads beyond the mask).
 template <bool Parts>
 struct GridIterT {
   // The DDA's per-axis state is vec3 (axisOf/setAxis, Math.h), never an array indexed by the
@@ -32,6 +47,8 @@ struct GridIterT {
   const GridView* g;
   vec3f org, dir, inv;
   float t, tmax, B;
+  /// 1 / B where B is a power of two (then x * invB is x / B, bit for bit), else 0.
+  float invB;
   vec3i cell, step;
   vec3f tNext, tDelta;
   bool done;
@@ -71,19 +88,44 @@ struct GridIterT {
     return false;
   }
 
-  /// Starts walking the parts of brick `c` (mask `m`) from t0 to t1.
+  /// x / B (a coordinate in bricks), as a multiplication where that is exact.
+  SS_FUNC float inBricks(float x) const { return invB != 0.f ? x * invB : x / B; }
+
+  /// Starts walking the parts of brick `c` (mask `m`) from t0 to t1. The walk is clipped to
+  /// the box of the set parts first (setPartBox; nothing to clip when it is the whole brick):
+  /// the parts outside it are unset and a sample on their faces has opacity 0 (the parts' +1
+  /// halo), so the runs give the same samples, and a ray that misses the box walks nothing
+  /// (mask 0).
   SS_FUNC void enterParts(vec3i c, uint64_t m, float t0, float t1) {
     const float S = B * (1.f / float(kSubPerAxis));
-    mask = m;
+    mask = 0;
+    if (m == 0) return;  // emptied by an edit since its byte was written: nothing to walk
+    vec3i lo, hi;
+    setPartBox(m, lo, hi);
+    const bool wholeBox = (lo.x | lo.y | lo.z) == 0 && (hi.x & hi.y & hi.z) == kSubPerAxis - 1;
+    for (int a = 0; a < 3; ++a) {
+      const int st = axisOf(step, a);
+      if (st == 0 || wholeBox) continue;
+      const float base = float(axisOf(c, a)) * B;
+      const float tLo = (base + float(axisOf(lo, a)) * S - axisOf(org, a)) * axisOf(inv, a);
+      const float tHi = (base + float(axisOf(hi, a) + 1) * S - axisOf(org, a)) * axisOf(inv, a);
+      t0 = ss_max(t0, st > 0 ? tLo : tHi);
+      t1 = ss_min(t1, st > 0 ? tHi : tLo);
+    }
+    mask = t0 < t1 ? m : 0;
     ts = t0;
     tsEnd = t1;
     const vec3f p = org + dir * t0;
     for (int a = 0; a < 3; ++a) {
       const float base = float(axisOf(c, a)) * B;
-      int k = int(floorf((axisOf(p, a) - base) / S));
+      int k = int(floorf(inBricks(axisOf(p, a) - base) * float(kSubPerAxis)));
       k = ss_maxi(0, ss_mini(k, kSubPerAxis - 1));
-      setAxis(sc, a, k);
       const int st = axisOf(step, a);
+      // Along the ray's axes the start lies in the box (clamped against rounding); across an
+      // axis it never moves, so outside the box's slab no part it meets is set.
+      if (st == 0 && (k < axisOf(lo, a) || k > axisOf(hi, a))) mask = 0;
+      k = ss_maxi(axisOf(lo, a), ss_mini(k, axisOf(hi, a)));
+      setAxis(sc, a, k);
       setAxis(sNext, a, st == 0 ? INFINITY : (base + float(st > 0 ? k + 1 : k) * S - axisOf(org, a)) * axisOf(inv, a));
     }
   }
@@ -102,12 +144,13 @@ struct GridIterT {
     t = tmin;
     tmax = tEnd;
     B = float(grid.brick);
+    invB = (grid.brick & (grid.brick - 1)) == 0 ? 1.f / B : 0.f;
     mask = 0;
     done = !(tmin < tEnd);
     if (done) return;
     const vec3f p = org + dir * tmin;
     for (int a = 0; a < 3; ++a) {
-      int c = int(floorf(axisOf(p, a) / B));
+      int c = int(floorf(inBricks(axisOf(p, a))));
       c = ss_maxi(0, ss_mini(c, axisOf(grid.dims, a) - 1));
       setAxis(cell, a, c);
       const float d = axisOf(dir, a);
@@ -159,7 +202,7 @@ struct GridIterT {
         if (ax == ja) {
           c = ca + axisOf(step, ax) * (rad + 1);
         } else {  // still inside the cube's slab on this axis (clamped against rounding)
-          c = int(floorf(axisOf(q, ax) / B));
+          c = int(floorf(inBricks(axisOf(q, ax))));
           c = ss_maxi(ss_maxi(ca - rad, 0), ss_mini(c, ss_mini(ca + rad, axisOf(g->dims, ax) - 1)));
         }
         if (c < 0 || c >= axisOf(g->dims, ax)) {  // left the grid
