@@ -131,10 +131,10 @@ class CpuBackend final : public Backend {
     f.depth = depth;
     f.traversal = traversal_;
     const OccupancyGrid& g = traversal_ == TraversalKind::Hybrid ? hybridGrid_ : occ_;
-    // On a CPU core a sample costs far more than a step of the part walk: Grid and DistanceGrid
-    // frames walk the parts of sparse bricks wherever there are masks (GridParts; 1.06-1.53x
-    // on seven of the paper's stand-ins at 1/4 scale, item by item in one process against the
-    // `:whole` bench suffix: docs/results/cpu-sub-brick-masks).
+    // Grid and DistanceGrid frames walk the parts of sparse bricks wherever there are masks
+    // (GridParts). Against the `:whole` bench suffix on the paper's stand-ins at 1/4 scale this
+    // measured 1.06-1.53x on 2026-11-24, and 0.92-1.03x on 2026-12-01, after the SIMD packets
+    // made samples cheaper (docs/results/cpu-sub-brick-masks).
     const bool parts = traversal_ == TraversalKind::Grid && !sub_.mask.empty();
     if (parts) f.traversal = TraversalKind::GridParts;
     f.grid = GridView{parts ? sub_.state.data() : g.occ.data(), g.dims, g.brick, dist_.empty() ? nullptr : dist_.data(),
