@@ -92,10 +92,12 @@ void applyItemTuning(Engine& engine, const Volume& v, const Options& o, const Be
   if (item.parts == -1) t.subMasks = false;
   if (item.parts >= 0) {
     t.subMasks = true;
+    t.cpuSubMasks = true;
     t.subMaskMaxSet = item.parts;
   }
   const Tuning& was = engine.tuning();
-  const bool reclassify = t.subMasks != was.subMasks || t.subMaskMaxSet != was.subMaskMaxSet;
+  const bool reclassify =
+      t.subMasks != was.subMasks || t.cpuSubMasks != was.cpuSubMasks || t.subMaskMaxSet != was.subMaskMaxSet;
   engine.setTuning(t);
   if (!reclassify) return;
   TransferFunction tf = makeTF(o, v), edited = tf;

@@ -90,7 +90,7 @@ struct BenchItem {
   int resident = -1;  ///< `resN`: Tuning::resident = N for this item (CUDA launch shape)
   /// Sub-brick masks for this item: -2 as the environment says; -1 (`whole`): none
   /// (Tuning::subMasks off); N (`partsN`): bricks with at most N of 64 parts set are walked part
-  /// by part (Tuning::subMaskMaxSet = N).
+  /// by part (Tuning::subMaskMaxSet = N; on the CPU backend too: Tuning::cpuSubMasks).
   int parts = -2;
 };
 BenchItem benchItem(const std::string& item);

@@ -32,7 +32,8 @@ const char* kUsage = R"(usage:
       --build-reps N: report the fastest of N rebuilds (default 1)
       bench-only suffixes: :hw / :exact (filter for this item), :cold (time the first build only),
       :resN (CUDA: persistent launch with N blocks per SM; res0 = plain), :whole (no sub-brick
-      masks: occupied bricks marched whole), :partsN (bricks with <= N of 64 parts set walked by parts)
+      masks: occupied bricks marched whole), :partsN (bricks with <= N of 64 parts set walked by parts,
+      on the CPU backend too, which marches whole bricks by default)
       --edits N [--edit-cut C]: after an item's frames, N opacity edits at a still view, alternately
       zeroing the TF's opacity below C of the range (default 0.3: bricks empty) and restoring it
       (bricks occupied again), each timed to its first frame finished on the device (the image

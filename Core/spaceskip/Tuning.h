@@ -39,6 +39,12 @@ struct Tuning {
   // --- classification (both backends) ---
   /// Sub-brick masks: without them an occupied brick is marched whole.
   bool subMasks = true;
+  /// The oneTBB backend computes the masks and walks the parts too (with subMasks on). Off: it
+  /// marches occupied bricks whole and an opacity edit reads no voxel. Off measured 0.96-1.10x
+  /// the frame with it on (18 of 22 items faster) on the paper's 11 stand-ins at 1/4 scale, and
+  /// an opacity edit that occupies bricks 1.6x faster to its first frame on N-body 512^3
+  /// (docs/results/cpu-sub-brick-masks).
+  bool cpuSubMasks = false;
   /// The most set parts (of 64) a brick may have to be walked part by part (subBrickState); 40
   /// measured best over 24 on the H100 and the oneTBB backend (docs/results/h100-tf-edit).
   int subMaskMaxSet = 40;

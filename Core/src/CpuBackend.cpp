@@ -62,7 +62,7 @@ class CpuBackend final : public Backend {
     for (size_t i = 0; onlyEmptied_ && i < o.occ.size(); ++i)
       if (o.occ[i] && !occ_.occ[i]) onlyEmptied_ = false;
     occ_ = std::move(o);
-    sub_ = computeSubMasks(volume_, occ_, tf, tuning_);
+    sub_ = tuning_.cpuSubMasks ? computeSubMasks(volume_, occ_, tf, tuning_) : SubMasks{};
     readVoxels_ = !sub_.mask.empty();
     markDistances();  // a field kept across the edit takes the new states' marks
     tf_ = tf;
@@ -132,9 +132,9 @@ class CpuBackend final : public Backend {
     f.traversal = traversal_;
     const OccupancyGrid& g = traversal_ == TraversalKind::Hybrid ? hybridGrid_ : occ_;
     // Grid and DistanceGrid frames walk the parts of sparse bricks wherever there are masks
-    // (GridParts). Against the `:whole` bench suffix on the paper's stand-ins at 1/4 scale this
-    // measured 1.06-1.53x on 2026-11-24, and 0.92-1.03x on 2026-12-01, after the SIMD packets
-    // made samples cheaper (docs/results/cpu-sub-brick-masks).
+    // (GridParts), which is only with Tuning::cpuSubMasks: against whole bricks on the paper's
+    // stand-ins at 1/4 scale the walk measured 1.06-1.53x on 2026-11-24, and 0.92-1.03x on
+    // 2026-12-01, after the SIMD packets made samples cheaper (docs/results/cpu-sub-brick-masks).
     const bool parts = traversal_ == TraversalKind::Grid && !sub_.mask.empty();
     if (parts) f.traversal = TraversalKind::GridParts;
     f.grid = GridView{parts ? sub_.state.data() : g.occ.data(), g.dims, g.brick, dist_.empty() ? nullptr : dist_.data(),

@@ -362,11 +362,14 @@ TEST(SubMasks, FewerSamplesAndTheSameImage) {
     int64_t naiveSamples = 0;
     const Image naive = test::renderCounting(v, tf, BuilderKind::Naive, c, 96, naiveSamples);
     for (BuilderKind k : {BuilderKind::Grid, BuilderKind::DistanceGrid}) {
-      int64_t with = 0, without = 0;
-      Tuning noMasks;
+      int64_t with = 0, without = 0, byDefault = 0;
+      Tuning noMasks, masks;
       noMasks.subMasks = false;
+      masks.cpuSubMasks = true;  // the oneTBB backend marches whole bricks unless told
       const Image whole = test::renderCounting(v, tf, k, c, 96, without, RenderParams{}, noMasks);
-      const Image parts = test::renderCounting(v, tf, k, c, 96, with);
+      const Image parts = test::renderCounting(v, tf, k, c, 96, with, RenderParams{}, masks);
+      test::renderCounting(v, tf, k, c, 96, byDefault);
+      EXPECT_EQ(byDefault, without) << builderName(k) << ": the CPU's default marches whole bricks";
       EXPECT_EQ(compareImages(whole, parts).maxAbs, 0.f) << builderName(k);
       EXPECT_LE(compareImages(naive, parts).maxAbs, 1.f / 255.f) << builderName(k);
       EXPECT_GT(with, 0) << builderName(k);

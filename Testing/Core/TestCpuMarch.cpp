@@ -46,8 +46,10 @@ struct Frame {
 };
 
 Image render(const Volume& v, const TransferFunction& tf, RenderParams rp, bool scalar, double az, double el,
-             bool persp, int w, int h, double zoom = 1.0, BuildParams bp = test::builder(BuilderKind::Naive)) {
+             bool persp, int w, int h, double zoom = 1.0, BuildParams bp = test::builder(BuilderKind::Naive),
+             const Tuning& tuning = Tuning{}) {
   Engine e(BackendKind::CPU);
+  e.setTuning(tuning);
   test::load(e, v, tf, bp);
   rp.countSamples = scalar;  // counting samples keeps the frame on the scalar integrator
   e.setRenderParams(rp);
@@ -123,7 +125,8 @@ TEST(CpuMarch, NanInfVoxelsAndACameraInside) {
 
 TEST(CpuMarch, EverySkippingStructureWalksTheSameRunsAsTheScalarIntegrator) {
   // Each lane walks its own ray's runs with the shared iterators: sparse data, where the runs
-  // of neighbouring rays differ, with every CPU builder (the sub-brick part walk among them).
+  // of neighbouring rays differ, with every CPU builder, and Grid and DistanceGrid also with
+  // the sub-brick part walk (Tuning::cpuSubMasks).
   struct Case {
     const char* shape;
     VoxelType type;
@@ -141,17 +144,21 @@ TEST(CpuMarch, EverySkippingStructureWalksTheSameRunsAsTheScalarIntegrator) {
     ASSERT_TRUE(v.scalarRange(lo, hi));
     const TransferFunction tf = TransferFunction::preset(c.tf, lo, hi);
     for (BuilderKind b : builders)
-      for (int variant = 0; variant < 2; ++variant) {
-        RenderParams rp;
-        rp.firstSampleOffset = variant == 0 ? 1.0 : 0.0;
-        rp.ertThreshold = variant == 1 ? 0.95 : 2.0;
-        const std::string what = std::string(c.shape) + " " + builderName(b) + " variant " + std::to_string(variant);
-        const BuildParams bp = test::builder(b, LeafCriterion::Deep, 0, 4, variant == 0 ? 8 : 4);
-        const Image a = render(v, tf, rp, false, 50, 30 - 40 * variant, variant == 1, 53, 45, 1.0, bp);
-        const Image s = render(v, tf, rp, true, 50, 30 - 40 * variant, variant == 1, 53, 45, 1.0, bp);
-        ASSERT_GT(coverage(s), 0.0) << what << " renders nothing";
-        expectSameBits(a, s, what);
-      }
+      for (int parts = 0; parts < (b == BuilderKind::Grid || b == BuilderKind::DistanceGrid ? 2 : 1); ++parts)
+        for (int variant = 0; variant < 2; ++variant) {
+          RenderParams rp;
+          rp.firstSampleOffset = variant == 0 ? 1.0 : 0.0;
+          rp.ertThreshold = variant == 1 ? 0.95 : 2.0;
+          Tuning t;
+          t.cpuSubMasks = parts == 1;
+          const std::string what = std::string(c.shape) + " " + builderName(b) + (parts ? " parts" : "") + " variant " +
+                                   std::to_string(variant);
+          const BuildParams bp = test::builder(b, LeafCriterion::Deep, 0, 4, variant == 0 ? 8 : 4);
+          const Image a = render(v, tf, rp, false, 50, 30 - 40 * variant, variant == 1, 53, 45, 1.0, bp, t);
+          const Image s = render(v, tf, rp, true, 50, 30 - 40 * variant, variant == 1, 53, 45, 1.0, bp, t);
+          ASSERT_GT(coverage(s), 0.0) << what << " renders nothing";
+          expectSameBits(a, s, what);
+        }
   }
 }
 
