@@ -2,6 +2,7 @@
 // values is never classified empty; a TF edit re-classifies bricks only.
 #include "spaceskip/Classification.h"
 #include "spaceskip/render/Integrator.h"
+#include "spaceskip/render/Scattering.h"
 #include "TestUtil.h"
 
 #include <gtest/gtest.h>
@@ -288,9 +289,6 @@ TEST(SubMasks, ThePartWalkYieldsExactlyTheSetParts) {
   // face: a point of the ray strictly inside a part lies in a yielded run exactly when the part
   // is set (the walk clipped to the set parts' box, setPartBox). Brick 8: the cell arithmetic
   // multiplies by 1 / 8; brick 12: it divides.
-  struct EveryBrick {
-    bool active(float, float) const { return true; }
-  };
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   int64_t checked = 0, inside = 0;
@@ -323,7 +321,7 @@ TEST(SubMasks, ThePartWalkYieldsExactlyTheSetParts) {
       it.init(g, r, inv, t0, t1);
       std::vector<std::array<float, 2>> runs;
       float a, b;
-      for (Step st; (st = it.next(EveryBrick{}, a, b)) != Step::Done;) {
+      for (Step st; (st = it.next(AllBricksActive{}, a, b)) != Step::Done;) {
         if (st == Step::Interval) runs.push_back({a, b});
       }
       for (int i = 0; i < 256; ++i) {
