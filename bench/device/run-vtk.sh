@@ -34,8 +34,7 @@
 #          for the mixing layer; TS_CASES), ours against
 #          vtkGPUVolumeRayCastMapper in one window, and the CLI's upload bound: time-series.log) core (Core's GoogleTest binary, then compute-sanitizer memcheck and racecheck on
 #          its CUDA tests: core.log) auto (the CLI's Builder Auto against fixed builders, dense and
-#          sparse 1024^3: cli-bench.log) cli-ab (CLI kernel fps, settings alternated per process:
-#          CLI_AB_RUNS, CLI_AB_DATASETS, CLI_AB_ITEMS: cli-ab.txt)
+#          sparse 1024^3: cli-bench.log)
 #          (default: all, in this order: tests memcheck bench-nbody1024 bench-nbody2048 bench-menger1024
 #          bench-host bench-float bench-ert)
 #   env:   BUNDLE (default ./.vtkbundle), XDISPLAY (77), FRAMES (16), TESTS_ASIS (1: the tests once more
@@ -400,34 +399,6 @@ if has core && ! late && [ -x "$coretests" ]; then
     log "$tool rc=$rc"
     [ $rc -eq 0 ] || status=1
     { echo "==== $tool ($filter) rc=$rc"; grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race|^\[  (PASSED|FAILED) " "$work/core-$tool.log" | head -20; } >> "$out/core.log"
-  done
-fi
-
-# --- Kernel fps (CLI, the paper's protocol) with settings alternated per process ----------------
-# CLI_AB_RUNS: one process each, a comma-separated list of VAR=VALUE (e.g. the layers of
-# segmented frames: SPACESKIP_SEGMENT_LAYERS=dense against the default rect); CLI_AB_DATASETS,
-# CLI_AB_ITEMS; a run "old" (or "old,VAR=VALUE...") uses the older bundle's CLI (OLD_VTK, with
-# bench-oldnew). Key columns of every run into cli-ab.txt.
-if has cli-ab; then
-  n=0
-  for spec in ${CLI_AB_RUNS:-SPACESKIP_SEGMENT_LAYERS=dense SPACESKIP_SEGMENT_LAYERS=rect SPACESKIP_SEGMENT_LAYERS=dense SPACESKIP_SEGMENT_LAYERS=rect}; do
-    late && break
-    n=$((n + 1))
-    log "CLI A/B run $n: $spec"
-    echo "==== run $n: $spec" >> "$work/cli-ab.log"
-    # "old" (alone or first in the list): the CLI of the older bundle (OLD_VTK, unpacked by bench-oldnew).
-    runcli=$cli
-    runenv=${spec//,/ }
-    if [ "${spec%%,*}" = old ]; then
-      runcli=$B/old/vtk/bin/spaceskip
-      runenv="LD_LIBRARY_PATH=$B/old/vtk/lib${LD_LIBRARY_PATH#$B/vtk/lib} ${runenv#old}"
-    fi
-    env $runenv timeout 300 "$runcli" bench --paper \
-      --datasets "${CLI_AB_DATASETS:-nbody_2048,nbody_1024,menger_sponge,kingsnake}" \
-      --builders "${CLI_AB_ITEMS:-distance-grid,distance-grid:hw,auto}" --frames "${CLI_AB_FRAMES:-8}" \
-      --csv "$work/cli-ab-$n.csv" >> "$work/cli-ab.log" 2>&1
-    log "CLI A/B run $n rc=$?"
-    { echo "==== run $n: $spec"; cut -d, -f1,6,7,13,14,17,18,26,33,34 "$work/cli-ab-$n.csv" 2>&1; } >> "$out/cli-ab.txt"
   done
 fi
 
