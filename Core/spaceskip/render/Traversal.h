@@ -91,6 +91,12 @@ struct GridIterT {
   /// x / B (a coordinate in bricks), as a multiplication where that is exact.
   SS_FUNC float inBricks(float x) const { return invB != 0.f ? x * invB : x / B; }
 
+  /// Where the ray meets the face k (0..kSubPerAxis) of the parts of the brick at `base` (its
+  /// low corner along axis a); S is a part's size. The clip, the start and the part DDA share it.
+  SS_FUNC float partFace(int a, float base, float S, int k) const {
+    return (base + float(k) * S - axisOf(org, a)) * axisOf(inv, a);
+  }
+
   /// Starts walking the parts of brick `c` (mask `m`) from t0 to t1. The walk is clipped to
   /// the box of the set parts first (setPartBox; nothing to clip when it is the whole brick):
   /// the parts outside it are unset and a sample on their faces has opacity 0 (the parts' +1
@@ -107,8 +113,8 @@ struct GridIterT {
       const int st = axisOf(step, a);
       if (st == 0 || wholeBox) continue;
       const float base = float(axisOf(c, a)) * B;
-      const float tLo = (base + float(axisOf(lo, a)) * S - axisOf(org, a)) * axisOf(inv, a);
-      const float tHi = (base + float(axisOf(hi, a) + 1) * S - axisOf(org, a)) * axisOf(inv, a);
+      const float tLo = partFace(a, base, S, axisOf(lo, a));
+      const float tHi = partFace(a, base, S, axisOf(hi, a) + 1);
       t0 = ss_max(t0, st > 0 ? tLo : tHi);
       t1 = ss_min(t1, st > 0 ? tHi : tLo);
     }
@@ -126,7 +132,7 @@ struct GridIterT {
       if (st == 0 && (k < axisOf(lo, a) || k > axisOf(hi, a))) mask = 0;
       k = ss_maxi(axisOf(lo, a), ss_mini(k, axisOf(hi, a)));
       setAxis(sc, a, k);
-      setAxis(sNext, a, st == 0 ? INFINITY : (base + float(st > 0 ? k + 1 : k) * S - axisOf(org, a)) * axisOf(inv, a));
+      setAxis(sNext, a, st == 0 ? INFINITY : partFace(a, base, S, st > 0 ? k + 1 : k));
     }
   }
 
