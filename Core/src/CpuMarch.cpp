@@ -128,7 +128,7 @@ struct LaneRuns {
   bool run(float& a, float& b) {
     const PlainMarcher m;
     while (!done) {
-      float x, y;
+      float x = 0.f, y = 0.f;
       const Step st = it.next(m, x, y);
       if (st == Step::Done) {
         done = true;

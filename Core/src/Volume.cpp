@@ -116,6 +116,7 @@ bool finiteRange(const void* data, int64_t n, double& lo, double& hi, int64_t st
       tbb::blocked_range<int64_t>(0, n, kRangeGrain), empty,
       [p, stride, finiteOnly](const tbb::blocked_range<int64_t>& br, MinMax acc) {
         if constexpr (std::is_integral_v<T>) {
+          (void)finiteOnly;  // integers are finite
           T mn = std::numeric_limits<T>::max(), mx = std::numeric_limits<T>::lowest();
           if (stride == 1) {
             for (int64_t i = br.begin(); i < br.end(); ++i) {

@@ -212,7 +212,7 @@ struct IntervalMarcher {
   /// blended with the scattered light (render/Scattering.h) as vtkGPUVolumeRayCastMapper does;
   /// `compW` >= 0, the sample's weight in the pixel's composite, lets its shadow rays be queued.
   SS_FUNC vec3f shadeColor(vec3f rgb, vec3f p, float alpha = -1.f, float compW = -1.f) const {
-    float gx, gy, gz;
+    float gx = 0.f, gy = 0.f, gz = 0.f;
     bool done = false;
     if constexpr (IsNearestSampler<Sampler>::value) {
       if (s->labels()) {

@@ -153,7 +153,11 @@ struct GridIterT {
     invB = (grid.brick & (grid.brick - 1)) == 0 ? 1.f / B : 0.f;
     mask = 0;
     done = !(tmin < tEnd);
-    if (done) return;
+    if (done) {  // next() says Done before it reads the DDA's state; set for the compilers' checks
+      cell = step = vec3i{0, 0, 0};
+      tNext = tDelta = vec3f{0.f, 0.f, 0.f};
+      return;
+    }
     const vec3f p = org + dir * tmin;
     for (int a = 0; a < 3; ++a) {
       int c = int(floorf(inBricks(axisOf(p, a))));
