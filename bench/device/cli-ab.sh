@@ -9,6 +9,8 @@
 # ("B,SPACESKIP_TRAVERSAL_STEPS=2": bundle B with that variable set).
 # A volume is one the CLI reads (gen:nbody:2048, a file) or paper:NAME[,NAME...]: stand-ins of the
 # paper's data sets on its protocol (bench --paper --datasets NAME..., always 1024x1024).
+# OUT gets env.txt, runs.txt, summary.txt and last.err (the last run's stderr): four files, so
+# that two OUTs come back within the device tool's eight.
 #
 #   bash bench/device/cli-ab.sh OUT "gen:nbody:2048 gen:rm:1024" "1024x1024 724x724"
 #   ORDER="A B,SPACESKIP_TRAVERSAL_STEPS=2 B" bash bench/device/cli-ab.sh OUT gen:nbody:2048 1024x1024
@@ -45,7 +47,7 @@ for v in $vols; do
       csv=$out/$x-${v//[:\/,]/_}-$s.csv
       env "${vars[@]}" LD_LIBRARY_PATH=/tmp/ab-$x/lib timeout "${CLI_TIMEOUT:-600}" /tmp/ab-$x/bin/spaceskip bench "${args[@]}" \
         --backend "${BACKEND:-cuda}" --builders "${BUILDER:-distance-grid}" --frames "${FRAMES:-60}" ${EXTRA:-} \
-        --csv "$csv.tmp" > /dev/null 2> "$out/$x.err" || { echo "$side $v $s failed:" >&2; tail -3 "$out/$x.err" >&2; }
+        --csv "$csv.tmp" > /dev/null 2> "$out/last.err" || { echo "$side $v $s failed:" >&2; tail -3 "$out/last.err" >&2; }
       # per row of the CSV: side, data set, item, size, then each asked column's name and value
       [ -s "$csv.tmp" ] && awk -F, -v x="$side" -v s="$s" -v cols="$columns" 'NR == 1 {
           for (i = 1; i <= NF; ++i) at[$i] = i
