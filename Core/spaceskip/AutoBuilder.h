@@ -3,10 +3,11 @@
 //
 // Skipping is lossless, so every candidate draws the same image and only its speed differs.
 // Measuring: every candidate renders a frame, in turn (the first pass); those within kPrune of the
-// first pass's cheapest render again, in the reverse order (the second pass: A B C D, then D C B A,
-// so a drift of the machine's load favours none and the last structure of the first pass needs no
-// rebuild), short frames several times in a row (until kMinMeasureSeconds, at most kMaxRepeats
-// frames: one sub-millisecond frame is at the mercy of a launch's jitter); a candidate's frame time
+// first pass's cheapest (and the first one, whose frame paid the measuring's warm-up) render
+// again, in the reverse order (the second pass: A B C D, then D C B A, so a drift of the machine's
+// load favours none and the last structure of the first pass needs no rebuild), short frames
+// several times in a row (until kMinMeasureSeconds, at most kMaxRepeats frames: one
+// sub-millisecond frame is at the mercy of a launch's jitter); a candidate's frame time
 // is the minimum of its frames (other work only ever adds time). Its cost is that frame time plus
 // its build time spread over kFramesPerBuild frames (cost()): a structure that draws a few percent
 // faster at the measured view but takes milliseconds to rebuild on every opacity edit loses to one
@@ -162,6 +163,7 @@ private:
   int current_ = -1;                  ///< the candidate to draw with (built when it differs from built_)
   int built_ = -1;                    ///< the candidate the backend holds, -1: none (or stale)
   int kept_ = -1;                     ///< the kept structure (during a re-check: the one before it)
+  int firstMeasured_ = -1;            ///< the candidate of the measuring's first frame (its warm-up)
   bool exploring_ = false;            ///< measuring (all candidates, or a re-check)
   bool rechecking_ = false;           ///< this measuring is a re-check of the kept one at a new view
   int pass_ = 0;                      ///< 1 or 2 while measuring all candidates

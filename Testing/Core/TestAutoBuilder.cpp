@@ -5,6 +5,7 @@
 // The protocol is tested on the user's frames (autoProbe 0, CUDA's default) and on probes inside
 // one frame (autoProbe 1, the CPU backend's default).
 #include "TestUtil.h"
+#include "spaceskip/AutoBuilder.h"
 #include "spaceskip/Builders.h"
 
 #include <gtest/gtest.h>
@@ -503,4 +504,40 @@ TEST(AutoBuilder, OnProbesOneFrameDecidesAndDrawsWithTheChoice) {
   EXPECT_FALSE(e.exploring());
   EXPECT_EQ(e.counters().autoProbeMeasurings, 4) << e.buildStats().choice;
   EXPECT_NE(e.buildStats().choice.find("re-checked 1x"), std::string::npos) << e.buildStats().choice;
+}
+
+TEST(AutoBuilder, TheMeasuringsFirstFramePaysItsWarmUpAndPrunesNothing) {
+  // The measuring's first frame also pays its warm-up (cold caches, the thread pool waking): once
+  // Naive's first probe of the dense Wavelet took 46 ms against its usual 16, which pruned it from
+  // the second pass, and Auto kept Grid (20 ms), slower than Naive. Scripted probe times: Naive
+  // first at 3x its time, then its own; the others steady.
+  AutoBuilder ab;
+  ab.start(test::builder(BuilderKind::Auto), BackendKind::CPU);
+  AutoBuilder::ViewKey view;
+  view.dir[2] = 1;
+  view.zoom = view.distance = 1;
+  view.valid = true;
+  std::vector<int> drawn;
+  auto naiveFrames = [&] {
+    return std::count_if(drawn.begin(), drawn.end(), [&](int c) { return ab.candidate(c).builder == BuilderKind::Naive; });
+  };
+  auto drawProbe = [&](int, int) {
+    const int c = ab.chooseBuild(false, false, -1);
+    if (ab.needsBuild()) ab.builtCandidate(c, 0.0);
+    const BuilderKind k = ab.candidate(c).builder;
+    const bool firstNaive = k == BuilderKind::Naive && naiveFrames() == 0;
+    drawn.push_back(c);
+    if (k == BuilderKind::Naive) return firstNaive ? 46e-3 : 16e-3;
+    return k == BuilderKind::Grid ? 20e-3 : 40e-3;
+  };
+  bool decided = false;
+  ASSERT_TRUE(ab.measureOnProbes(256, 256, view, drawProbe, [](double) {}, [] { return 0.5; }, decided));
+  ASSERT_TRUE(decided);
+  EXPECT_EQ(keptOf(ab.choice()), "Naive") << ab.choice();
+  ASSERT_EQ(ab.candidate(drawn.front()).builder, BuilderKind::Naive) << "test premise: Naive is measured first";
+  // Naive drew one frame more, and no candidate that the first pass pruned fairly (40 ms > 1.5 x
+  // 20 ms) drew again.
+  EXPECT_EQ(naiveFrames(), 2);
+  EXPECT_EQ(drawn.size(), size_t(ab.candidates(test::builder(BuilderKind::Auto), BackendKind::CPU).size()) + 2)
+      << "the first pass, Grid once (20 ms: 1 frame reaches 2 ms) and Naive once more";
 }
