@@ -3,7 +3,11 @@
 block started and ended on which SM, what the launch order expected of it, and what the frame
 would have taken in other orders.
 
-  block-trace.py TRACE...
+  block-trace.py [--first N] TRACE...
+
+--first N: also the blocks at launch positions 0..N-1 (a lab build's units launched first, e.g.
+isolated on their SMs): their SM, start, time, the other blocks that ran on that SM beside them,
+and their warps' march iterations and cycles an iteration.
 
 The order's alternatives are played by a list scheduler: SM count x resident blocks slots, each
 block in turn to the slot that frees first, each taking the time it took in the trace. It matched
@@ -51,7 +55,7 @@ def neighbourhood_max(cost, gz, gy, gx, r):
     return out.reshape(-1)
 
 
-def main(paths):
+def main(paths, first=0):
     for path in paths:
         t = load(path)
         n, (gx, gy, gz), hz, blocks = t["n"], t["grid"], t["hz"], t["blocks"]
@@ -95,10 +99,10 @@ def main(paths):
         }
         for name, order in orders.items():
             print(f"  scheduled, {name:27s} {schedule(order, took, slots):7.1f} us")
-        counts(path, t, took)
+        counts(path, t, took, first, dict(sm=sm, unit=unit, start=start, end=end))
 
 
-def counts(path, t, took):
+def counts(path, t, took, first=0, trace=None):
     """With TRACE.counts (each pixel's samples and march iterations in each segment): what the
     slowest blocks' rays did against the median block's. A warp is two rows of a 16 x 8 tile."""
     try:
@@ -134,12 +138,27 @@ def counts(path, t, took):
         print(f"  {name:8s} {took[u]:8.1f}  {u // (gx * gy):7d}  {s.max():8.0f} / {s.mean():7.1f}"
               f"  {i.max():9.0f} / {i.mean():7.1f}  {' '.join(f'{v:.0f}' for v in warp):>20s}"
               f"  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}")
+    if first and trace is not None:
+        sm, unit, start, end = trace["sm"], trace["unit"], trace["start"], trace["end"]
+        print(f"  the first {first} launch positions: position  SM  start us  took us  blocks beside"
+              "  warp max iterations  cycles per warp iteration")
+        for p in range(min(first, len(unit))):
+            u = int(unit[p])
+            beside = int(np.sum((sm == sm[p]) & (start < end[p]) & (end > start[p]))) - 1
+            _, i = block(u)
+            warp = i.reshape(4, 32).max(axis=1)
+            print(f"  {p:8d} {sm[p]:4d} {start[p]:9.1f} {end[p] - start[p]:8.1f} {beside:6d}"
+                  f"  {' '.join(f'{v:.0f}' for v in warp):>20s}  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}")
     total_s, total_i = samples.sum(), iters.sum()
     print(f"  frame: {total_s:.0f} samples, {total_i:.0f} iterations; "
           f"{(samples > 0).sum()} pixel segments with samples of {layers}")
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 2:
+    args = sys.argv[1:]
+    first = 0
+    if args[:1] == ["--first"] and len(args) > 1:
+        first, args = int(args[1]), args[2:]
+    if not args:
         sys.exit(__doc__)
-    main(sys.argv[1:])
+    main(args, first)

@@ -7,7 +7,7 @@
 # BIN is a CLI built with bench/device/block-trace.patch (a measurement build, never main):
 #   git apply bench/device/block-trace.patch && ninja -C build spaceskip &&
 #   bash bench/device/pack-core.sh build && git apply -R bench/device/block-trace.patch
-#   usage: block-trace.sh OUT BIN [VOLUME] [SIZES]
+#   usage: block-trace.sh OUT BIN [VOLUME] [SIZES]   (FIRST=N: block-trace.py --first N)
 set -uo pipefail
 out=$1 bin=$2 vol=${3:-gen:nbody:2048} sizes=${4:-1024x1024 724x724}
 here=$(cd "$(dirname "$0")" && pwd)
@@ -17,4 +17,4 @@ for s in $sizes; do
   SPACESKIP_TRACE_FRAME=40 SPACESKIP_TRACE_OUT="$out/trace-$s.bin" \
     "$bin" bench "$vol" --backend cuda --builders distance-grid --size "$s" --frames 60 > "$out/bench-$s.txt" 2>&1
 done
-python3 "$here/block-trace.py" "$out"/trace-*.bin | tee "$out/summary.txt"
+python3 "$here/block-trace.py" ${FIRST:+--first "$FIRST"} "$out"/trace-*.bin | tee "$out/summary.txt"
