@@ -132,12 +132,14 @@ def counts(path, t, took, first=0, trace=None):
     rows = [("slowest", int(order[k])) for k in range(5)] + [("median", int(order[len(order) // 2]))]
     print("  block         us  segment  samples max/mean  iterations max/mean  warp max iterations"
           "  cycles per warp iteration")
+    def warps(u, i):  # the unit's warps' most iterations, and its cycles over the slowest's
+        warp = i.reshape(4, 32).max(axis=1)
+        return f"{' '.join(f'{v:.0f}' for v in warp):>20s}  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}"
+
     for name, u in rows:
         s, i = block(u)
-        warp = i.reshape(4, 32).max(axis=1)
         print(f"  {name:8s} {took[u]:8.1f}  {u // (gx * gy):7d}  {s.max():8.0f} / {s.mean():7.1f}"
-              f"  {i.max():9.0f} / {i.mean():7.1f}  {' '.join(f'{v:.0f}' for v in warp):>20s}"
-              f"  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}")
+              f"  {i.max():9.0f} / {i.mean():7.1f}  {warps(u, i)}")
     if first and trace is not None:
         sm, unit, start, end = trace["sm"], trace["unit"], trace["start"], trace["end"]
         print(f"  the first {first} launch positions: position  SM  start us  took us  blocks beside"
@@ -145,10 +147,7 @@ def counts(path, t, took, first=0, trace=None):
         for p in range(min(first, len(unit))):
             u = int(unit[p])
             beside = int(np.sum((sm == sm[p]) & (start < end[p]) & (end > start[p]))) - 1
-            _, i = block(u)
-            warp = i.reshape(4, 32).max(axis=1)
-            print(f"  {p:8d} {sm[p]:4d} {start[p]:9.1f} {end[p] - start[p]:8.1f} {beside:6d}"
-                  f"  {' '.join(f'{v:.0f}' for v in warp):>20s}  {took[u] * t['hz'] / 1e6 / max(warp.max(), 1):9.0f}")
+            print(f"  {p:8d} {sm[p]:4d} {start[p]:9.1f} {end[p] - start[p]:8.1f} {beside:6d}  {warps(u, block(u)[1])}")
     total_s, total_i = samples.sum(), iters.sum()
     print(f"  frame: {total_s:.0f} samples, {total_i:.0f} iterations; "
           f"{(samples > 0).sum()} pixel segments with samples of {layers}")
